@@ -1,0 +1,1 @@
+"""Servo buses: one interface (base.Bus), vendor backends, and a factory."""

@@ -1,0 +1,96 @@
+"""The servo-bus interface every backend implements (Dynamixel, Feetech, MuJoCo).
+
+Buses speak ticks and servo ids only; radians live in ``robot.servo_map``.
+Backends do no I/O in their constructor: ``open()`` (or ``with bus:``) connects.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from types import TracebackType
+
+
+@dataclass(frozen=True)
+class ServoInfo:
+    """What a scan learns about one servo.
+
+    id: bus id; model: model number; model_name: datasheet name; firmware: firmware
+    version; return_delay_us: configured return delay [µs]; baud: baud rate it answered at.
+    """
+
+    id: int
+    model: int
+    model_name: str
+    firmware: int | None = None
+    return_delay_us: float | None = None
+    baud: int | None = None
+
+
+@dataclass(frozen=True)
+class ServoState:
+    """One servo's read-back.
+
+    position: present position [ticks]; load: signed load [% of max torque];
+    temperature: [°C]; voltage: [V]; errors: normalised hardware-error names
+    ("overheating", "overload", "voltage", "encoder", "electrical_shock", "overcurrent").
+    """
+
+    id: int
+    position: int
+    load: float | None = None
+    temperature: float | None = None
+    voltage: float | None = None
+    errors: frozenset[str] = field(default_factory=frozenset)
+
+
+class Bus(ABC):
+    """A chain of servos. Use as a context manager; ``close()`` turns torque off."""
+
+    #: "dynamixel" | "feetech" | "sim"
+    kind: str = "abstract"
+
+    @abstractmethod
+    def open(self) -> None:
+        """Connect (open the port / start the simulation). Raises BusError with a fix."""
+
+    @abstractmethod
+    def close(self, *, torque_off: bool = True) -> None:
+        """Disconnect; by default disable torque on every known servo first. Idempotent."""
+
+    @property
+    @abstractmethod
+    def is_open(self) -> bool: ...
+
+    @abstractmethod
+    def ping(self, servo_id: int) -> int | None:
+        """Model number of ``servo_id``, or None if it does not answer."""
+
+    @abstractmethod
+    def scan(self, ids: Iterable[int]) -> list[ServoInfo]:
+        """Every servo among ``ids`` that answers, in id order."""
+
+    @abstractmethod
+    def set_torque(self, ids: Iterable[int], *, enabled: bool) -> None:
+        """Enable or disable torque on ``ids``."""
+
+    @abstractmethod
+    def write_goals(self, goals: Mapping[int, int]) -> None:
+        """Goal positions [ticks] for many servos as ONE sync-write packet."""
+
+    @abstractmethod
+    def read_state(self, ids: Iterable[int]) -> dict[int, ServoState]:
+        """Present state of ``ids`` by sync read. Raises BusError naming a missing id."""
+
+    def read_positions(self, ids: Iterable[int]) -> dict[int, int]:
+        """Present positions [ticks] of ``ids``."""
+        return {i: s.position for i, s in self.read_state(ids).items()}
+
+    def __enter__(self) -> Bus:
+        self.open()
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        self.close()

@@ -1,0 +1,182 @@
+"""Control tables and servo models as data. No address literal lives anywhere else.
+
+Each table maps a register name to ``Register(address, size)``. Sizes are in bytes.
+
+- Dynamixel X series (Protocol 2.0): ROBOTIS e-Manual, "XL430-W250" control table
+  (https://emanual.robotis.com/docs/en/dxl/x/xl430-w250/), shared by the X family.
+- Feetech STS/SMS (little-endian, Protocol-1 style): Feetech "STS/SMS series memory table"
+  (FT-SMS-STS-emanual), as used by feetech-servo-sdk's ``SMS_STS`` definitions.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+
+class Register(NamedTuple):
+    """One control-table entry.
+
+    address: byte address in the servo's control table
+    size: width [bytes]
+    """
+
+    address: int
+    size: int
+
+
+# ROBOTIS e-Manual, X series control table (XL430-W250, XM430, XC430, ...).
+DYNAMIXEL_X: dict[str, Register] = {
+    "model_number": Register(0, 2),
+    "firmware_version": Register(6, 1),
+    "id": Register(7, 1),
+    "baud_rate": Register(8, 1),
+    "return_delay_time": Register(9, 1),
+    "drive_mode": Register(10, 1),
+    "operating_mode": Register(11, 1),
+    "homing_offset": Register(20, 4),
+    "temperature_limit": Register(31, 1),
+    "max_voltage_limit": Register(32, 2),
+    "min_voltage_limit": Register(34, 2),
+    "velocity_limit": Register(44, 4),
+    "max_position_limit": Register(48, 4),
+    "min_position_limit": Register(52, 4),
+    "torque_enable": Register(64, 1),
+    "led": Register(65, 1),
+    "status_return_level": Register(68, 1),
+    "hardware_error_status": Register(70, 1),
+    "profile_acceleration": Register(108, 4),
+    "profile_velocity": Register(112, 4),
+    "goal_position": Register(116, 4),
+    "moving": Register(122, 1),
+    "present_load": Register(126, 2),
+    "present_velocity": Register(128, 4),
+    "present_position": Register(132, 4),
+    "present_input_voltage": Register(144, 2),
+    "present_temperature": Register(146, 1),
+}
+
+# Feetech STS/SMS memory table (STS3215 and siblings), little-endian.
+FEETECH_STS: dict[str, Register] = {
+    "firmware_major": Register(0, 1),
+    "firmware_minor": Register(1, 1),
+    "model_number": Register(3, 2),
+    "id": Register(5, 1),
+    "baud_rate": Register(6, 1),
+    "return_delay_time": Register(7, 1),
+    "status_return_level": Register(8, 1),
+    "min_angle_limit": Register(9, 2),
+    "max_angle_limit": Register(11, 2),
+    "max_temperature_limit": Register(13, 1),
+    "max_voltage_limit": Register(14, 1),
+    "min_voltage_limit": Register(15, 1),
+    "max_torque_limit": Register(16, 2),
+    "homing_offset": Register(31, 2),
+    "operating_mode": Register(33, 1),
+    "torque_enable": Register(40, 1),
+    "acceleration": Register(41, 1),
+    "goal_position": Register(42, 2),
+    "goal_time": Register(44, 2),
+    "goal_speed": Register(46, 2),
+    "torque_limit": Register(48, 2),
+    "lock": Register(55, 1),
+    "present_position": Register(56, 2),
+    "present_speed": Register(58, 2),
+    "present_load": Register(60, 2),
+    "present_voltage": Register(62, 1),
+    "present_temperature": Register(63, 1),
+    "status": Register(65, 1),
+    "moving": Register(66, 1),
+    "present_current": Register(69, 2),
+}
+
+TABLES: dict[str, dict[str, Register]] = {"dynamixel_x": DYNAMIXEL_X, "feetech_sts": FEETECH_STS}
+
+# Hardware-error bits → normalised fault names.
+# Dynamixel X "Hardware Error Status" (70): bit 0 input voltage, 2 overheating,
+# 3 motor encoder, 4 electrical shock, 5 overload.
+DYNAMIXEL_X_ERROR_BITS: dict[int, str] = {
+    0: "voltage",
+    2: "overheating",
+    3: "encoder",
+    4: "electrical_shock",
+    5: "overload",
+}
+# Feetech STS "status" (65): bit 0 voltage, 1 angle sensor, 2 overheating, 3 overcurrent,
+# 5 overload.
+FEETECH_STS_ERROR_BITS: dict[int, str] = {
+    0: "voltage",
+    1: "encoder",
+    2: "overheating",
+    3: "overcurrent",
+    5: "overload",
+}
+ERROR_BITS: dict[str, dict[int, str]] = {
+    "dynamixel_x": DYNAMIXEL_X_ERROR_BITS,
+    "feetech_sts": FEETECH_STS_ERROR_BITS,
+}
+
+# Baud-rate register codes.
+DYNAMIXEL_X_BAUD: dict[int, int] = {
+    0: 9600, 1: 57600, 2: 115200, 3: 1000000, 4: 2000000, 5: 3000000, 6: 4000000,
+}
+FEETECH_STS_BAUD: dict[int, int] = {
+    0: 1000000, 1: 500000, 2: 250000, 3: 128000, 4: 115200, 5: 76800, 6: 57600, 7: 38400,
+}
+BAUD_CODES: dict[str, dict[int, int]] = {
+    "dynamixel_x": DYNAMIXEL_X_BAUD,
+    "feetech_sts": FEETECH_STS_BAUD,
+}
+
+# Unit of one "return delay" register step [s]: Dynamixel X 2 µs, Feetech STS 2 µs.
+RETURN_DELAY_UNIT_S: dict[str, float] = {"dynamixel_x": 2e-6, "feetech_sts": 2e-6}
+
+
+class ServoModel(NamedTuple):
+    """Datasheet facts about one servo model.
+
+    number: model number as reported by ping / the model_number register
+    family: key into TABLES
+    resolution: ticks per revolution
+    stall_torque: stall torque at the nominal voltage [N m]
+    no_load_speed: no-load speed at the nominal voltage [rad/s]
+    mass: [kg]
+    nominal_voltage: [V]
+    """
+
+    name: str
+    number: int
+    family: str
+    resolution: int
+    stall_torque: float
+    no_load_speed: float
+    mass: float
+    nominal_voltage: float
+
+
+_RPM = 2.0 * math.pi / 60.0
+
+MODELS: dict[str, ServoModel] = {
+    # ROBOTIS XL430-W250-T: 1.4 N m, 57 rpm at 11.1 V; 57.2 g.
+    "XL430-W250": ServoModel("XL430-W250", 1060, "dynamixel_x", 4096, 1.4, 57 * _RPM, 0.0572, 11.1),
+    # ROBOTIS XM430-W350: 4.1 N m, 46 rpm at 12 V; 82 g.
+    "XM430-W350": ServoModel("XM430-W350", 1020, "dynamixel_x", 4096, 4.1, 46 * _RPM, 0.082, 12.0),
+    # ROBOTIS XC430-W150: 1.6 N m (12 V stall), 70 rpm; 65 g.
+    "XC430-W150": ServoModel("XC430-W150", 1070, "dynamixel_x", 4096, 1.6, 70 * _RPM, 0.065, 12.0),
+    # Feetech STS3215 (7.4 V): 19.5 kg cm = 1.91 N m, 0.222 s/60 deg; 55 g.
+    "STS3215": ServoModel("STS3215", 777, "feetech_sts", 4096, 1.91, (math.pi / 3) / 0.222, 0.055, 7.4),
+    # Feetech STS3032: 4.5 kg cm = 0.44 N m, 0.1 s/60 deg at 6 V; 17 g.
+    "STS3032": ServoModel("STS3032", 1288, "feetech_sts", 4096, 0.44, (math.pi / 3) / 0.1, 0.017, 6.0),
+}
+
+MODELS_BY_NUMBER: dict[str, dict[int, ServoModel]] = {}
+for _m in MODELS.values():
+    MODELS_BY_NUMBER.setdefault(_m.family, {})[_m.number] = _m
+
+BUS_FAMILIES: dict[str, str] = {"dynamixel": "dynamixel_x", "feetech": "feetech_sts"}
+
+
+def model_name(family: str, number: int) -> str:
+    """Human name of a model number within a family, or ``"unknown(<number>)"``."""
+    model = MODELS_BY_NUMBER.get(family, {}).get(number)
+    return model.name if model else f"unknown({number})"

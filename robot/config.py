@@ -1,0 +1,384 @@
+"""Robot and gait TOML files → frozen, validated dataclasses.
+
+Every error is one line: ``<file>: <field path>: <what is expected>, got <value>``.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import MISSING, dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+from robot.bus.tables import BUS_FAMILIES, MODELS, ServoModel
+from robot.errors import ConfigError
+from robot.params import SPECS, GaitParams, canonical_name, check_value
+
+CONFIG_DIR = Path(__file__).resolve().parent.parent / "configs"
+ROBOTS_DIR = CONFIG_DIR / "robots"
+GAITS_DIR = CONFIG_DIR / "gaits"
+DEFAULT_ROBOT = ROBOTS_DIR / "biped18-dynamixel.toml"
+DEFAULT_GAIT = "walk"
+
+SIDES = ("r", "l")
+LEG_JOINTS = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
+ARM_JOINTS = ("shoulder_pitch", "shoulder_roll", "elbow")
+LEG_NAMES = tuple(f"{s}_{j}" for s in SIDES for j in LEG_JOINTS)
+ARM_NAMES = tuple(f"{s}_{j}" for s in SIDES for j in ARM_JOINTS)
+JOINT_NAMES = LEG_NAMES + ARM_NAMES
+
+
+@dataclass(frozen=True)
+class BusConfig:
+    """kind: "dynamixel" | "feetech"; model: servo model name; port: device; baud [bit/s]."""
+
+    kind: str
+    model: str
+    port: str = "/dev/ttyUSB0"
+    baud: int = 1_000_000
+    retries: int = 2
+    timeout_ms: float = 20.0
+
+    @property
+    def servo(self) -> ServoModel:
+        return MODELS[self.model]
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Kinematic dimensions [m]. Frames: REP-103 (x forward, y left, z up).
+
+    The pelvis frame's origin is midway between the two hip joint centres. All three hip
+    axes (yaw z, roll x, pitch y) meet at the hip centre; the knee is ``thigh`` below it,
+    the ankle (pitch y, roll x) ``shin`` below the knee, the sole ``ankle_height`` below
+    the ankle. Shoulders (pitch y, roll x) sit ``torso_height`` above the pelvis origin and
+    ``shoulder_width / 2`` to each side; the elbow (y) is ``upper_arm`` below, the hand
+    ``forearm`` below the elbow.
+    """
+
+    hip_width: float
+    thigh: float
+    shin: float
+    ankle_height: float
+    foot_length: float
+    foot_width: float
+    foot_forward: float
+    torso_height: float
+    torso_depth: float
+    shoulder_width: float
+    upper_arm: float
+    forearm: float
+
+    @property
+    def leg_length(self) -> float:
+        """Hip centre to ankle with straight knee [m]."""
+        return self.thigh + self.shin
+
+
+@dataclass(frozen=True)
+class Masses:
+    """Link masses including the servos they carry [kg]."""
+
+    torso: float
+    hip_yaw_link: float
+    hip_roll_link: float
+    thigh: float
+    shin: float
+    ankle_link: float
+    foot: float
+    upper_arm: float
+    forearm: float
+    shoulder_link: float = 0.03
+
+    @property
+    def total(self) -> float:
+        leg = (self.hip_yaw_link + self.hip_roll_link + self.thigh + self.shin
+               + self.ankle_link + self.foot)
+        arm = self.shoulder_link + self.upper_arm + self.forearm
+        return self.torso + 2 * leg + 2 * arm
+
+
+@dataclass(frozen=True)
+class JointConfig:
+    """One joint and its servo.
+
+    servo_id: bus id; sign: +1/-1 (servo direction vs joint axis); zero_ticks: ticks at
+    0 rad; min_rad, max_rad: joint limits [rad]; max_speed_rad_s: slew limit [rad/s].
+    """
+
+    name: str
+    servo_id: int
+    sign: int
+    zero_ticks: int
+    min_rad: float
+    max_rad: float
+    max_speed_rad_s: float
+
+
+@dataclass(frozen=True)
+class RobotConfig:
+    name: str
+    bus: BusConfig
+    geometry: Geometry
+    mass: Masses
+    joints: tuple[JointConfig, ...]
+    rest: Mapping[str, float] = field(default_factory=dict)
+    source: str = "<memory>"
+
+    def joint(self, name: str) -> JointConfig:
+        for j in self.joints:
+            if j.name == name:
+                return j
+        raise ConfigError(f"{self.source}: no joint {name!r}; valid: "
+                          f"{', '.join(j.name for j in self.joints)}")
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        return tuple(j.name for j in self.joints)
+
+    @property
+    def has_arms(self) -> bool:
+        return any(j.name in ARM_NAMES for j in self.joints)
+
+    @property
+    def ids(self) -> tuple[int, ...]:
+        return tuple(j.servo_id for j in self.joints)
+
+    def joint_by_id(self, servo_id: int) -> JointConfig | None:
+        for j in self.joints:
+            if j.servo_id == servo_id:
+                return j
+        return None
+
+
+@dataclass(frozen=True)
+class Gait:
+    """A named gait preset: parameters plus where it came from."""
+
+    name: str
+    params: GaitParams
+    source: str = "<memory>"
+
+
+# ---------------------------------------------------------------------------- helpers
+
+
+def _read_toml(path: Path) -> dict[str, Any]:
+    try:
+        with path.open("rb") as f:
+            return tomllib.load(f)
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: file not found") from None
+    except tomllib.TOMLDecodeError as e:
+        raise ConfigError(f"{path}: not valid TOML: {e}") from e
+
+
+def _number(src: str, path: str, value: Any, *, lo: float = -math.inf, hi: float = math.inf,
+            integer: bool = False, positive: bool = False) -> Any:
+    kind = "an integer" if integer else "a number"
+    ok_type = isinstance(value, int) if integer else isinstance(value, (int, float))
+    if isinstance(value, bool) or not ok_type:
+        raise ConfigError(f"{src}: {path}: expected {kind}, got {value!r}")
+    if not math.isfinite(float(value)):
+        raise ConfigError(f"{src}: {path}: expected a finite number, got {value!r}")
+    if positive and value <= 0:
+        raise ConfigError(f"{src}: {path}: expected a positive number, got {value!r}")
+    if not lo <= value <= hi:
+        raise ConfigError(f"{src}: {path}: expected {kind} in [{lo:g}, {hi:g}], got {value!r}")
+    return value if integer else float(value)
+
+
+def _table(src: str, path: str, value: Any) -> dict[str, Any]:
+    if not isinstance(value, dict):
+        raise ConfigError(f"{src}: {path}: expected a table, got {value!r}")
+    return value
+
+
+def _build(cls: Any, src: str, path: str, data: Any, *, overrides: Mapping[str, Any] = {},
+           positive: bool = False) -> Any:
+    """Build a flat dataclass of numbers/strings from a TOML table, checking every field."""
+    data = _table(src, path, data)
+    names = [f.name for f in fields(cls) if f.name not in overrides]
+    unknown = sorted(set(data) - set(names))
+    if unknown:
+        raise ConfigError(f"{src}: {path}.{unknown[0]}: unknown key; valid: {', '.join(names)}")
+    kwargs: dict[str, Any] = dict(overrides)
+    for f in fields(cls):
+        if f.name in overrides:
+            continue
+        fpath = f"{path}.{f.name}"
+        if f.name not in data:
+            if f.default is not MISSING:
+                continue
+            raise ConfigError(f"{src}: {fpath}: missing (expected {f.type})")
+        v = data[f.name]
+        if f.type in ("str", str):
+            if not isinstance(v, str) or not v:
+                raise ConfigError(f"{src}: {fpath}: expected a non-empty string, got {v!r}")
+            kwargs[f.name] = v
+        elif f.type in ("int", int):
+            kwargs[f.name] = _number(src, fpath, v, integer=True)
+        else:
+            kwargs[f.name] = _number(src, fpath, v, positive=positive)
+    return cls(**kwargs)
+
+
+# ---------------------------------------------------------------------------- robots
+
+
+def load_robot(path: str | Path | None = None) -> RobotConfig:
+    """Load and validate a robot TOML file (default: the Dynamixel biped)."""
+    p = Path(path) if path is not None else DEFAULT_ROBOT
+    return parse_robot(_read_toml(p), source=str(p))
+
+
+def parse_robot(data: Mapping[str, Any], *, source: str = "<memory>") -> RobotConfig:
+    src = source
+    allowed = {"name", "bus", "geometry", "mass", "joints", "rest"}
+    unknown = sorted(set(data) - allowed)
+    if unknown:
+        raise ConfigError(f"{src}: {unknown[0]}: unknown key; valid: {', '.join(sorted(allowed))}")
+    for key in ("name", "bus", "geometry", "mass", "joints"):
+        if key not in data:
+            raise ConfigError(f"{src}: {key}: missing")
+    name = data["name"]
+    if not isinstance(name, str) or not name:
+        raise ConfigError(f"{src}: name: expected a non-empty string, got {name!r}")
+
+    bus = _build(BusConfig, src, "bus", data["bus"])
+    if bus.kind not in BUS_FAMILIES:
+        raise ConfigError(f"{src}: bus.kind: expected one of {', '.join(BUS_FAMILIES)}, "
+                          f"got {bus.kind!r}")
+    if bus.model not in MODELS:
+        raise ConfigError(f"{src}: bus.model: unknown servo model {bus.model!r}; valid: "
+                          f"{', '.join(MODELS)}")
+    if MODELS[bus.model].family != BUS_FAMILIES[bus.kind]:
+        raise ConfigError(f"{src}: bus.model: {bus.model} is not a {bus.kind} servo")
+    if bus.baud <= 0:
+        raise ConfigError(f"{src}: bus.baud: expected a positive integer, got {bus.baud}")
+
+    geometry = _build(Geometry, src, "geometry", data["geometry"], positive=True)
+    mass = _build(Masses, src, "mass", data["mass"], positive=True)
+
+    jtab = _table(src, "joints", data["joints"])
+    unknown = sorted(set(jtab) - set(JOINT_NAMES))
+    if unknown:
+        raise ConfigError(f"{src}: joints.{unknown[0]}: unknown joint; valid: "
+                          f"{', '.join(JOINT_NAMES)}")
+    missing = [n for n in LEG_NAMES if n not in jtab]
+    if missing:
+        raise ConfigError(f"{src}: joints.{missing[0]}: missing (every leg joint is required)")
+    arms = [n for n in ARM_NAMES if n in jtab]
+    if arms and len(arms) != len(ARM_NAMES):
+        absent = next(n for n in ARM_NAMES if n not in jtab)
+        raise ConfigError(f"{src}: joints.{absent}: missing (arms need all of "
+                          f"{', '.join(ARM_NAMES)}, or none)")
+    resolution = MODELS[bus.model].resolution
+    joints: list[JointConfig] = []
+    seen: dict[int, str] = {}
+    for jn in JOINT_NAMES:
+        if jn not in jtab:
+            continue
+        jp = f"joints.{jn}"
+        j = _build(JointConfig, src, jp, jtab[jn], overrides={"name": jn})
+        if not 0 <= j.servo_id <= 252:
+            raise ConfigError(f"{src}: {jp}.servo_id: expected an id in [0, 252], got {j.servo_id}")
+        if j.servo_id in seen:
+            raise ConfigError(f"{src}: {jp}.servo_id: duplicate servo id {j.servo_id} "
+                              f"(also joints.{seen[j.servo_id]})")
+        seen[j.servo_id] = jn
+        if j.sign not in (1, -1):
+            raise ConfigError(f"{src}: {jp}.sign: expected +1 or -1, got {j.sign}")
+        if not 0 <= j.zero_ticks < resolution:
+            raise ConfigError(f"{src}: {jp}.zero_ticks: expected an integer in "
+                              f"[0, {resolution - 1}], got {j.zero_ticks}")
+        if not j.min_rad < j.max_rad:
+            raise ConfigError(f"{src}: {jp}: limits reversed or empty: min_rad {j.min_rad} "
+                              f"must be < max_rad {j.max_rad}")
+        if not (-math.pi <= j.min_rad and j.max_rad <= math.pi):
+            raise ConfigError(f"{src}: {jp}: limits must lie within [-pi, pi], got "
+                              f"[{j.min_rad}, {j.max_rad}]")
+        if j.max_speed_rad_s <= 0:
+            raise ConfigError(f"{src}: {jp}.max_speed_rad_s: expected a positive number, "
+                              f"got {j.max_speed_rad_s}")
+        joints.append(j)
+
+    rest_raw = _table(src, "rest", data.get("rest", {}))
+    rest: dict[str, float] = {}
+    names = {j.name: j for j in joints}
+    for jn, v in rest_raw.items():
+        if jn not in names:
+            raise ConfigError(f"{src}: rest.{jn}: unknown joint; valid: {', '.join(names)}")
+        q = _number(src, f"rest.{jn}", v)
+        if not names[jn].min_rad <= q <= names[jn].max_rad:
+            raise ConfigError(f"{src}: rest.{jn}: {q} is outside the joint limits "
+                              f"[{names[jn].min_rad}, {names[jn].max_rad}]")
+        rest[jn] = q
+    return RobotConfig(name=name, bus=bus, geometry=geometry, mass=mass, joints=tuple(joints),
+                       rest=rest, source=src)
+
+
+# ---------------------------------------------------------------------------- gaits
+
+
+def gait_names() -> list[str]:
+    """Names of the bundled gait presets."""
+    return sorted(p.stem for p in GAITS_DIR.glob("*.toml"))
+
+
+def resolve_gait_path(name_or_path: str | Path) -> Path:
+    """A preset name (``walk``) or a path to a TOML file → a path."""
+    s = str(name_or_path)
+    if s.endswith(".toml") or "/" in s or Path(s).exists():
+        return Path(s)
+    p = GAITS_DIR / f"{s}.toml"
+    if not p.exists():
+        raise ConfigError(f"--gait: unknown preset {s!r}; valid: {', '.join(gait_names())} "
+                          f"(or a path to a .toml file)")
+    return p
+
+
+def load_gait(name_or_path: str | Path | None = None) -> Gait:
+    """Load and validate a gait preset by name or path (default: ``walk``)."""
+    p = resolve_gait_path(name_or_path if name_or_path is not None else DEFAULT_GAIT)
+    return parse_gait(_read_toml(p), source=str(p))
+
+
+def parse_gait(data: Mapping[str, Any], *, source: str = "<memory>") -> Gait:
+    src = source
+    allowed = {"name", "fps", "description", "params", "mapping"}
+    unknown = sorted(set(data) - allowed)
+    if unknown:
+        raise ConfigError(f"{src}: {unknown[0]}: unknown key; valid: {', '.join(sorted(allowed))}")
+    name = data.get("name", Path(src).stem)
+    if not isinstance(name, str) or not name:
+        raise ConfigError(f"{src}: name: expected a non-empty string, got {name!r}")
+    values: dict[str, float] = {}
+    if "fps" in data:
+        values["fps"] = check_value("fps", data["fps"], where=f"{src}: fps")
+    for section, paper in (("params", True), ("mapping", False)):
+        table = _table(src, section, data.get(section, {}))
+        for key, v in table.items():
+            where = f"{src}: {section}.{key}"
+            canon = canonical_name(key, where=where)
+            if canon == "fps":
+                raise ConfigError(f"{where}: fps belongs at the top level of the gait file")
+            if SPECS[canon].paper != paper:
+                right = "params" if SPECS[canon].paper else "mapping"
+                raise ConfigError(f"{where}: {canon} belongs in [{right}]")
+            if canon in values:
+                raise ConfigError(f"{where}: {canon} given twice (alias of {canon})")
+            values[canon] = check_value(canon, v, where=where)
+    return Gait(name=name, params=GaitParams().replace(values, where=src), source=src)
+
+
+def gait_to_toml(gait: Gait) -> str:
+    """Serialise a gait so that ``parse_gait`` reads it back unchanged."""
+    p = gait.params.as_dict()
+    lines = [f'name = "{gait.name}"', f"fps = {p['fps']!r}", "", "[params]"]
+    lines += [f"{n} = {p[n]!r}" for n, s in SPECS.items() if s.paper and n != "fps"]
+    lines += ["", "[mapping]"]
+    lines += [f"{n} = {p[n]!r}" for n, s in SPECS.items() if not s.paper]
+    return "\n".join(lines) + "\n"

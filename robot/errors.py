@@ -1,0 +1,26 @@
+"""One root exception for the project; subclasses say which layer failed.
+
+Messages say what was wrong, where (file, field, servo id) and how to fix it.
+"""
+
+from __future__ import annotations
+
+
+class BipedError(Exception):
+    """Root of every error this package raises on purpose."""
+
+
+class ConfigError(BipedError):
+    """A robot or gait file, CLI argument or live parameter is invalid."""
+
+
+class IKError(BipedError):
+    """Inverse kinematics could not produce a pose (never raised inside the control loop)."""
+
+
+class BusError(BipedError):
+    """A servo bus operation failed: names the servo id, its joint, the SDK's message and a fix."""
+
+
+class SafetyStop(BipedError):
+    """The watchdog stopped the robot; the message gives the reason."""

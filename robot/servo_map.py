@@ -1,0 +1,72 @@
+"""Radians ↔ ticks per servo: the only place (with the buses) that knows a tick.
+
+ticks = zero_ticks + sign * q * resolution / (2 pi), rounded, inside the tick limits that
+the joint limits imply.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from robot.config import RobotConfig
+
+
+class ServoMap:
+    """Vectorised joint-angle ↔ goal-tick conversion for one robot.
+
+    Arrays are ordered like ``robot.joints``.
+    """
+
+    def __init__(self, robot: RobotConfig) -> None:
+        res = robot.bus.servo.resolution
+        self.names: tuple[str, ...] = robot.joint_names
+        self.ids: tuple[int, ...] = robot.ids
+        self.resolution = res
+        self.ticks_per_rad = res / (2.0 * math.pi)
+        self.sign = np.array([j.sign for j in robot.joints], dtype=float)
+        self.zero = np.array([j.zero_ticks for j in robot.joints], dtype=float)
+        self.q_min = np.array([j.min_rad for j in robot.joints])
+        self.q_max = np.array([j.max_rad for j in robot.joints])
+        self.max_speed = np.array([j.max_speed_rad_s for j in robot.joints])
+        a = self.zero + self.sign * self.q_min * self.ticks_per_rad
+        b = self.zero + self.sign * self.q_max * self.ticks_per_rad
+        # Tick limits: the ticks strictly inside [q_min, q_max] after rounding.
+        self.tick_min = np.ceil(np.minimum(a, b) - 1e-9).astype(np.int64)
+        self.tick_max = np.floor(np.maximum(a, b) + 1e-9).astype(np.int64)
+        self._index = {n: i for i, n in enumerate(self.names)}
+        self._id_index = {sid: i for i, sid in enumerate(self.ids)}
+
+    def index(self, name: str) -> int:
+        return self._index[name]
+
+    def clamp(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Joint angles clipped to the joint limits [rad]."""
+        return np.clip(np.asarray(q, dtype=float), self.q_min, self.q_max)
+
+    def to_ticks(self, q: npt.ArrayLike) -> npt.NDArray[np.int64]:
+        """Joint angles [rad] → goal ticks, clamped to the limits (never outside them)."""
+        raw = self.zero + self.sign * np.asarray(q, dtype=float) * self.ticks_per_rad
+        return np.clip(np.rint(raw).astype(np.int64), self.tick_min, self.tick_max)
+
+    def to_rad(self, ticks: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Ticks → joint angles [rad] (not clamped: a read-back may be outside limits)."""
+        return (np.asarray(ticks, dtype=float) - self.zero) * self.sign / self.ticks_per_rad
+
+    def goals(self, q: npt.ArrayLike) -> dict[int, int]:
+        """Joint angles [rad] → ``{servo_id: ticks}`` ready for ``Bus.write_goals``."""
+        return dict(zip(self.ids, self.to_ticks(q).tolist(), strict=True))
+
+    def from_positions(self, positions: Mapping[int, int]) -> npt.NDArray[np.float64]:
+        """``{servo_id: ticks}`` (all ids) → joint angles [rad] in joint order."""
+        return self.to_rad([positions[i] for i in self.ids])
+
+    def vector(self, pose: Mapping[str, float], *, default: float = 0.0) -> npt.NDArray[np.float64]:
+        """A ``{joint: rad}`` mapping → an array in joint order (missing joints = default)."""
+        return np.array([pose.get(n, default) for n in self.names], dtype=float)
+
+    def named(self, q: Sequence[float] | npt.NDArray[np.float64]) -> dict[str, float]:
+        return {n: float(v) for n, v in zip(self.names, q, strict=True)}

@@ -37,6 +37,9 @@ class ServoMap:
         # Tick limits: the ticks strictly inside [q_min, q_max] after rounding.
         self.tick_min = np.ceil(np.minimum(a, b) - 1e-9).astype(np.int64)
         self.tick_max = np.floor(np.maximum(a, b) + 1e-9).astype(np.int64)
+        self._rows = list(zip(self.ids, self.zero.tolist(),
+                              (self.sign * self.ticks_per_rad).tolist(),
+                              self.tick_min.tolist(), self.tick_max.tolist(), strict=True))
         self._index = {n: i for i, n in enumerate(self.names)}
         self._id_index = {sid: i for i, sid in enumerate(self.ids)}
 
@@ -56,9 +59,14 @@ class ServoMap:
         """Ticks → joint angles [rad] (not clamped: a read-back may be outside limits)."""
         return (np.asarray(ticks, dtype=float) - self.zero) * self.sign / self.ticks_per_rad
 
-    def goals(self, q: npt.ArrayLike) -> dict[int, int]:
-        """Joint angles [rad] → ``{servo_id: ticks}`` ready for ``Bus.write_goals``."""
-        return dict(zip(self.ids, self.to_ticks(q).tolist(), strict=True))
+    def goals(self, q: Sequence[float]) -> dict[int, int]:
+        """Joint angles [rad] → ``{servo_id: ticks}`` ready for ``Bus.write_goals``,
+        clamped to the tick limits. Pure Python: this runs every control tick."""
+        out: dict[int, int] = {}
+        for (sid, zero, gain, lo, hi), v in zip(self._rows, q, strict=True):
+            t = round(zero + gain * v)
+            out[sid] = lo if t < lo else hi if t > hi else t
+        return out
 
     def from_positions(self, positions: Mapping[int, int]) -> npt.NDArray[np.float64]:
         """``{servo_id: ticks}`` (all ids) → joint angles [rad] in joint order."""

@@ -1,0 +1,51 @@
+"""`biped bench`: kinematic core, buses over the emulator, and the control loop."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+from typing import Any
+
+SECTIONS: dict[str, str] = {
+    "core": "robot.bench:run_core_bench",
+}
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
+    p = sub.add_parser("bench", help="run the benchmarks and report percentiles and ratios")
+    p.add_argument("--only", choices=sorted(SECTIONS), action="append",
+                   help="run only these sections (repeatable)")
+    p.add_argument("--quick", action="store_true", help="fewer iterations (a smoke run)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    return p
+
+
+def _load(ref: str) -> Any:
+    module, func = ref.split(":")
+    return getattr(importlib.import_module(module), func)
+
+
+def _fmt(d: Any, indent: str = "  ") -> list[str]:
+    lines = []
+    for k, v in d.items():
+        if isinstance(v, dict):
+            lines.append(f"{indent}{k}:")
+            lines += _fmt(v, indent + "  ")
+        elif isinstance(v, float):
+            lines.append(f"{indent}{k}: {v:,.3f}")
+        else:
+            lines.append(f"{indent}{k}: {v}")
+    return lines
+
+
+def run(args: argparse.Namespace) -> int:
+    results: dict[str, Any] = {}
+    for name in args.only or list(SECTIONS):
+        results[name] = _load(SECTIONS[name])(quick=args.quick)
+        if not args.json:
+            print(f"{name}:")
+            print("\n".join(_fmt(results[name])))
+    if args.json:
+        print(json.dumps(results, indent=2))
+    return 0

@@ -1,0 +1,42 @@
+"""`biped curves`: the gait's channels and joint angles as a CSV (and a plot)."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+
+import numpy as np
+
+from robot.commands.common import add_robot_args, gait_from, positive_float, robot_from
+from robot.curves_io import plot_curves, write_csv
+from robot.engine import GaitEngine
+
+log = logging.getLogger(__name__)
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
+    p = sub.add_parser("curves", help="write the gait as CSV curves (and a PNG plot)",
+                       description="Evaluate the gait at constant parameters and write the "
+                                   "paper's channels and the joint angles.")
+    add_robot_args(p)
+    p.add_argument("--seconds", type=positive_float, default=4.0, help="duration [s]")
+    p.add_argument("--rate", type=positive_float, default=100.0, help="samples per second")
+    p.add_argument("--out", required=True, metavar="FILE.csv", help="CSV to write")
+    p.add_argument("--plot", metavar="FILE.png", help="also write a plot")
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    robot = robot_from(args)
+    gait = gait_from(args)
+    n = int(round(args.seconds * args.rate)) + 1
+    times = np.arange(n) / args.rate
+    engine = GaitEngine(robot, gait.params)
+    channels, q = engine.curves(times)
+    write_csv(args.out, times, channels, robot.joint_names, q)
+    print(f"wrote {args.out}: {n} rows, gait {gait.name}, robot {robot.name}")
+    if args.plot:
+        plot_curves(args.plot, times, channels, robot.joint_names, q,
+                    title=f"gait {gait.name} on {robot.name}")
+        print(f"wrote {args.plot}")
+    return 0

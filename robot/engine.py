@@ -1,0 +1,166 @@
+"""Gait engine: params + phase + envelope → channels → targets → IK → joint angles.
+
+Pure (no I/O). ``tick(dt)`` serves the control loop on floats; ``curves(times)`` serves
+previs on numpy arrays. Joint angles come out in ``robot.joints`` order, clamped to the
+joint limits; unreachable targets are clamped by the IK and counted, never NaN.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robot import gait
+from robot.config import JOINT_NAMES, RobotConfig
+from robot.ik import arm_ik, leg_ik
+from robot.params import GaitParams
+from robot.targets import BodyTargets, body_targets
+from robot.xmath import Num
+
+log = logging.getLogger(__name__)
+
+
+def solve(t: BodyTargets, robot: RobotConfig) -> tuple[list[Num], Num]:
+    """IK for every joint of ``robot`` (its joint order) and a reachable flag."""
+    g = robot.geometry
+    r = leg_ik(g, "r", t.r_sole, t.r_foot)
+    lft = leg_ik(g, "l", t.l_sole, t.l_foot)
+    q: list[Num] = [*r.q, *lft.q]
+    ok = r.reachable & lft.reachable
+    if robot.has_arms:
+        ra = arm_ik(g, t.r_hand)
+        la = arm_ik(g, t.l_hand)
+        q += [*ra.q, *la.q]
+        ok = ok & ra.reachable & la.reachable
+    return q, ok
+
+
+def _smoothstep(x: float) -> float:
+    x = min(max(x, 0.0), 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+class GaitEngine:
+    """Live gait state for one robot.
+
+    The envelope ramps the gait amplitude in after ``start()`` and out after ``stop()``,
+    over ``ramp_cycles`` gait cycles; the phase starts at 0 (start of the right swing).
+    """
+
+    def __init__(self, robot: RobotConfig, params: GaitParams) -> None:
+        if robot.joint_names != tuple(n for n in JOINT_NAMES if n in robot.joint_names):
+            raise ValueError("robot joints must be in canonical order")
+        self.robot = robot
+        self._params = params
+        self.phase = gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0)
+        self.time = 0.0
+        self._ramp = 0.0          # linear ramp variable in [0, 1]
+        self._running = False
+        self.unreachable_ticks = 0
+        self._lo = [j.min_rad for j in robot.joints]
+        self._hi = [j.max_rad for j in robot.joints]
+
+    # -- parameters -------------------------------------------------------------------
+    @property
+    def params(self) -> GaitParams:
+        return self._params
+
+    def set_params(self, changes: Mapping[str, Any], *, where: str = "parameter") -> GaitParams:
+        """Validate and apply ``changes``; on error nothing changes (ConfigError)."""
+        self._params = self._params.replace(changes, where=where)
+        return self._params
+
+    def replace_params(self, params: GaitParams) -> None:
+        self._params = params
+
+    # -- envelope ---------------------------------------------------------------------
+    def start(self) -> None:
+        self._running = True
+
+    def stop(self) -> None:
+        self._running = False
+
+    @property
+    def amplitude(self) -> float:
+        """Current envelope value in [0, 1]."""
+        return _smoothstep(self._ramp)
+
+    @property
+    def stopped(self) -> bool:
+        """True once a stop has fully ramped out."""
+        return not self._running and self._ramp <= 0.0
+
+    @property
+    def running(self) -> bool:
+        return self._running
+
+    # -- evaluation -------------------------------------------------------------------
+    def pose(self, *, amplitude: float | None = None) -> list[float]:
+        """Joint angles [rad] at the current phase (default: the current envelope)."""
+        a = self.amplitude if amplitude is None else amplitude
+        p = self._params
+        ch = gait.channels(self.phase, p, amplitude=a)
+        q, ok = solve(body_targets(ch, p, self.robot.geometry, amplitude=a), self.robot)
+        if not ok:
+            self.unreachable_ticks += 1
+            if self.unreachable_ticks in (1, 10, 100) or self.unreachable_ticks % 1000 == 0:
+                log.warning("gait target out of reach (%d ticks so far): clamped to the "
+                            "nearest reachable pose; reduce stride, foot height or crouch",
+                            self.unreachable_ticks)
+        lo, hi = self._lo, self._hi
+        return [lo[i] if v < lo[i] else hi[i] if v > hi[i] else float(v)
+                for i, v in enumerate(q)]
+
+    def start_pose(self) -> list[float]:
+        """The pose at phase 0 with the envelope at 0 (where a walk starts and ends)."""
+        saved = self.phase
+        self.phase = gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0)
+        try:
+            return self.pose(amplitude=0.0)
+        finally:
+            self.phase = saved
+
+    def tick(self, dt: float) -> list[float]:
+        """Advance by ``dt`` [s] (phase and envelope) and return the joint angles [rad]."""
+        p = self._params
+        ramp_s = p.ramp_cycles * p.cycle_s
+        step = 1.0 if not math.isfinite(ramp_s) or ramp_s <= 0 else dt / ramp_s
+        if self._running:
+            self._ramp = min(1.0, self._ramp + step)
+        else:
+            self._ramp = max(0.0, self._ramp - step)
+        if self._ramp > 0.0:
+            self.phase = gait.advance(self.phase, p, dt)
+        else:
+            # Fully ramped out: at zero amplitude the pose does not depend on the phase, so
+            # resetting it is invisible and the next start begins a fresh stride.
+            self.phase = gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0)
+        self.time += dt
+        return self.pose()
+
+    def curves(self, times: npt.NDArray[np.float64], *, chunk: int = 16384,
+               with_channels: bool = True
+               ) -> tuple[dict[str, npt.NDArray[np.float64]], npt.NDArray[np.float64]]:
+        """Channels and joint angles (n_joints, n) over ``times`` [s] at full amplitude and
+        constant parameters (vectorised, in cache-sized chunks). ``with_channels=False``
+        returns an empty channel dict and only the joint angles."""
+        times = np.asarray(times, dtype=float)
+        n = times.shape[0]
+        names = gait.CHANNELS if with_channels else ()
+        out_ch = {name: np.empty(n) for name in names}
+        out_q = np.empty((len(self.robot.joints), n))
+        for i in range(0, n, chunk):
+            sl = slice(i, min(i + chunk, n))
+            ch = gait.curves(times[sl], self._params)
+            q, _ = solve(body_targets(ch, self._params, self.robot.geometry), self.robot)
+            for name in names:
+                out_ch[name][sl] = ch[name]
+            for j, v in enumerate(q):
+                out_q[j, sl] = v
+        np.clip(out_q, np.array(self._lo)[:, None], np.array(self._hi)[:, None], out=out_q)
+        return out_ch, out_q

@@ -1,0 +1,104 @@
+"""Paper channels → metric body targets for a physical biped (the documented corrections).
+
+The paper animates a Maya rig (Y up, Z forward, rig units). Here, once:
+- axes: rig Z (forward) → robot x, rig Y (up) → robot z; rig units → metres by
+  ``s = leg_length / rig_leg`` (amplitude scaling by leg length);
+- eq 12: the left foot's stride is put in anti-phase (``+tz * Slgt_L``), as the paper does
+  for the up-legs (eq 14/15) and the arms (eq 17/18); its lift uses the anti-phase of eq 8
+  (``-sin + delta_f``) so delta_f means the same for both feet;
+- foot heights below the ground are stance: clamped at the ground;
+- lateral sway of the pelvis in step with the stride (weight over the stance foot);
+- steering: ``speed`` scales the stride, ``turn`` yaws the feet (hip yaw) and
+  ``side_step`` moves them sideways, both in step with the stride;
+- eq 14/15: the up-leg translations move the pelvis: their mean shifts it forward, their
+  difference yaws it, ``UpLeg_tY`` sets the hip height;
+- eq 3-7 have no spine joint on an 18-DoF biped: ``spine_gain * (StZ_ik - CtZ)`` pitches
+  the torso; eq 10/13 pitch each foot by ``toe_gain * Toe_tY`` while it is lifted;
+- eq 17-20 move each hand relative to its shoulder.
+
+Outputs are in the pelvis frame (feet) and the torso frame relative to each shoulder
+(hands). Floats or numpy arrays, like robot.gait.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+from robot import xmath as xm
+from robot.config import Geometry
+from robot.params import GaitParams
+from robot.xmath import Num, Rot, Vec
+
+HAND_OUT = 0.01  # hands this far outside the shoulder line [m], clear of the torso
+ARM_HANG = 0.92  # hanging hand distance below the shoulder / arm length
+
+
+class BodyTargets(NamedTuple):
+    """Targets for one instant.
+
+    r_sole, l_sole: sole points [m] in the pelvis frame; r_foot, l_foot: foot rotations in
+    the pelvis frame; r_hand, l_hand: hand points [m] relative to each shoulder centre;
+    lift_r, lift_l: foot clearance above the ground [m].
+    """
+
+    r_sole: Vec
+    r_foot: Rot
+    l_sole: Vec
+    l_foot: Rot
+    r_hand: Vec
+    l_hand: Vec
+    lift_r: Num
+    lift_l: Num
+
+
+def scale(g: Geometry, p: GaitParams) -> float:
+    """Metres per rig unit."""
+    return g.leg_length / p.rig_leg
+
+
+def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
+                 amplitude: float = 1.0) -> BodyTargets:
+    """Map the paper's channels (robot.gait.channels at ``amplitude``) to body targets."""
+    s = scale(g, p)
+    a_delta = amplitude * p.delta_f
+    ty, tz = ch["ty"], ch["tz"]
+    sin_t = ty - a_delta                # amplitude * sin(theta)
+    # Pelvis: height from eq 14/15 tY, forward shift and yaw from their tZ.
+    hip_h = p.stance * g.leg_length + g.ankle_height + s * ch["RightUpLeg_tY"]
+    px = s * 0.5 * (ch["RightUpLeg_tZ"] + ch["LeftUpLeg_tZ"])
+    yaw = s * (ch["RightUpLeg_tZ"] - ch["LeftUpLeg_tZ"]) / g.hip_width
+    py = p.sway * (sin_t * xm.cos(p.sway_phase) - tz * xm.sin(p.sway_phase))
+    pitch = p.torso_lean + p.spine_gain * (ch["StZ_ik"] - ch["CtZ"])
+    pelvis_rot = xm.rz_ry(yaw, pitch)
+
+    # Feet in the level frame under the pelvis origin.
+    ty_l = 2.0 * a_delta - ty           # eq 8 in anti-phase
+    lift_r = xm.maximum(s * ch["RightFoot_tY"], 0.0)
+    lift_l = xm.maximum(s * p.Fhgt_L * ty_l, 0.0)
+    stride_r = ch["RightFoot_tZ"] - p.Fpos_R            # -tz * Slgt_R
+    stride_l = -(ch["LeftFoot_tZ"] - p.Fpos_L)          # +tz * Slgt_L (anti-phase)
+    half_w = g.hip_width / 2 + p.foot_spread
+    r_pos = (s * (p.speed * stride_r + p.Fpos_R),
+             -half_w - 0.5 * p.side_step * tz,
+             -hip_h + lift_r)
+    l_pos = (s * (p.speed * stride_l + p.Fpos_L),
+             half_w + 0.5 * p.side_step * tz,
+             -hip_h + lift_l)
+    w_r = xm.clip(ty, 0.0, 1.0)
+    w_l = xm.clip(ty_l, 0.0, 1.0)
+    r_rot = xm.rz_ry(-0.5 * p.turn * tz, -p.toe_gain * ch["RightToe_tY"] * w_r)
+    l_rot = xm.rz_ry(0.5 * p.turn * tz, -p.toe_gain * ch["LeftToe_tY"] * w_l)
+
+    r_sole = xm.apply_t(pelvis_rot, (r_pos[0] - px, r_pos[1] - py, r_pos[2]))
+    l_sole = xm.apply_t(pelvis_rot, (l_pos[0] - px, l_pos[1] - py, l_pos[2]))
+    r_foot = xm.matmul(xm.transpose(pelvis_rot), r_rot)
+    l_foot = xm.matmul(xm.transpose(pelvis_rot), l_rot)
+
+    # Hands relative to the shoulders (torso frame).
+    sa = s * p.arm_scale
+    hang = -ARM_HANG * (g.upper_arm + g.forearm)
+    r_hand = (sa * (ch["RightArm_tZ"] + ch["RightShoulder_tZ"]), -HAND_OUT,
+              hang + sa * (ch["RightArm_tY"] + ch["RightShoulder_tY"]))
+    l_hand = (sa * (ch["LeftArm_tZ"] + ch["LeftShoulder_tZ"]), HAND_OUT,
+              hang + sa * (ch["LeftArm_tY"] + ch["LeftShoulder_tY"]))
+    return BodyTargets(r_sole, r_foot, l_sole, l_foot, r_hand, l_hand, lift_r, lift_l)

@@ -17,6 +17,9 @@ from robot.errors import BipedError
 # Order is the order of `biped --help`.
 COMMANDS: tuple[str, ...] = (
     "curves",
+    "scan",
+    "torque",
+    "pose",
     "bench",
 )
 

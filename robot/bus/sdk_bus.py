@@ -1,0 +1,385 @@
+"""What the Dynamixel and Feetech buses share: one vendor SDK behind ``base.Bus``.
+
+Subclasses set the SDK module, the control-table family and the state block, and
+implement three hooks (packet handler, state decoding, hardware errors). Everything else
+(retries, the SDK's PORT_BUSY and stale-data pitfalls, limit checks, error messages that
+name the servo and its joint) lives here, once.
+
+Not thread-safe by design except for one lock around each transaction.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable, Iterable, Mapping
+from types import ModuleType
+from typing import Any, ClassVar
+
+from robot.bus import health
+from robot.bus.base import Bus, ServoInfo, ServoState
+from robot.bus.tables import (
+    BAUD_CODES,
+    ERROR_BITS,
+    RETURN_DELAY_UNIT_S,
+    TABLES,
+    Register,
+    model_name,
+)
+from robot.config import RobotConfig
+from robot.errors import BusError
+
+log = logging.getLogger(__name__)
+
+
+class TimedPort:
+    """Mixin for an SDK ``PortHandler``: a configurable reply timeout [ms] instead of the
+    SDK's 34 ms, a monotonic clock, and an input flush before every packet (the Feetech
+    SDK's ``clearPort`` only flushes output, so a late reply would be read as the next one).
+    """
+
+    timeout_ms: float = 20.0
+    ser: Any
+    tx_time_per_byte: float
+    packet_start_time: float
+    packet_timeout: float
+
+    def getCurrentTime(self) -> float:
+        return time.monotonic() * 1000.0
+
+    def setPacketTimeout(self, packet_length: int) -> None:
+        self.packet_start_time = self.getCurrentTime()
+        self.packet_timeout = self.tx_time_per_byte * packet_length + self.timeout_ms
+
+    def clearPort(self) -> None:
+        self.ser.reset_input_buffer()
+
+
+def error_names(family: str, bits: int) -> frozenset[str]:
+    """Hardware-error register bits → normalised names (tables.ERROR_BITS)."""
+    return frozenset(name for bit, name in ERROR_BITS[family].items() if bits >> bit & 1)
+
+
+def sign_magnitude(value: int, sign_bit: int) -> int:
+    """Feetech-style sign-magnitude integer → int."""
+    magnitude = value & ((1 << sign_bit) - 1)
+    return -magnitude if value >> sign_bit & 1 else magnitude
+
+
+class SdkBus(Bus):
+    """A servo chain driven through a vendor SDK. Subclasses: DynamixelBus, FeetechBus.
+
+    port: serial device; baud [bit/s]; robot: joints, limits and ids (without it the bus
+    can scan, ping and toggle torque but refuses goals); retries: extra attempts per
+    transaction (default robot.bus.retries, else 2); timeout_ms: reply timeout [ms] per
+    transaction (default robot.bus.timeout_ms, else 20); check_health: run the checks of
+    ``robot.bus.health`` on open (results in ``self.health``).
+    """
+
+    family: ClassVar[str]
+    sdk: ClassVar[ModuleType]
+    port_class: ClassVar[type]
+    state_block: ClassVar[tuple[str, str]]  # first and last register of the read_state block
+    firmware_register: ClassVar[str]
+
+    def __init__(self, port: str, *, baud: int, robot: RobotConfig | None = None,
+                 retries: int | None = None, timeout_ms: float | None = None,
+                 check_health: bool = True) -> None:
+        self.port_name = port
+        self.baud = int(baud)
+        self.robot = robot
+        self.retries = int(retries if retries is not None else
+                           (robot.bus.retries if robot else 2))
+        self.timeout_ms = float(timeout_ms if timeout_ms is not None else
+                                (robot.bus.timeout_ms if robot else 20.0))
+        if self.retries < 0 or not self.timeout_ms > 0:
+            raise BusError(f"retries must be >= 0 and timeout_ms > 0, got {self.retries}, "
+                           f"{self.timeout_ms}")
+        self.check_health = check_health
+        self.table: dict[str, Register] = TABLES[self.family]
+        self.health: list[str] = []
+        self._limits: dict[int, tuple[int, int]] = {}
+        if robot is not None:
+            from robot.servo_map import ServoMap
+
+            sm = ServoMap(robot)
+            for sid, lo, hi in zip(sm.ids, sm.tick_min.tolist(), sm.tick_max.tolist(),
+                                   strict=True):
+                self._limits[sid] = (max(lo, 0), min(hi, sm.resolution - 1))
+        first, last = (self.table[n] for n in self.state_block)
+        self._block_start = first.address
+        self._block_len = last.address + last.size - first.address
+        self._port: Any = None
+        self._ph: Any = None
+        self._writer: Any = None
+        self._reader: Any = None
+        self._reader_ids: tuple[int, ...] = ()
+        self._torqued: set[int] = set()
+        self._lock = threading.RLock()
+
+    # ------------------------------------------------------------------ hooks
+    def _make_packet_handler(self) -> Any:
+        raise NotImplementedError
+
+    def _status_failed(self, error: int) -> bool:
+        """Whether a status packet's error byte means the instruction failed."""
+        return False
+
+    def _decode_state(self, sid: int, block: bytes, status: int) -> ServoState:
+        raise NotImplementedError
+
+    # ------------------------------------------------------------------ lifecycle
+    @property
+    def is_open(self) -> bool:
+        return self._port is not None and bool(self._port.is_open)
+
+    def open(self) -> None:
+        if self.is_open:
+            return
+        port = self.port_class(self.port_name)
+        port.timeout_ms = self.timeout_ms
+        self._port = port
+        self._ph = self._make_packet_handler()
+        self.set_baud(self.baud)
+        goal = self.table["goal_position"]
+        self._writer = self.sdk.GroupSyncWrite(port, self._ph, goal.address, goal.size)
+        health.try_low_latency(port.ser)
+        if self.check_health:
+            try:
+                self.health = health.check(self)
+            except BaseException:
+                self.close(torque_off=False)
+                raise
+
+    def set_baud(self, baud: int) -> None:
+        """(Re)open the port at ``baud`` [bit/s]; raises BusError naming the valid rates."""
+        rates = sorted(BAUD_CODES[self.family].values())
+        try:
+            ok = self._port.setBaudRate(int(baud))
+        except OSError as e:
+            self._port = None
+            raise BusError(f"cannot open {self.port_name}: {e}; is the adapter plugged in "
+                           f"(ls /dev/serial/by-id/) and are you in the dialout group "
+                           f"(sudo usermod -aG dialout $USER)?") from e
+        if not ok:
+            raise BusError(f"baud {baud} is not supported by the {self.kind} SDK; valid: "
+                           f"{', '.join(map(str, rates))}")
+        self.baud = int(baud)
+
+    def close(self, *, torque_off: bool = True) -> None:
+        port, self._port = self._port, None
+        if port is None:
+            return
+        ids = sorted(set(self.robot.ids if self.robot else ()) | self._torqued)
+        if torque_off and ids and port.is_open:
+            try:
+                port.is_using = False
+                reg = self.table["torque_enable"]
+                group = self.sdk.GroupSyncWrite(port, self._ph, reg.address, reg.size)
+                for sid in ids:
+                    group.addParam(sid, [0])
+                result = group.txPacket()
+                if result != self.sdk.COMM_SUCCESS:
+                    log.warning("torque off on close failed: %s", self._ph.getTxRxResult(result))
+            except OSError as e:
+                log.warning("torque off on close failed (port error: %s); servos %s may still "
+                            "hold torque", e, ids)
+        try:
+            if port.is_open:
+                port.closePort()
+        except OSError as e:
+            log.debug("closing %s: %s", self.port_name, e)
+
+    # ------------------------------------------------------------------ messages
+    def who(self, sid: int) -> str:
+        """``id 7 (l_hip_roll)``: the servo and its joint when the robot config knows it."""
+        joint = self.robot.joint_by_id(sid) if self.robot else None
+        return f"id {sid} ({joint.name})" if joint else f"id {sid}"
+
+    def _fix(self, result: int | None, sid: int | None) -> str:
+        scan = f"`biped scan --bus {self.kind} --port {self.port_name}`"
+        if result == self.sdk.COMM_RX_CORRUPT:
+            return ("replies are garbled: check cable and ground, lower the baud rate, or look "
+                    f"for two servos sharing an id with {scan}")
+        if result in (self.sdk.COMM_TX_FAIL, self.sdk.COMM_PORT_BUSY, None):
+            return (f"is {self.port_name} still plugged in and not used by another program? "
+                    "reconnect the adapter and retry")
+        target = f"of {self.who(sid)}" if sid is not None else "of the servos"
+        return f"check power and wiring {target}; is the baud rate right? try {scan}"
+
+    def _error(self, sid: int | None, what: str, detail: str, result: int | None) -> BusError:
+        where = f"{self.who(sid)}: " if sid is not None else ""
+        return BusError(f"{self.kind} {self.port_name} @ {self.baud}: {where}{what} failed: "
+                        f"{detail}; {self._fix(result, sid)}")
+
+    # ------------------------------------------------------------------ transactions
+    def _begin(self) -> Any:
+        if not self.is_open:
+            raise BusError(f"{self.kind} bus on {self.port_name} is not open; call open() or "
+                           "use `with bus:`")
+        self._port.is_using = False  # an earlier exception must not leave PORT_BUSY set
+        return self._port
+
+    def _transact(self, what: str, sid: int | None, fn: Callable[[], tuple[Any, int, int]],
+                  *, missing_ok: bool = False,
+                  blame: Callable[[], int | None] | None = None) -> tuple[Any, int]:
+        """Run one SDK exchange ``fn() -> (value, comm result, status byte)`` with retries.
+
+        Returns (value, status byte); (None, 0) for a silent servo when ``missing_ok``.
+        ``blame()`` names the servo at fault after a failed group exchange.
+        """
+        result = self.sdk.COMM_SUCCESS
+        with self._lock:
+            for attempt in range(self.retries + 1):
+                port = self._begin()
+                try:
+                    value, result, error = fn()
+                except OSError as e:
+                    port.is_using = False
+                    raise self._error(sid, what, f"port error: {e}", None) from e
+                if result == self.sdk.COMM_SUCCESS:
+                    if self._status_failed(error):
+                        raise self._error(sid, what, self._ph.getRxPacketError(error), result)
+                    return value, error
+                if missing_ok and result == self.sdk.COMM_RX_TIMEOUT:
+                    return None, 0
+                log.debug("%s %s attempt %d: %s", what, self.who(sid) if sid is not None else "",
+                          attempt + 1, self._ph.getTxRxResult(result))
+        detail = f"{self._ph.getTxRxResult(result)} (after {self.retries + 1} attempts)"
+        if blame is not None:
+            sid = blame()
+            what = f"{what} (no valid reply from it)" if sid is not None else what
+        raise self._error(sid, what, detail, result)
+
+    def read_register(self, sid: int, name: str) -> int:
+        """Unsigned value of register ``name`` of servo ``sid``."""
+        reg = self.table[name]
+        data, _ = self._transact(f"read {name}", sid, lambda: self._ph.readTxRx(
+            self._port, sid, reg.address, reg.size))
+        return int.from_bytes(bytes(data[:reg.size]), "little")
+
+    def write_register(self, sid: int, name: str, value: int) -> None:
+        """Write register ``name`` of servo ``sid`` and wait for its status reply."""
+        reg = self.table[name]
+        data = list(int(value).to_bytes(reg.size, "little", signed=value < 0))
+        self._transact(f"write {name}={value}", sid, lambda: (None, *self._ph.writeTxRx(
+            self._port, sid, reg.address, reg.size, data)))
+
+    # ------------------------------------------------------------------ Bus API
+    def ping(self, servo_id: int) -> int | None:
+        model, _ = self._transact("ping", servo_id, lambda: self._ph.ping(self._port, servo_id),
+                                  missing_ok=True)
+        return None if model is None else int(model)
+
+    def scan(self, ids: Iterable[int]) -> list[ServoInfo]:
+        found: list[ServoInfo] = []
+        unit_us = RETURN_DELAY_UNIT_S[self.family] * 1e6
+        for sid in sorted(set(ids)):
+            model = self.ping(sid)
+            if model is None:
+                continue
+            found.append(ServoInfo(
+                id=sid, model=model, model_name=model_name(self.family, model),
+                firmware=self.read_register(sid, self.firmware_register),
+                return_delay_us=self.read_register(sid, "return_delay_time") * unit_us,
+                baud=self.baud))
+        return found
+
+    def set_torque(self, ids: Iterable[int], *, enabled: bool) -> None:
+        failures: list[BusError] = []
+        for sid in sorted(set(ids)):
+            try:
+                self.write_register(sid, "torque_enable", int(enabled))
+            except BusError as e:
+                failures.append(e)
+            else:
+                (self._torqued.add if enabled else self._torqued.discard)(sid)
+        if failures:
+            more = f" (and {len(failures) - 1} more servos)" if len(failures) > 1 else ""
+            raise BusError(f"{failures[0]}{more}") from failures[0]
+
+    def write_goals(self, goals: Mapping[int, int]) -> None:
+        if not goals:
+            return
+        size = self.table["goal_position"].size
+        params = [(sid, list(self._check_goal(sid, t).to_bytes(size, "little")))
+                  for sid, t in goals.items()]
+
+        def send() -> tuple[None, int, int]:
+            self._writer.clearParam()
+            for sid, data in params:
+                self._writer.addParam(sid, data)
+            return None, self._writer.txPacket(), 0
+
+        self._transact("sync write goal_position", None, send)
+
+    def _check_goal(self, sid: int, ticks: int) -> int:
+        t = int(ticks)
+        if t != ticks:
+            raise BusError(f"write_goals: goal for {self.who(sid)} must be whole ticks, got "
+                           f"{ticks!r}")
+        if sid not in self._limits:
+            if self.robot is None:
+                raise BusError("write_goals: this bus has no robot config, so it cannot check "
+                               "joint limits; construct it with robot=...")
+            raise BusError(f"write_goals: id {sid} is not a servo of robot {self.robot.name}; "
+                           f"valid ids: {', '.join(map(str, sorted(self._limits)))}")
+        lo, hi = self._limits[sid]
+        if not lo <= t <= hi:
+            raise BusError(f"write_goals: goal {t} ticks for {self.who(sid)} is outside its "
+                           f"limits [{lo}, {hi}] ticks; refusing to move it (clamp first, e.g. "
+                           "ServoMap.to_ticks)")
+        return t
+
+    def read_state(self, ids: Iterable[int]) -> dict[int, ServoState]:
+        ids = tuple(dict.fromkeys(ids))
+        if not ids:
+            return {}
+        raw = self._sync_read(ids)
+        return {sid: self._decode_state(sid, block, status) for sid, (block, status)
+                in raw.items()}
+
+    def _sync_read(self, ids: tuple[int, ...]) -> dict[int, tuple[bytes, int]]:
+        """One sync read of the state block: {id: (block bytes, status byte)}.
+
+        Replies are collected here rather than in GroupSyncRead.rxPacket so that only data
+        received in *this* exchange is used (that SDK keeps stale data after a failure) and
+        the status byte of each servo is kept. Retried as a whole; raises naming the first
+        servo that did not answer (the ones after it are silenced by it).
+        """
+        n = self._block_len
+        with self._lock:
+            if self._reader is None or ids != self._reader_ids:
+                self._reader = self.sdk.GroupSyncRead(self._begin(), self._ph,
+                                                      self._block_start, n)
+                for sid in ids:
+                    self._reader.addParam(sid)
+                self._reader_ids = ids
+            got: dict[int, tuple[bytes, int]] = {}
+            failed: list[int | None] = [None]
+
+            def exchange() -> tuple[None, int, int]:
+                got.clear()
+                failed[0] = None
+                result = self._reader.txPacket()
+                if result != self.sdk.COMM_SUCCESS:
+                    return None, result, 0
+                for sid in ids:
+                    data, result, error = self._ph.readRx(self._port, sid, n)
+                    if result == self.sdk.COMM_SUCCESS and len(data) < n:
+                        result = self.sdk.COMM_RX_CORRUPT
+                    if result != self.sdk.COMM_SUCCESS:
+                        failed[0] = sid
+                        return None, result, 0
+                    got[sid] = (bytes(data), error)
+                return None, result, 0
+
+            self._transact("sync read state", None, exchange, blame=lambda: failed[0])
+            return got
+
+    def field(self, block: bytes, name: str) -> int:
+        """Unsigned little-endian value of register ``name`` inside a state block."""
+        reg = self.table[name]
+        start = reg.address - self._block_start
+        return int.from_bytes(block[start:start + reg.size], "little")

@@ -21,6 +21,7 @@ COMMANDS: tuple[str, ...] = (
     "torque",
     "pose",
     "bench",
+    "mjcf",
 )
 
 

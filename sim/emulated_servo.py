@@ -1,0 +1,361 @@
+"""One emulated servo: a control table (bytearray) laid out by ``robot.bus.tables``.
+
+The servo is protocol-agnostic: the wire codecs (``sim.dxl_protocol``, ``sim.sts_protocol``)
+call :meth:`EmulatedServo.read` / :meth:`EmulatedServo.write` with raw addresses and bytes.
+Motion is evaluated lazily: call :meth:`EmulatedServo.update` with the current time [s]
+before touching the table; present position then moves toward goal position at the model's
+no-load speed while torque is enabled.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import NamedTuple
+
+from robot.bus.tables import (
+    BAUD_CODES,
+    ERROR_BITS,
+    MODELS,
+    RETURN_DELAY_UNIT_S,
+    TABLES,
+    Register,
+)
+
+#: Registers a host may not write (the servo answers with an access error).
+READ_ONLY: frozenset[str] = frozenset({
+    "model_number", "firmware_version", "firmware_major", "firmware_minor",
+    "hardware_error_status", "moving", "status", "present_load", "present_velocity",
+    "present_speed", "present_position", "present_input_voltage", "present_voltage",
+    "present_temperature", "present_current",
+})
+#: Dynamixel registers holding two's-complement signed values.
+DXL_SIGNED: frozenset[str] = frozenset({
+    "homing_offset", "goal_position", "present_load", "present_velocity", "present_position",
+})
+#: Allowed raw values of a few registers [inclusive range]; others accept any value.
+VALID_RANGE: dict[str, tuple[int, int]] = {
+    "torque_enable": (0, 1),
+    "led": (0, 1),
+    "status_return_level": (0, 2),
+    "return_delay_time": (0, 254),
+    "id": (0, 252),
+}
+#: Factory defaults by register name (raw units), applied after the model's own values.
+DEFAULTS: dict[str, dict[str, int]] = {
+    "dynamixel_x": {
+        "firmware_version": 46, "operating_mode": 3, "status_return_level": 2,
+        "temperature_limit": 72,
+        "max_voltage_limit": 140, "min_voltage_limit": 60, "velocity_limit": 265,
+        "present_input_voltage": 115, "present_temperature": 35,
+    },
+    "feetech_sts": {
+        "firmware_major": 3, "firmware_minor": 10, "status_return_level": 1,
+        "max_temperature_limit": 70, "max_voltage_limit": 140, "min_voltage_limit": 40,
+        "max_torque_limit": 1000, "torque_limit": 1000, "lock": 1,
+        "present_voltage": 74, "present_temperature": 35,
+    },
+}
+
+
+class WriteError(enum.Enum):
+    """Why a write was refused; each codec maps it to its protocol's error code."""
+
+    NONE = 0
+    ACCESS = 1       # read-only, unknown or EEPROM-while-torque-on address
+    RANGE = 2        # value outside the register's allowed range
+    LIMIT = 3        # goal outside the position limits
+    LENGTH = 4       # the write covers part of a register
+
+
+@dataclass(frozen=True)
+class ServoSpec:
+    """What the emulator needs to build one servo.
+
+    servo_id: bus id; model: key of ``tables.MODELS``; zero_ticks: initial present
+    position [ticks]; min_ticks/max_ticks: position limits [ticks]; baud: [bit/s].
+    """
+
+    servo_id: int
+    model: str
+    zero_ticks: int
+    min_ticks: int
+    max_ticks: int
+    baud: int
+
+
+class EmulatedServo:
+    """Control table plus a first-order position model for one servo."""
+
+    def __init__(self, spec: ServoSpec, now: float) -> None:
+        self.spec = spec
+        self.model = MODELS[spec.model]
+        self.family = self.model.family
+        self.table: dict[str, Register] = TABLES[self.family]
+        self.mem = bytearray(max(r.address + r.size for r in self.table.values()))
+        self._owner = bytearray(len(self.mem))  # 0: no register; else index+1
+        self._regs = list(self.table.items())
+        for i, (_, reg) in enumerate(self._regs):
+            self._owner[reg.address:reg.address + reg.size] = bytes([i + 1]) * reg.size
+        self.conditions: set[str] = set()   # injected hardware faults (names of ERROR_BITS)
+        self.speed_tps = self.model.no_load_speed * self.model.resolution / (2 * math.pi)
+        codes = {b: c for c, b in BAUD_CODES[self.family].items()}
+        if spec.baud not in codes:
+            raise ValueError(f"servo {spec.servo_id}: baud {spec.baud} is not a "
+                             f"{self.family} rate; valid: {sorted(codes)}")
+        values = dict(DEFAULTS[self.family])
+        values.update(model_number=self.model.number, id=spec.servo_id,
+                      baud_rate=codes[spec.baud], return_delay_time=0,
+                      present_position=spec.zero_ticks, goal_position=spec.zero_ticks)
+        if self.family == "dynamixel_x":
+            values.update(max_position_limit=spec.max_ticks, min_position_limit=spec.min_ticks)
+        else:
+            values.update(max_angle_limit=spec.max_ticks, min_angle_limit=spec.min_ticks)
+        for name, v in values.items():
+            self.set(name, v)
+        self._pos = float(spec.zero_ticks)
+        self._t = now
+
+    # ------------------------------------------------------------------ raw access
+    def get(self, name: str) -> int:
+        """Value of a register by name (signed where the Dynamixel table says so)."""
+        reg = self.table[name]
+        signed = self.family == "dynamixel_x" and name in DXL_SIGNED
+        return int.from_bytes(self.mem[reg.address:reg.address + reg.size], "little",
+                              signed=signed)
+
+    def set(self, name: str, value: int) -> None:
+        """Store a register by name without any check (the emulator's back door)."""
+        reg = self.table[name]
+        bits = 8 * reg.size
+        self.mem[reg.address:reg.address + reg.size] = (value % (1 << bits)).to_bytes(
+            reg.size, "little")
+        if name == "present_position":
+            self._pos = float(self.get(name))
+
+    def snapshot(self) -> dict[str, int]:
+        return {name: self.get(name) for name in self.table}
+
+    @property
+    def servo_id(self) -> int:
+        return self.get("id")
+
+    @property
+    def baud(self) -> int | None:
+        """The rate [bit/s] the servo listens at (from its baud_rate register)."""
+        return BAUD_CODES[self.family].get(self.get("baud_rate"))
+
+    @property
+    def return_delay_s(self) -> float:
+        return self.get("return_delay_time") * RETURN_DELAY_UNIT_S[self.family]
+
+    @property
+    def status_return_level(self) -> int:
+        return self.get("status_return_level")
+
+    @property
+    def error_register(self) -> str:
+        return "hardware_error_status" if self.family == "dynamixel_x" else "status"
+
+    # ------------------------------------------------------------------ behaviour
+    def update(self, now: float) -> None:
+        """Advance the position model to ``now`` [s, time.monotonic()]."""
+        dt = max(0.0, now - self._t)
+        self._t = now
+        self._assert_faults()
+        goal = self.get("goal_position")
+        if self.get("torque_enable"):
+            step = self.speed_tps * dt
+            self._pos = min(goal, self._pos + step) if goal > self._pos else max(
+                goal, self._pos - step)
+        present = round(self._pos)
+        reg = self.table["present_position"]
+        self.mem[reg.address:reg.address + reg.size] = (present % (1 << 8 * reg.size)).to_bytes(
+            reg.size, "little")
+        self.set("moving", int(present != goal and bool(self.get("torque_enable"))))
+
+    def _assert_faults(self) -> None:
+        bits = {name: bit for bit, name in ERROR_BITS[self.family].items()}
+        value = 0
+        for name in self.conditions:
+            value |= 1 << bits[name]
+        if self.family == "dynamixel_x":
+            # X series latch hardware errors until reboot and drop torque (shutdown).
+            value |= self.get("hardware_error_status")
+            if value:
+                self.set("torque_enable", 0)
+        self.set(self.error_register, value)
+
+    @property
+    def error_bits(self) -> int:
+        return self.get(self.error_register)
+
+    def read(self, address: int, length: int) -> bytes | None:
+        """``length`` bytes from ``address``, or None when the range leaves the table."""
+        if address < 0 or length < 0 or address + length > len(self.mem):
+            return None
+        return bytes(self.mem[address:address + length])
+
+    def write(self, address: int, data: bytes) -> WriteError:
+        """Apply a host write if every byte lands in whole, writable registers."""
+        end = address + len(data)
+        if address < 0 or end > len(self.mem) or not data:
+            return WriteError.ACCESS
+        touched: list[tuple[str, Register]] = []
+        for a in range(address, end):
+            owner = self._owner[a]
+            if not owner:
+                return WriteError.ACCESS
+            name, reg = self._regs[owner - 1]
+            if not touched or touched[-1][0] != name:
+                touched.append((name, reg))
+        if touched[0][1].address < address or touched[-1][1].address + touched[-1][1].size > end:
+            return WriteError.LENGTH
+        eeprom_end = self.table["torque_enable"].address
+        values: dict[str, int] = {}
+        for name, reg in touched:
+            if name in READ_ONLY:
+                return WriteError.ACCESS
+            if (self.family == "dynamixel_x" and reg.address < eeprom_end
+                    and self.get("torque_enable")):
+                return WriteError.ACCESS
+            raw = data[reg.address - address:reg.address - address + reg.size]
+            values[name] = decode_value(self.family, reg.address, raw)
+            err = self._check(name, values[name])
+            if err is not WriteError.NONE:
+                return err
+            if name == "goal_position" and self.family == "feetech_sts":
+                values[name] = min(max(values[name], self.get("min_angle_limit")),
+                                   self.get("max_angle_limit"))
+        shutdown = self.family == "dynamixel_x" and self.get("hardware_error_status") != 0
+        for name, v in values.items():
+            if name == "torque_enable" and shutdown:
+                continue  # refused while in shutdown; the status carries the alert bit
+            self.set(name, v)
+        return WriteError.NONE
+
+    def _check(self, name: str, value: int) -> WriteError:
+        lo_hi = VALID_RANGE.get(name)
+        if lo_hi and not lo_hi[0] <= value <= lo_hi[1]:
+            return WriteError.RANGE
+        if name == "baud_rate" and value not in BAUD_CODES[self.family]:
+            return WriteError.RANGE
+        if name == "goal_position" and self.family == "dynamixel_x":
+            if not self.get("min_position_limit") <= value <= self.get("max_position_limit"):
+                return WriteError.LIMIT
+        return WriteError.NONE
+
+    def reboot(self) -> None:
+        """Dynamixel reboot: clear latched errors and torque; goal := present."""
+        self.set("hardware_error_status", 0)
+        self.set("torque_enable", 0)
+        self.set("goal_position", round(self._pos))
+        self._assert_faults()
+
+
+def decode_value(family: str, address: int, data: bytes) -> int:
+    """A written value as the log shows it: little-endian, signed for signed registers."""
+    signed = family == "dynamixel_x" and any(
+        reg.address == address and reg.size == len(data) and name in DXL_SIGNED
+        for name, reg in TABLES[family].items())
+    return int.from_bytes(data, "little", signed=signed)
+
+
+# ---------------------------------------------------------------------- codec → chain
+
+
+class Reply(NamedTuple):
+    """One status packet to send: from ``servo_id``, after ``delay_s`` [s] of return delay."""
+
+    servo_id: int
+    data: bytes
+    delay_s: float
+
+
+class Handled(NamedTuple):
+    """What a codec made of one instruction packet: the log fields plus the replies."""
+
+    instruction: str
+    ids: tuple[int, ...]
+    address: int | None
+    values: dict[int, int]
+    length: int | None
+    replies: list[Reply]
+
+
+def chain_replies(hearing: Mapping[int, EmulatedServo], items: Sequence[tuple[int, int, int]],
+                  read_status: Callable[[EmulatedServo, int, int], bytes]) -> list[Reply]:
+    """Status packets for (id, address, length) reads in request order (sync/bulk read).
+
+    A missing servo is silent and, as on a real chain, silences every servo after it.
+    """
+    replies = []
+    for sid, address, n in items:
+        servo = hearing.get(sid)
+        if servo is None:
+            break
+        replies.append(Reply(sid, read_status(servo, address, n), servo.return_delay_s))
+    return replies
+
+
+def sync_write(family: str, address: int, length: int, chunk: bytes,
+               hearing: Mapping[int, EmulatedServo]) -> dict[int, int]:
+    """Apply ``(id, data[length])*`` to the servos that hear it; return id → value written."""
+    values: dict[int, int] = {}
+    step = 1 + length
+    for i in range(0, len(chunk) - step + 1, step):
+        sid, data = chunk[i], chunk[i + 1:i + step]
+        values[sid] = decode_value(family, address, data)
+        if sid in hearing:
+            hearing[sid].write(address, data)
+    return values
+
+
+class FrameParser:
+    """Incremental instruction-packet parser; subclasses give the framing rules.
+
+    ``feed`` returns every complete (servo_id, instruction, params); packets failing the
+    checksum are counted in ``bad_checksum`` and skipped (resync one byte later).
+    """
+
+    header: bytes = b""
+    prefix_len: int = 0
+
+    def __init__(self) -> None:
+        self.buf = bytearray()
+        self.bad_checksum = 0
+
+    def total_length(self, prefix: bytes) -> int | None:
+        """Whole packet length [bytes] from its first ``prefix_len`` bytes; None: no packet."""
+        raise NotImplementedError
+
+    def decode(self, packet: bytes) -> tuple[int, int, bytes] | None:
+        """(servo_id, instruction, params), or None when the checksum is wrong."""
+        raise NotImplementedError
+
+    def feed(self, data: bytes) -> list[tuple[int, int, bytes]]:
+        self.buf += data
+        out: list[tuple[int, int, bytes]] = []
+        while True:
+            start = self.buf.find(self.header)
+            if start < 0:
+                del self.buf[:max(0, len(self.buf) - (len(self.header) - 1))]
+                return out
+            del self.buf[:start]
+            if len(self.buf) < self.prefix_len:
+                return out
+            total = self.total_length(bytes(self.buf[:self.prefix_len]))
+            if total is None:
+                del self.buf[:1]
+                continue
+            if len(self.buf) < total:
+                return out
+            frame = self.decode(bytes(self.buf[:total]))
+            if frame is None:
+                self.bad_checksum += 1
+                del self.buf[:1]
+                continue
+            del self.buf[:total]
+            out.append(frame)

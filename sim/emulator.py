@@ -1,0 +1,495 @@
+"""A chain of emulated servos on a pseudo-terminal, served from its own process.
+
+The real vendor SDKs (dynamixel_sdk, scservo_sdk) open the pty's slave path like a USB
+adapter and talk Dynamixel Protocol 2.0 (``sim.dxl_protocol``) or Feetech STS
+(``sim.sts_protocol``) to it. The test process drives faults and reads the log through a
+``multiprocessing`` pipe while the child serves.
+
+- Time: every time stamp is ``time.monotonic()`` [s] (system-wide on Linux, so comparable
+  between the test process and the child). Motion is evaluated lazily at each packet.
+- Baud: a pty carries no baud rate, but pyserial stores the requested speed in the slave's
+  termios; the child holds the slave open and reads that speed (``TCGETS2``) at every
+  packet. A servo whose ``baud_rate`` register names another rate does not hear the packet
+  (counted as ``baud_mismatch``), so "wrong baud: nothing answers" is testable.
+- Replies come back as fast as the pty allows (no wire-time emulation) after each servo's
+  return delay (``return_delay_time`` x 2 us). A missing servo costs the SDK its timeout.
+- Hardware faults: Dynamixel X latches ``hardware_error_status`` until reboot and drops
+  torque (shutdown), every status packet then carries the alert bit 0x80; Feetech's
+  ``status`` register follows the injected condition live and is the reply's error byte.
+- Log: one :class:`Packet` per instruction packet with a valid checksum that at least one
+  servo heard. Broadcast writes log id 254. Written values are decoded little-endian
+  (signed for Dynamixel's signed registers); for bulk reads ``values`` maps id → address.
+"""
+
+from __future__ import annotations
+
+import array
+import collections
+import fcntl
+import logging
+import math
+import os
+import random
+import select
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+import tty
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from multiprocessing.connection import Connection
+from pathlib import Path
+from types import ModuleType, TracebackType
+from typing import Any
+
+from robot.bus.tables import BAUD_CODES, BUS_FAMILIES, ERROR_BITS, MODELS, TABLES
+from robot.config import RobotConfig
+from robot.errors import BipedError
+from sim import dxl_protocol, sts_protocol
+from sim.emulated_servo import EmulatedServo, ServoSpec
+
+log = logging.getLogger(__name__)
+
+ROOT = Path(__file__).resolve().parent.parent   # puts `sim` and `robot` on the child's path
+
+DEFAULT_MODEL = {"dynamixel": "XL430-W250", "feetech": "STS3215"}
+DEFAULT_BAUD = 1_000_000
+CENTER_TICKS = 2048
+LOG_MAX = 200_000            # packets kept in the child
+REPLY_TIMEOUT_S = 5.0        # control-channel answer [s]
+START_TIMEOUT_S = 20.0       # child start-up [s]
+TCGETS2 = 0x802C542A         # Linux ioctl: struct termios2 (44 bytes), c_ospeed at word 10
+TERMIOS2_WORDS = 11
+TERMIOS2_OSPEED = 10
+COUNTER_KEYS = ("rx_bytes", "tx_bytes", "rx_packets", "tx_packets", "rx_bad_checksum",
+                "dropped", "corrupted", "baud_mismatch", "tx_overflow")
+
+
+class EmulatorError(BipedError):
+    """The emulator was misused or its child process failed."""
+
+
+@dataclass(frozen=True)
+class Packet:
+    """One received instruction packet.
+
+    t: reception time [s, time.monotonic()]; instruction: "ping", "read", "write",
+    "reboot", "sync_read", "sync_write", "fast_sync_read", "bulk_read", ...; ids: target
+    ids in packet order; address: start address (None for ping/reboot/bulk); values:
+    written value per id (writes), start address per id (bulk read), else empty;
+    length: data length [bytes] where the instruction has one.
+    """
+
+    t: float
+    instruction: str
+    ids: tuple[int, ...]
+    address: int | None
+    values: dict[int, int] = field(default_factory=dict)
+    length: int | None = None
+
+
+@dataclass(frozen=True)
+class ChainSpec:
+    protocol: str
+    servos: tuple[ServoSpec, ...]
+    seed: int = 0
+
+
+# ============================================================================ child side
+
+
+class _ChainServer:
+    """Runs in the child: owns the pty, the servos and the fault state."""
+
+    def __init__(self, spec: ChainSpec, conn: Connection) -> None:
+        self.conn = conn
+        self.codec: ModuleType = dxl_protocol if spec.protocol == "dynamixel" else sts_protocol
+        self.parser = self.codec.Parser()
+        now = time.monotonic()
+        self.servos = [EmulatedServo(s, now) for s in spec.servos]
+        self.rng = random.Random(spec.seed)
+        self.log: collections.deque[Packet] = collections.deque(maxlen=LOG_MAX)
+        self.counters: dict[str, int] = dict.fromkeys(
+            [*COUNTER_KEYS, *self.codec.NAMES.values()], 0)
+        self.drop_rate = self.corrupt_rate = 0.0
+        self.missing: set[int] = set()
+        self.vanish: dict[int, float] = {}
+        master, slave = os.openpty()
+        tty.setraw(slave)
+        os.set_blocking(master, False)
+        self.master: int | None = master
+        self.slave: int | None = slave
+        self.path = os.ttyname(slave)
+
+    def by_id(self, servo_id: int) -> EmulatedServo:
+        for s in self.servos:
+            if s.servo_id == servo_id:
+                return s
+        raise EmulatorError(f"no emulated servo with id {servo_id}; ids: "
+                            f"{sorted(s.servo_id for s in self.servos)}")
+
+    def port_speed(self) -> int | None:
+        """The baud rate [bit/s] the host configured on the slave, if readable."""
+        if self.slave is None:
+            return None
+        buf = array.array("I", [0] * TERMIOS2_WORDS)
+        try:
+            fcntl.ioctl(self.slave, TCGETS2, buf)
+        except OSError:
+            return None
+        return int(buf[TERMIOS2_OSPEED]) or None
+
+    # ------------------------------------------------------------------ wire
+    def on_bytes(self, data: bytes) -> None:
+        self.counters["rx_bytes"] += len(data)
+        before = self.parser.bad_checksum
+        frames = self.parser.feed(data)
+        self.counters["rx_bad_checksum"] += self.parser.bad_checksum - before
+        for servo_id, inst, params in frames:
+            now = time.monotonic()
+            speed = self.port_speed()
+            present = [s for s in self.servos if s.servo_id not in self.missing
+                       and self.vanish.get(s.servo_id, float("inf")) > now]
+            hearing = {s.servo_id: s for s in present if speed is None or s.baud == speed}
+            if present and not hearing:
+                self.counters["baud_mismatch"] += 1
+                continue
+            for s in hearing.values():
+                s.update(now)
+            h = self.codec.handle(servo_id, inst, params, hearing)
+            self.counters["rx_packets"] += 1
+            self.counters[h.instruction] = self.counters.get(h.instruction, 0) + 1
+            self.log.append(Packet(now, h.instruction, h.ids, h.address, h.values, h.length))
+            for r in h.replies:
+                self.send(r.data, r.delay_s)
+
+    def send(self, data: bytes, delay_s: float) -> None:
+        if self.rng.random() < self.drop_rate:
+            self.counters["dropped"] += 1
+            return
+        if self.rng.random() < self.corrupt_rate:
+            self.counters["corrupted"] += 1
+            data = data[:-1] + bytes([data[-1] ^ 0xFF])   # the checksum / CRC high byte
+        if delay_s > 0:
+            time.sleep(delay_s)
+        if self.master is None:
+            return
+        try:
+            n = os.write(self.master, data)
+        except (BlockingIOError, OSError):
+            n = 0
+        if n < len(data):
+            self.counters["tx_overflow"] += 1
+        self.counters["tx_bytes"] += n
+        self.counters["tx_packets"] += 1
+
+    def close_port(self) -> None:
+        for fd in (self.master, self.slave):
+            if fd is not None:
+                os.close(fd)
+        self.master = self.slave = None
+
+    # ------------------------------------------------------------------ control
+    def on_request(self, cmd: str, args: tuple[Any, ...]) -> Any:
+        if cmd == "faults":
+            return self.set_faults(args[0])
+        if cmd == "clear":
+            self.drop_rate = self.corrupt_rate = 0.0
+            self.missing.clear()
+            self.vanish.clear()
+            for s in self.servos:
+                s.conditions.clear()
+            return None
+        if cmd == "log":
+            out = list(self.log)
+            if args[0]:
+                self.log.clear()
+            return out
+        if cmd == "counters":
+            return dict(self.counters)
+        if cmd == "registers":
+            s = self.by_id(args[0])
+            s.update(time.monotonic())
+            return s.snapshot()
+        if cmd == "set_register":
+            s = self.by_id(args[0])
+            s.update(time.monotonic())
+            s.set(args[1], args[2])
+            return None
+        raise EmulatorError(f"unknown emulator request {cmd!r}")
+
+    def set_faults(self, f: dict[str, Any]) -> None:
+        if f.get("drop_rate") is not None:
+            self.drop_rate = f["drop_rate"]
+        if f.get("corrupt_rate") is not None:
+            self.corrupt_rate = f["corrupt_rate"]
+        if f.get("missing_ids") is not None:
+            self.missing = set(f["missing_ids"])
+        self.vanish.update(f.get("vanish_at") or {})
+        for sid, kind in (f.get("hw_error") or {}).items():
+            s = self.by_id(sid)
+            s.conditions = {kind} if kind else set()
+            s.update(time.monotonic())
+        if f.get("close_port"):
+            self.close_port()
+
+    def serve(self) -> None:
+        self.conn.send(("ready", self.path))
+        while True:
+            fds: list[Any] = [self.conn] + ([self.master] if self.master is not None else [])
+            readable, _, _ = select.select(fds, [], [])
+            if self.master is not None and self.master in readable:
+                try:
+                    data = os.read(self.master, 4096)
+                except (BlockingIOError, InterruptedError):
+                    data = b""
+                except OSError:      # EIO: nobody has the slave open (cannot happen: we do)
+                    data = b""
+                if data:
+                    self.on_bytes(data)
+            if self.conn in readable:
+                try:
+                    cmd, args = self.conn.recv()
+                except (EOFError, OSError):
+                    return           # the parent is gone
+                if cmd == "stop":
+                    self.conn.send(("ok", None))
+                    return
+                try:
+                    self.conn.send(("ok", self.on_request(cmd, args)))
+                except Exception as e:  # noqa: BLE001 - report every failure to the parent
+                    self.conn.send(("error", f"{type(e).__name__}: {e}"))
+
+
+def _child_main(fd: int) -> None:
+    """Child-process entry point: ``fd`` is the control socket; the spec comes first."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)   # the parent decides when to stop
+    conn = Connection(fd)
+    try:
+        spec = conn.recv()
+        server = _ChainServer(spec, conn)
+    except Exception as e:  # noqa: BLE001 - tell the parent why we could not start
+        conn.send(("error", f"{type(e).__name__}: {e}"))
+        conn.close()
+        return
+    try:
+        server.serve()
+    finally:
+        server.close_port()
+        conn.close()
+
+
+# ============================================================================ parent side
+
+
+def _limits(robot: RobotConfig | None, servo_id: int, resolution: int) -> tuple[int, int, int]:
+    """(zero, min, max) [ticks] for ``servo_id`` from the robot's joint, else the full turn."""
+    joint = robot.joint_by_id(servo_id) if robot is not None else None
+    if joint is None:
+        return CENTER_TICKS, 0, resolution - 1
+    per_rad = resolution / (2 * math.pi)
+    ends = [joint.zero_ticks + joint.sign * q * per_rad for q in (joint.min_rad, joint.max_rad)]
+    lo = max(0, int(min(ends)))
+    hi = min(resolution - 1, int(max(ends) + 0.999999))
+    return joint.zero_ticks, lo, hi
+
+
+class Emulator:
+    """A servo chain on a pty in a child process. No I/O until :meth:`start`."""
+
+    def __init__(self, protocol: str, robot: RobotConfig | None = None, *,
+                 ids: Sequence[int] | None = None, model: str | None = None, seed: int = 0,
+                 baud: int | None = None) -> None:
+        if protocol not in BUS_FAMILIES:
+            raise EmulatorError(f"protocol: expected one of {', '.join(BUS_FAMILIES)}, "
+                                f"got {protocol!r}")
+        self.protocol = protocol
+        self.family = BUS_FAMILIES[protocol]
+        same_kind = robot is not None and robot.bus.kind == protocol
+        model = model or (robot.bus.model if robot is not None and same_kind
+                          else DEFAULT_MODEL[protocol])
+        if model not in MODELS or MODELS[model].family != self.family:
+            valid = [m for m, s in MODELS.items() if s.family == self.family]
+            raise EmulatorError(f"model: {model!r} is not a {protocol} servo; valid: "
+                                f"{', '.join(valid)}")
+        if ids is None:
+            if robot is None:
+                raise EmulatorError("Emulator needs a robot config or ids=[...]")
+            ids = robot.ids
+        baud = baud or (robot.bus.baud if robot is not None and same_kind else DEFAULT_BAUD)
+        if baud not in BAUD_CODES[self.family].values():
+            raise EmulatorError(f"baud: {baud} is not a {protocol} rate; valid: "
+                                f"{sorted(BAUD_CODES[self.family].values())}")
+        resolution = MODELS[model].resolution
+        specs = []
+        for sid in ids:
+            zero, lo, hi = _limits(robot, sid, resolution)
+            specs.append(ServoSpec(sid, model, zero, lo, hi, baud))
+        self.model = model
+        self.baud = baud
+        self.ids = tuple(ids)
+        self.spec = ChainSpec(protocol, tuple(specs), seed)
+        self._proc: subprocess.Popen[bytes] | None = None
+        self._conn: Connection | None = None
+        self._port: str | None = None
+        self._lock = threading.Lock()
+
+    # ------------------------------------------------------------------ lifecycle
+    def start(self) -> str:
+        """Start the child; return the pty slave path (e.g. ``/dev/pts/5``).
+
+        The child is a fresh interpreter (``python -c``), not a ``multiprocessing`` spawn,
+        so callers need no ``if __name__ == "__main__"`` guard; the control channel is a
+        socketpair wrapped in a ``multiprocessing`` Connection.
+        """
+        if self._port is not None:
+            return self._port
+        parent_sock, child_sock = socket.socketpair()
+        fd = child_sock.fileno()
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(
+            p for p in (str(ROOT), env.get("PYTHONPATH", "")) if p)
+        self._proc = subprocess.Popen(
+            [sys.executable, "-c", f"from sim.emulator import _child_main; _child_main({fd})"],
+            pass_fds=[fd], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, env=env)
+        child_sock.close()
+        self._conn = Connection(parent_sock.detach())
+        try:
+            self._conn.send(self.spec)
+            if not self._conn.poll(START_TIMEOUT_S):
+                raise EmulatorError(
+                    f"the emulator process did not start within {START_TIMEOUT_S} s")
+            tag, path = self._conn.recv()
+        except (OSError, EOFError) as e:
+            self.stop()
+            raise EmulatorError("the emulator process died while starting (see its "
+                                "stderr)") from e
+        except EmulatorError:
+            self.stop()
+            raise
+        if tag != "ready":
+            self.stop()
+            raise EmulatorError(f"the emulator failed to start: {path}")
+        self._port = str(path)
+        log.info("emulating %d %s servos (%s, %d bit/s) on %s", len(self.ids), self.model,
+                 self.protocol, self.baud, self._port)
+        return self._port
+
+    def stop(self) -> None:
+        """Stop the child and close the pty. Idempotent."""
+        conn, proc = self._conn, self._proc
+        self._conn = self._proc = None
+        self._port = None
+        if conn is not None:
+            try:
+                conn.send(("stop", ()))
+                if conn.poll(1.0):
+                    conn.recv()
+            except (OSError, EOFError):
+                pass
+            conn.close()
+        if proc is not None:
+            try:
+                proc.wait(2.0)
+            except subprocess.TimeoutExpired:
+                proc.terminate()
+                proc.wait(2.0)
+
+    @property
+    def port(self) -> str:
+        if self._port is None:
+            raise EmulatorError("the emulator is not running; call start() first")
+        return self._port
+
+    @property
+    def alive(self) -> bool:
+        return self._proc is not None and self._proc.poll() is None
+
+    def __enter__(self) -> Emulator:
+        self.start()
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        self.stop()
+
+    # ------------------------------------------------------------------ control
+    def _call(self, cmd: str, *args: Any) -> Any:
+        with self._lock:
+            if self._conn is None:
+                raise EmulatorError("the emulator is not running; call start() first")
+            try:
+                self._conn.send((cmd, args))
+                if not self._conn.poll(REPLY_TIMEOUT_S):
+                    raise EmulatorError(f"the emulator did not answer {cmd!r} within "
+                                        f"{REPLY_TIMEOUT_S} s")
+                tag, payload = self._conn.recv()
+            except (OSError, EOFError) as e:
+                raise EmulatorError(f"the emulator process is gone ({e!r})") from e
+        if tag == "error":
+            raise EmulatorError(payload)
+        return payload
+
+    def set_faults(self, *, drop_rate: float | None = None, corrupt_rate: float | None = None,
+                   missing_ids: Iterable[int] | None = None,
+                   vanish: Mapping[int, float] | None = None,
+                   hw_error: Mapping[int, str | None] | None = None,
+                   close_port: bool = False) -> None:
+        """Change faults while serving; unspecified ones keep their setting.
+
+        drop_rate / corrupt_rate: share of replies lost / sent with a bad checksum [0..1];
+        missing_ids: ids that never answer (replaces the set); vanish: id → seconds from now
+        after which it stops answering; hw_error: id → "overheating" | "overload" |
+        "voltage" | ... (names in tables.ERROR_BITS) or None to end the condition;
+        close_port: close the pty (the SDK then gets an error; the log stays readable).
+        """
+        for name, rate in (("drop_rate", drop_rate), ("corrupt_rate", corrupt_rate)):
+            if rate is not None and not 0.0 <= rate <= 1.0:
+                raise EmulatorError(f"{name}: expected a share in [0, 1], got {rate}")
+        kinds = set(ERROR_BITS[self.family].values())
+        for sid, kind in (hw_error or {}).items():
+            if kind is not None and kind not in kinds:
+                raise EmulatorError(f"hw_error[{sid}]: unknown fault {kind!r}; valid: "
+                                    f"{', '.join(sorted(kinds))}")
+        now = time.monotonic()
+        self._call("faults", {
+            "drop_rate": drop_rate, "corrupt_rate": corrupt_rate,
+            "missing_ids": None if missing_ids is None else list(missing_ids),
+            "vanish_at": {sid: now + t for sid, t in (vanish or {}).items()},
+            "hw_error": dict(hw_error or {}), "close_port": close_port,
+        })
+
+    def clear_faults(self) -> None:
+        """End every injected fault (a latched Dynamixel hardware error needs a reboot)."""
+        self._call("clear")
+
+    def log(self, *, clear: bool = False) -> list[Packet]:
+        """Every logged instruction packet, oldest first; ``clear`` empties the log."""
+        return list(self._call("log", clear))
+
+    def counters(self) -> dict[str, int]:
+        """Packets per instruction name, plus rx/tx bytes and packets and fault counts."""
+        return dict(self._call("counters"))
+
+    def registers(self, servo_id: int) -> dict[str, int]:
+        """Snapshot of one servo's control table by register name (motion brought to now)."""
+        return dict(self._call("registers", servo_id))
+
+    def set_register(self, servo_id: int, name: str, value: int) -> None:
+        """Store a register without the checks a host write gets (e.g. return_delay_time)."""
+        if name not in TABLES[self.family]:
+            raise EmulatorError(f"register {name!r} is not in the {self.family} table; "
+                                f"valid: {', '.join(TABLES[self.family])}")
+        self._call("set_register", servo_id, name, int(value))
+
+    def set_baud(self, baud: int) -> None:
+        """Make every servo listen at ``baud`` [bit/s] (writes their baud_rate register)."""
+        codes = {b: c for c, b in BAUD_CODES[self.family].items()}
+        if baud not in codes:
+            raise EmulatorError(f"baud: {baud} is not a {self.protocol} rate; valid: "
+                                f"{sorted(codes)}")
+        for sid in self.ids:
+            self.set_register(sid, "baud_rate", codes[baud])

@@ -20,6 +20,7 @@ COMMANDS: tuple[str, ...] = (
     "scan",
     "torque",
     "pose",
+    "emulate",
     "bench",
     "mjcf",
 )

@@ -23,33 +23,26 @@ adapter and talk Dynamixel Protocol 2.0 (``sim.dxl_protocol``) or Feetech STS
 
 from __future__ import annotations
 
-import array
-import collections
-import fcntl
 import logging
 import math
 import os
-import random
-import select
-import signal
 import socket
 import subprocess
 import sys
 import threading
 import time
-import tty
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
 from multiprocessing.connection import Connection
 from pathlib import Path
-from types import ModuleType, TracebackType
+from types import TracebackType
 from typing import Any
 
 from robot.bus.tables import BAUD_CODES, BUS_FAMILIES, ERROR_BITS, MODELS, TABLES
 from robot.config import RobotConfig
-from robot.errors import BipedError
-from sim import dxl_protocol, sts_protocol
-from sim.emulated_servo import EmulatedServo, ServoSpec
+from sim.emulated_servo import ServoSpec
+from sim.emulator_server import ChainSpec, EmulatorError, Packet
+
+__all__ = ["ChainSpec", "Emulator", "EmulatorError", "Packet"]
 
 log = logging.getLogger(__name__)
 
@@ -58,231 +51,8 @@ ROOT = Path(__file__).resolve().parent.parent   # puts `sim` and `robot` on the 
 DEFAULT_MODEL = {"dynamixel": "XL430-W250", "feetech": "STS3215"}
 DEFAULT_BAUD = 1_000_000
 CENTER_TICKS = 2048
-LOG_MAX = 200_000            # packets kept in the child
 REPLY_TIMEOUT_S = 5.0        # control-channel answer [s]
 START_TIMEOUT_S = 20.0       # child start-up [s]
-TCGETS2 = 0x802C542A         # Linux ioctl: struct termios2 (44 bytes), c_ospeed at word 10
-TERMIOS2_WORDS = 11
-TERMIOS2_OSPEED = 10
-COUNTER_KEYS = ("rx_bytes", "tx_bytes", "rx_packets", "tx_packets", "rx_bad_checksum",
-                "dropped", "corrupted", "baud_mismatch", "tx_overflow")
-
-
-class EmulatorError(BipedError):
-    """The emulator was misused or its child process failed."""
-
-
-@dataclass(frozen=True)
-class Packet:
-    """One received instruction packet.
-
-    t: reception time [s, time.monotonic()]; instruction: "ping", "read", "write",
-    "reboot", "sync_read", "sync_write", "fast_sync_read", "bulk_read", ...; ids: target
-    ids in packet order; address: start address (None for ping/reboot/bulk); values:
-    written value per id (writes), start address per id (bulk read), else empty;
-    length: data length [bytes] where the instruction has one.
-    """
-
-    t: float
-    instruction: str
-    ids: tuple[int, ...]
-    address: int | None
-    values: dict[int, int] = field(default_factory=dict)
-    length: int | None = None
-
-
-@dataclass(frozen=True)
-class ChainSpec:
-    protocol: str
-    servos: tuple[ServoSpec, ...]
-    seed: int = 0
-
-
-# ============================================================================ child side
-
-
-class _ChainServer:
-    """Runs in the child: owns the pty, the servos and the fault state."""
-
-    def __init__(self, spec: ChainSpec, conn: Connection) -> None:
-        self.conn = conn
-        self.codec: ModuleType = dxl_protocol if spec.protocol == "dynamixel" else sts_protocol
-        self.parser = self.codec.Parser()
-        now = time.monotonic()
-        self.servos = [EmulatedServo(s, now) for s in spec.servos]
-        self.rng = random.Random(spec.seed)
-        self.log: collections.deque[Packet] = collections.deque(maxlen=LOG_MAX)
-        self.counters: dict[str, int] = dict.fromkeys(
-            [*COUNTER_KEYS, *self.codec.NAMES.values()], 0)
-        self.drop_rate = self.corrupt_rate = 0.0
-        self.missing: set[int] = set()
-        self.vanish: dict[int, float] = {}
-        master, slave = os.openpty()
-        tty.setraw(slave)
-        os.set_blocking(master, False)
-        self.master: int | None = master
-        self.slave: int | None = slave
-        self.path = os.ttyname(slave)
-
-    def by_id(self, servo_id: int) -> EmulatedServo:
-        for s in self.servos:
-            if s.servo_id == servo_id:
-                return s
-        raise EmulatorError(f"no emulated servo with id {servo_id}; ids: "
-                            f"{sorted(s.servo_id for s in self.servos)}")
-
-    def port_speed(self) -> int | None:
-        """The baud rate [bit/s] the host configured on the slave, if readable."""
-        if self.slave is None:
-            return None
-        buf = array.array("I", [0] * TERMIOS2_WORDS)
-        try:
-            fcntl.ioctl(self.slave, TCGETS2, buf)
-        except OSError:
-            return None
-        return int(buf[TERMIOS2_OSPEED]) or None
-
-    # ------------------------------------------------------------------ wire
-    def on_bytes(self, data: bytes) -> None:
-        self.counters["rx_bytes"] += len(data)
-        before = self.parser.bad_checksum
-        frames = self.parser.feed(data)
-        self.counters["rx_bad_checksum"] += self.parser.bad_checksum - before
-        for servo_id, inst, params in frames:
-            now = time.monotonic()
-            speed = self.port_speed()
-            present = [s for s in self.servos if s.servo_id not in self.missing
-                       and self.vanish.get(s.servo_id, float("inf")) > now]
-            hearing = {s.servo_id: s for s in present if speed is None or s.baud == speed}
-            if present and not hearing:
-                self.counters["baud_mismatch"] += 1
-                continue
-            for s in hearing.values():
-                s.update(now)
-            h = self.codec.handle(servo_id, inst, params, hearing)
-            self.counters["rx_packets"] += 1
-            self.counters[h.instruction] = self.counters.get(h.instruction, 0) + 1
-            self.log.append(Packet(now, h.instruction, h.ids, h.address, h.values, h.length))
-            for r in h.replies:
-                self.send(r.data, r.delay_s)
-
-    def send(self, data: bytes, delay_s: float) -> None:
-        if self.rng.random() < self.drop_rate:
-            self.counters["dropped"] += 1
-            return
-        if self.rng.random() < self.corrupt_rate:
-            self.counters["corrupted"] += 1
-            data = data[:-1] + bytes([data[-1] ^ 0xFF])   # the checksum / CRC high byte
-        if delay_s > 0:
-            time.sleep(delay_s)
-        if self.master is None:
-            return
-        try:
-            n = os.write(self.master, data)
-        except (BlockingIOError, OSError):
-            n = 0
-        if n < len(data):
-            self.counters["tx_overflow"] += 1
-        self.counters["tx_bytes"] += n
-        self.counters["tx_packets"] += 1
-
-    def close_port(self) -> None:
-        for fd in (self.master, self.slave):
-            if fd is not None:
-                os.close(fd)
-        self.master = self.slave = None
-
-    # ------------------------------------------------------------------ control
-    def on_request(self, cmd: str, args: tuple[Any, ...]) -> Any:
-        if cmd == "faults":
-            return self.set_faults(args[0])
-        if cmd == "clear":
-            self.drop_rate = self.corrupt_rate = 0.0
-            self.missing.clear()
-            self.vanish.clear()
-            for s in self.servos:
-                s.conditions.clear()
-            return None
-        if cmd == "log":
-            out = list(self.log)
-            if args[0]:
-                self.log.clear()
-            return out
-        if cmd == "counters":
-            return dict(self.counters)
-        if cmd == "registers":
-            s = self.by_id(args[0])
-            s.update(time.monotonic())
-            return s.snapshot()
-        if cmd == "set_register":
-            s = self.by_id(args[0])
-            s.update(time.monotonic())
-            s.set(args[1], args[2])
-            return None
-        raise EmulatorError(f"unknown emulator request {cmd!r}")
-
-    def set_faults(self, f: dict[str, Any]) -> None:
-        if f.get("drop_rate") is not None:
-            self.drop_rate = f["drop_rate"]
-        if f.get("corrupt_rate") is not None:
-            self.corrupt_rate = f["corrupt_rate"]
-        if f.get("missing_ids") is not None:
-            self.missing = set(f["missing_ids"])
-        self.vanish.update(f.get("vanish_at") or {})
-        for sid, kind in (f.get("hw_error") or {}).items():
-            s = self.by_id(sid)
-            s.conditions = {kind} if kind else set()
-            s.update(time.monotonic())
-        if f.get("close_port"):
-            self.close_port()
-
-    def serve(self) -> None:
-        self.conn.send(("ready", self.path))
-        while True:
-            fds: list[Any] = [self.conn] + ([self.master] if self.master is not None else [])
-            readable, _, _ = select.select(fds, [], [])
-            if self.master is not None and self.master in readable:
-                try:
-                    data = os.read(self.master, 4096)
-                except (BlockingIOError, InterruptedError):
-                    data = b""
-                except OSError:      # EIO: nobody has the slave open (cannot happen: we do)
-                    data = b""
-                if data:
-                    self.on_bytes(data)
-            if self.conn in readable:
-                try:
-                    cmd, args = self.conn.recv()
-                except (EOFError, OSError):
-                    return           # the parent is gone
-                if cmd == "stop":
-                    self.conn.send(("ok", None))
-                    return
-                try:
-                    self.conn.send(("ok", self.on_request(cmd, args)))
-                except Exception as e:  # noqa: BLE001 - report every failure to the parent
-                    self.conn.send(("error", f"{type(e).__name__}: {e}"))
-
-
-def _child_main(fd: int) -> None:
-    """Child-process entry point: ``fd`` is the control socket; the spec comes first."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)   # the parent decides when to stop
-    conn = Connection(fd)
-    try:
-        spec = conn.recv()
-        server = _ChainServer(spec, conn)
-    except Exception as e:  # noqa: BLE001 - tell the parent why we could not start
-        conn.send(("error", f"{type(e).__name__}: {e}"))
-        conn.close()
-        return
-    try:
-        server.serve()
-    finally:
-        server.close_port()
-        conn.close()
-
-
-# ============================================================================ parent side
 
 
 def _limits(robot: RobotConfig | None, servo_id: int, resolution: int) -> tuple[int, int, int]:
@@ -353,7 +123,7 @@ class Emulator:
         env["PYTHONPATH"] = os.pathsep.join(
             p for p in (str(ROOT), env.get("PYTHONPATH", "")) if p)
         self._proc = subprocess.Popen(
-            [sys.executable, "-c", f"from sim.emulator import _child_main; _child_main({fd})"],
+            [sys.executable, "-c", f"import sim.emulator_server as s; s.child_main({fd})"],
             pass_fds=[fd], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, env=env)
         child_sock.close()
         self._conn = Connection(parent_sock.detach())

@@ -12,15 +12,12 @@ from typing import Any
 import dynamixel_sdk
 
 from robot.bus.base import ServoState
-from robot.bus.sdk_bus import SdkBus, TimedPort, error_names
+from robot.bus.sdk_bus import SdkBus
+from robot.bus.sdk_port import TimedPort, error_names, twos_complement
 
 
 class _Port(TimedPort, dynamixel_sdk.PortHandler):
     """dynamixel_sdk's PortHandler with a configurable timeout (see TimedPort)."""
-
-
-def _signed(value: int, bits: int) -> int:
-    return value - (1 << bits) if value >> (bits - 1) & 1 else value
 
 
 class DynamixelBus(SdkBus):
@@ -50,8 +47,8 @@ class DynamixelBus(SdkBus):
             errors = error_names(self.family, self.read_register(sid, "hardware_error_status"))
         return ServoState(
             id=sid,
-            position=_signed(self.field(block, "present_position"), 32),
-            load=_signed(self.field(block, "present_load"), 16) * 0.1,
+            position=twos_complement(self.field(block, "present_position"), 32),
+            load=twos_complement(self.field(block, "present_load"), 16) * 0.1,
             temperature=float(self.field(block, "present_temperature")),
             voltage=self.field(block, "present_input_voltage") * 0.1,
             errors=errors,

@@ -13,7 +13,8 @@ from typing import Any
 import scservo_sdk
 
 from robot.bus.base import ServoState
-from robot.bus.sdk_bus import SdkBus, TimedPort, error_names, sign_magnitude
+from robot.bus.sdk_bus import SdkBus
+from robot.bus.sdk_port import TimedPort, error_names, sign_magnitude
 
 LITTLE_ENDIAN = 0  # scservo_sdk's SCS_END value for STS/SMS
 

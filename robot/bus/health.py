@@ -99,7 +99,8 @@ def wrong_baud_error(bus: SdkBus, ids: Sequence[int]) -> BusError:
                         f"power-up), the data cable and the adapter, then `biped scan --bus "
                         f"{bus.kind} --port {bus.port_name}`")
     rate, found = probe
-    return BusError(f"{head}, but {', '.join(bus.who(i) for i in found)} answers at {rate} "
+    verb = "answers" if len(found) == 1 else "answer"
+    return BusError(f"{head}, but {', '.join(bus.who(i) for i in found)} {verb} at {rate} "
                     f"baud: is the baud rate right? use --baud {rate} (or bus.baud = {rate} in "
                     "the robot config), or set every servo to the configured rate")
 

@@ -1,70 +1,31 @@
 """What the Dynamixel and Feetech buses share: one vendor SDK behind ``base.Bus``.
 
 Subclasses set the SDK module, the control-table family and the state block, and
-implement three hooks (packet handler, state decoding, hardware errors). Everything else
+implement three hooks (packet handler, status-byte failure, state decoding). Everything else
 (retries, the SDK's PORT_BUSY and stale-data pitfalls, limit checks, error messages that
 name the servo and its joint) lives here, once.
 
-Not thread-safe by design except for one lock around each transaction.
+One lock serialises transactions, so a telemetry thread may share the bus.
 """
 
 from __future__ import annotations
 
 import logging
 import threading
-import time
 from collections.abc import Callable, Iterable, Mapping
 from types import ModuleType
 from typing import Any, ClassVar
 
 from robot.bus import health
 from robot.bus.base import Bus, ServoInfo, ServoState
-from robot.bus.tables import (
-    BAUD_CODES,
-    ERROR_BITS,
-    RETURN_DELAY_UNIT_S,
-    TABLES,
-    Register,
-    model_name,
-)
+from robot.bus.limits import TickLimits
+from robot.bus.sdk_port import PORT_ERRORS
+from robot.bus.sync_read import BlockSyncRead, Reply
+from robot.bus.tables import BAUD_CODES, RETURN_DELAY_UNIT_S, TABLES, Register, model_name
 from robot.config import RobotConfig
 from robot.errors import BusError
 
 log = logging.getLogger(__name__)
-
-
-class TimedPort:
-    """Mixin for an SDK ``PortHandler``: a configurable reply timeout [ms] instead of the
-    SDK's 34 ms, a monotonic clock, and an input flush before every packet (the Feetech
-    SDK's ``clearPort`` only flushes output, so a late reply would be read as the next one).
-    """
-
-    timeout_ms: float = 20.0
-    ser: Any
-    tx_time_per_byte: float
-    packet_start_time: float
-    packet_timeout: float
-
-    def getCurrentTime(self) -> float:
-        return time.monotonic() * 1000.0
-
-    def setPacketTimeout(self, packet_length: int) -> None:
-        self.packet_start_time = self.getCurrentTime()
-        self.packet_timeout = self.tx_time_per_byte * packet_length + self.timeout_ms
-
-    def clearPort(self) -> None:
-        self.ser.reset_input_buffer()
-
-
-def error_names(family: str, bits: int) -> frozenset[str]:
-    """Hardware-error register bits → normalised names (tables.ERROR_BITS)."""
-    return frozenset(name for bit, name in ERROR_BITS[family].items() if bits >> bit & 1)
-
-
-def sign_magnitude(value: int, sign_bit: int) -> int:
-    """Feetech-style sign-magnitude integer → int."""
-    magnitude = value & ((1 << sign_bit) - 1)
-    return -magnitude if value >> sign_bit & 1 else magnitude
 
 
 class SdkBus(Bus):
@@ -99,22 +60,14 @@ class SdkBus(Bus):
         self.check_health = check_health
         self.table: dict[str, Register] = TABLES[self.family]
         self.health: list[str] = []
-        self._limits: dict[int, tuple[int, int]] = {}
-        if robot is not None:
-            from robot.servo_map import ServoMap
-
-            sm = ServoMap(robot)
-            for sid, lo, hi in zip(sm.ids, sm.tick_min.tolist(), sm.tick_max.tolist(),
-                                   strict=True):
-                self._limits[sid] = (max(lo, 0), min(hi, sm.resolution - 1))
+        self.limits = TickLimits(robot)
         first, last = (self.table[n] for n in self.state_block)
         self._block_start = first.address
-        self._block_len = last.address + last.size - first.address
+        self._reader = BlockSyncRead(self.sdk, first.address,
+                                     last.address + last.size - first.address)
         self._port: Any = None
         self._ph: Any = None
         self._writer: Any = None
-        self._reader: Any = None
-        self._reader_ids: tuple[int, ...] = ()
         self._torqued: set[int] = set()
         self._lock = threading.RLock()
 
@@ -131,6 +84,16 @@ class SdkBus(Bus):
 
     # ------------------------------------------------------------------ lifecycle
     @property
+    def port_handler(self) -> Any:
+        """The SDK's PortHandler while open (for diagnostics and raw-SDK comparisons)."""
+        return self._port
+
+    @property
+    def packet_handler(self) -> Any:
+        """The SDK's packet handler while open."""
+        return self._ph
+
+    @property
     def is_open(self) -> bool:
         return self._port is not None and bool(self._port.is_open)
 
@@ -142,6 +105,7 @@ class SdkBus(Bus):
         self._port = port
         self._ph = self._make_packet_handler()
         self.set_baud(self.baud)
+        self._reader.bind(port, self._ph)
         goal = self.table["goal_position"]
         self._writer = self.sdk.GroupSyncWrite(port, self._ph, goal.address, goal.size)
         health.try_low_latency(port.ser)
@@ -182,13 +146,13 @@ class SdkBus(Bus):
                 result = group.txPacket()
                 if result != self.sdk.COMM_SUCCESS:
                     log.warning("torque off on close failed: %s", self._ph.getTxRxResult(result))
-            except OSError as e:
+            except PORT_ERRORS as e:
                 log.warning("torque off on close failed (port error: %s); servos %s may still "
                             "hold torque", e, ids)
         try:
             if port.is_open:
                 port.closePort()
-        except OSError as e:
+        except PORT_ERRORS as e:
             log.debug("closing %s: %s", self.port_name, e)
 
     # ------------------------------------------------------------------ messages
@@ -235,7 +199,7 @@ class SdkBus(Bus):
                 port = self._begin()
                 try:
                     value, result, error = fn()
-                except OSError as e:
+                except PORT_ERRORS as e:
                     port.is_using = False
                     raise self._error(sid, what, f"port error: {e}", None) from e
                 if result == self.sdk.COMM_SUCCESS:
@@ -303,7 +267,7 @@ class SdkBus(Bus):
         if not goals:
             return
         size = self.table["goal_position"].size
-        params = [(sid, list(self._check_goal(sid, t).to_bytes(size, "little")))
+        params = [(sid, list(self.limits.check(sid, t, self.who(sid)).to_bytes(size, "little")))
                   for sid, t in goals.items()]
 
         def send() -> tuple[None, int, int]:
@@ -314,69 +278,14 @@ class SdkBus(Bus):
 
         self._transact("sync write goal_position", None, send)
 
-    def _check_goal(self, sid: int, ticks: int) -> int:
-        t = int(ticks)
-        if t != ticks:
-            raise BusError(f"write_goals: goal for {self.who(sid)} must be whole ticks, got "
-                           f"{ticks!r}")
-        if sid not in self._limits:
-            if self.robot is None:
-                raise BusError("write_goals: this bus has no robot config, so it cannot check "
-                               "joint limits; construct it with robot=...")
-            raise BusError(f"write_goals: id {sid} is not a servo of robot {self.robot.name}; "
-                           f"valid ids: {', '.join(map(str, sorted(self._limits)))}")
-        lo, hi = self._limits[sid]
-        if not lo <= t <= hi:
-            raise BusError(f"write_goals: goal {t} ticks for {self.who(sid)} is outside its "
-                           f"limits [{lo}, {hi}] ticks; refusing to move it (clamp first, e.g. "
-                           "ServoMap.to_ticks)")
-        return t
-
     def read_state(self, ids: Iterable[int]) -> dict[int, ServoState]:
         ids = tuple(dict.fromkeys(ids))
         if not ids:
             return {}
-        raw = self._sync_read(ids)
-        return {sid: self._decode_state(sid, block, status) for sid, (block, status)
-                in raw.items()}
-
-    def _sync_read(self, ids: tuple[int, ...]) -> dict[int, tuple[bytes, int]]:
-        """One sync read of the state block: {id: (block bytes, status byte)}.
-
-        Replies are collected here rather than in GroupSyncRead.rxPacket so that only data
-        received in *this* exchange is used (that SDK keeps stale data after a failure) and
-        the status byte of each servo is kept. Retried as a whole; raises naming the first
-        servo that did not answer (the ones after it are silenced by it).
-        """
-        n = self._block_len
-        with self._lock:
-            if self._reader is None or ids != self._reader_ids:
-                self._reader = self.sdk.GroupSyncRead(self._begin(), self._ph,
-                                                      self._block_start, n)
-                for sid in ids:
-                    self._reader.addParam(sid)
-                self._reader_ids = ids
-            got: dict[int, tuple[bytes, int]] = {}
-            failed: list[int | None] = [None]
-
-            def exchange() -> tuple[None, int, int]:
-                got.clear()
-                failed[0] = None
-                result = self._reader.txPacket()
-                if result != self.sdk.COMM_SUCCESS:
-                    return None, result, 0
-                for sid in ids:
-                    data, result, error = self._ph.readRx(self._port, sid, n)
-                    if result == self.sdk.COMM_SUCCESS and len(data) < n:
-                        result = self.sdk.COMM_RX_CORRUPT
-                    if result != self.sdk.COMM_SUCCESS:
-                        failed[0] = sid
-                        return None, result, 0
-                    got[sid] = (bytes(data), error)
-                return None, result, 0
-
-            self._transact("sync read state", None, exchange, blame=lambda: failed[0])
-            return got
+        got: dict[int, Reply] = {}
+        self._transact("sync read state", None, lambda: self._reader.exchange(ids, got),
+                       blame=lambda: self._reader.failed)
+        return {sid: self._decode_state(sid, *got[sid]) for sid in ids}
 
     def field(self, block: bytes, name: str) -> int:
         """Unsigned little-endian value of register ``name`` inside a state block."""

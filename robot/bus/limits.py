@@ -1,0 +1,40 @@
+"""The bus's last line of defence: goal ticks outside a joint's limits are refused."""
+
+from __future__ import annotations
+
+from robot.config import RobotConfig
+from robot.errors import BusError
+
+
+class TickLimits:
+    """Allowed goal range [ticks] per servo id, from the joint limits (``ServoMap``) and the
+    servo's resolution. Without a robot config nothing is allowed."""
+
+    def __init__(self, robot: RobotConfig | None) -> None:
+        self.robot = robot
+        self.by_id: dict[int, tuple[int, int]] = {}
+        if robot is not None:
+            from robot.servo_map import ServoMap
+
+            sm = ServoMap(robot)
+            for sid, lo, hi in zip(sm.ids, sm.tick_min.tolist(), sm.tick_max.tolist(),
+                                   strict=True):
+                self.by_id[sid] = (max(int(lo), 0), min(int(hi), sm.resolution - 1))
+
+    def check(self, sid: int, ticks: int, who: str) -> int:
+        """``ticks`` as an int if allowed for servo ``sid`` (named ``who``), else BusError."""
+        t = int(ticks)
+        if t != ticks:
+            raise BusError(f"write_goals: goal for {who} must be whole ticks, got {ticks!r}")
+        if sid not in self.by_id:
+            if self.robot is None:
+                raise BusError("write_goals: this bus has no robot config, so it cannot check "
+                               "joint limits; construct it with robot=...")
+            raise BusError(f"write_goals: id {sid} is not a servo of robot {self.robot.name}; "
+                           f"valid ids: {', '.join(map(str, sorted(self.by_id)))}")
+        lo, hi = self.by_id[sid]
+        if not lo <= t <= hi:
+            raise BusError(f"write_goals: goal {t} ticks for {who} is outside its limits "
+                           f"[{lo}, {hi}] ticks; refusing to move it (clamp first, e.g. "
+                           "ServoMap.goals)")
+        return t

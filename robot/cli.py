@@ -16,6 +16,7 @@ from robot.errors import BipedError
 
 # Order is the order of `biped --help`.
 COMMANDS: tuple[str, ...] = (
+    "walk",
     "curves",
     "scan",
     "torque",

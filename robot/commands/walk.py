@@ -1,0 +1,161 @@
+"""`biped walk`: the main job. Default: the default robot and walk, on the MuJoCo bus,
+headless, faster than real time, with a readable summary (or one JSON object)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import signal
+import sys
+import time
+from collections.abc import Callable
+from typing import Any
+
+from robot.bus.factory import make_bus
+from robot.commands.common import (add_bus_args, add_robot_args, gait_from, positive_float,
+                                   positive_int, robot_from)
+from robot.engine import GaitEngine
+from robot.errors import ConfigError
+from robot.recorder import Recorder
+from robot.servo_map import ServoMap
+from robot.streamer import Streamer, Telemetry
+
+log = logging.getLogger(__name__)
+
+
+def add_walk_args(p: argparse.ArgumentParser) -> None:
+    """Options shared by `walk` and `panel`."""
+    add_robot_args(p)
+    add_bus_args(p, default="sim")
+    p.add_argument("--rate", type=positive_float, default=200.0, help="control rate [Hz]")
+    p.add_argument("--read-every", type=positive_int, default=10, metavar="N",
+                   help="read servos back every N ticks (default: %(default)s)")
+    p.add_argument("--hold", action="store_true",
+                   help="hold the rest pose with torque on at the end (default: torque off)")
+    p.add_argument("--realtime", action="store_true", help="pace the simulation to the wall clock")
+    p.add_argument("--view", action="store_true", help="open the MuJoCo viewer (needs a display)")
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
+    p = sub.add_parser("walk", help="walk the robot (MuJoCo by default, or a real bus)")
+    add_walk_args(p)
+    p.add_argument("--seconds", type=positive_float, default=10.0, help="gait duration [s]")
+    p.add_argument("--record", metavar="PATH", help="per-tick record (.csv or .jsonl)")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="override a gait parameter (repeatable), e.g. --set turn=0.2")
+    return p
+
+
+def parse_sets(items: list[str]) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        try:
+            if not sep:
+                raise ValueError
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise ConfigError(f"--set {item!r}: expected NAME=NUMBER, e.g. turn=0.2") from None
+    return out
+
+
+def install_signals(streamer: Streamer) -> Callable[[], None]:
+    """SIGINT/SIGTERM: first → safe stop (ramp out, rest, torque off); second → torque off."""
+    def handler(signum: int, _frame: Any) -> None:
+        if streamer.telemetry.stop_reason and signum == signal.SIGINT:
+            streamer.emergency_stop()
+        else:
+            streamer.request_stop(f"signal {signal.Signals(signum).name}")
+
+    old = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
+
+    def restore() -> None:
+        for s, h in old.items():
+            signal.signal(s, h)
+    return restore
+
+
+def run(args: argparse.Namespace) -> int:
+    robot = robot_from(args)
+    gait = gait_from(args)
+    params = gait.params.replace(parse_sets(args.set), where="--set")
+    kind = args.bus or "sim"
+    if kind != "sim" and (args.view or args.realtime):
+        raise ConfigError("--view and --realtime apply to --bus sim only")
+    options: dict[str, Any] = {"realtime": args.realtime, "view": args.view} if kind == "sim" else {}
+    bus = make_bus(kind, robot=robot, port=args.port, baud=args.baud, **options)
+    recorder = Recorder(args.record, robot.joint_names, robot.ids) if args.record else None
+    engine = GaitEngine(robot, params)
+    smap = ServoMap(robot)
+    monitor = None
+    observers: list[Callable[[Telemetry], None]] = []
+    wall0 = time.perf_counter()
+    with bus:
+        if kind == "sim":
+            from sim.metrics import WalkMonitor
+
+            sim_bus: Any = bus
+            monitor = WalkMonitor(standing_height=sim_bus.standing_height)
+
+            def watch(tel: Telemetry) -> None:
+                pos, quat = sim_bus.base_pose()
+                monitor.update(tel.t, pos, quat, sim_bus.upright_angle())
+            observers.append(watch)
+        if recorder is not None:
+            observers.append(recorder.open())
+
+        def observe(tel: Telemetry) -> None:
+            for o in observers:
+                o(tel)
+        streamer = Streamer(smap, bus, engine, rate_hz=args.rate, read_every=args.read_every,
+                            hold_at_end=args.hold, observer=observe)
+        restore = install_signals(streamer)
+        try:
+            stats = streamer.run(seconds=args.seconds)
+        finally:
+            restore()
+            if recorder is not None:
+                recorder.close()
+    wall = time.perf_counter() - wall0
+    result: dict[str, Any] = {"robot": robot.name, "gait": gait.name, "bus": kind,
+                              "seconds": args.seconds}
+    if monitor is not None:
+        result.update(monitor.summary(args.seconds))
+    result.update({
+        "ticks": stats.ticks, "rate_hz": stats.rate_hz, "achieved_hz": stats.achieved_hz,
+        "period_error_p50_ms": stats.period_error_p50_ms,
+        "period_error_p99_ms": stats.period_error_p99_ms,
+        "period_error_max_ms": stats.period_error_max_ms,
+        "overruns": stats.overruns, "bus_errors": stats.bus_errors,
+        "realtime_factor": stats.duration_s / wall if wall > 0 else 0.0,
+        "stop_reason": stats.stop_reason,
+    })
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(format_summary(result))
+    return 0 if not stats.stop_reason.startswith(("watchdog", "exception")) else 1
+
+
+def format_summary(r: dict[str, Any]) -> str:
+    lines = [f"{r['robot']} walked gait '{r['gait']}' for {r['seconds']:g} s on the {r['bus']} bus"]
+    if "distance_m" in r:
+        lines += [
+            f"  distance      {r['distance_m']:+.3f} m forward ({r['speed_m_s']:.3f} m/s)",
+            f"  lateral drift {r['lateral_drift_m']:+.3f} m",
+            f"  heading       {r['heading_change_deg']:+.1f} deg",
+            f"  fell          {'YES at %.1f s' % r['fell_at_s'] if r['fell'] else 'no'}"
+            f" (lowest torso {r['min_torso_height_m']:.3f} m, max tilt {r['max_tilt_deg']:.1f} deg)",
+        ]
+    lines += [
+        f"  loop          {r['ticks']} ticks at {r['rate_hz']:g} Hz (achieved {r['achieved_hz']:.1f} Hz),"
+        f" period error p50 {r['period_error_p50_ms']:.3f} ms, p99 {r['period_error_p99_ms']:.3f} ms,"
+        f" {r['overruns']} overruns, {r['bus_errors']} bus errors",
+        f"  realtime      x{r['realtime_factor']:.1f}",
+        f"  stopped       {r['stop_reason']}",
+    ]
+    return "\n".join(lines)
+
+

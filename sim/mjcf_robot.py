@@ -64,7 +64,7 @@ def num(*values: float) -> str:
 
 
 def _sub(parent: ET.Element, tag: str, **attrs: str) -> ET.Element:
-    return ET.SubElement(parent, tag, {k.rstrip("_"): v for k, v in attrs.items()})
+    return ET.SubElement(parent, tag, {k.rstrip("_"): v for k, v in attrs.items() if v})
 
 
 def joint_class(robot: RobotConfig, name: str) -> str:
@@ -154,14 +154,14 @@ def add_worldbody(root: ET.Element, robot: RobotConfig) -> None:
         _sub(b, "geom", class_="visual", type="box", size=servo_box, material="servo")
         b = _body(b, f"{side}_thigh", (0, 0, 0), f"{side}_hip_pitch", robot)
         _inertial(b, m.thigh, (0, 0, -g.thigh / 2), (s, s, g.thigh))
-        for cls in ("visual", leg):
-            _sub(b, "geom", class_=cls, type="capsule", size=fmt(r),
+        for cls, gname in (("visual", ""), (leg, f"{side}_thigh")):
+            _sub(b, "geom", name=gname, class_=cls, type="capsule", size=fmt(r),
                  fromto=fmt(0, 0, 0, 0, 0, -g.thigh), material="link")
         b = _body(b, f"{side}_shin", (0, 0, -g.thigh), f"{side}_knee", robot)
         _inertial(b, m.shin, (0, 0, -g.shin / 2), (s, s, g.shin))
         _sub(b, "geom", class_="visual", type="box", size=servo_box, material="servo")
-        for cls in ("visual", leg):
-            _sub(b, "geom", class_=cls, type="capsule", size=fmt(r),
+        for cls, gname in (("visual", ""), (leg, f"{side}_shin")):
+            _sub(b, "geom", name=gname, class_=cls, type="capsule", size=fmt(r),
                  fromto=fmt(0, 0, 0, 0, 0, -g.shin), material="link")
         b = _body(b, f"{side}_ankle_link", (0, 0, -g.shin), f"{side}_ankle_pitch", robot)
         _inertial(b, m.ankle_link, (0, 0, 0), (s, s, s))

@@ -171,12 +171,14 @@ class MujocoBus(Bus):
 
     # ------------------------------------------------------------------ Bus interface
 
-    def _index(self, servo_id: int) -> int:
+    def _indices(self, ids: Iterable[int]) -> list[int]:
+        """Joint indices of ``ids``; BusError naming the first unknown id (or if closed)."""
         self.model  # noqa: B018  (raises BusError if closed)
+        index = self._id_index
         try:
-            return self._id_index[servo_id]
-        except KeyError:
-            raise BusError(f"sim bus: servo id {servo_id} does not exist on robot "
+            return [index[i] for i in ids]
+        except KeyError as e:
+            raise BusError(f"sim bus: servo id {e.args[0]} does not exist on robot "
                            f"{self.robot.name} ({self.robot.source}); configured ids: "
                            f"{', '.join(map(str, self.robot.ids))}") from None
 
@@ -191,7 +193,7 @@ class MujocoBus(Bus):
                 for i in sorted(set(ids)) if self.ping(i) is not None]
 
     def set_torque(self, ids: Iterable[int], *, enabled: bool) -> None:
-        idx = [self._index(i) for i in ids]
+        idx = self._indices(ids)
         if enabled:
             # Torque on: the setpoint restarts from where the joint is.
             off = [i for i in idx if not self._enabled[i]]
@@ -202,13 +204,13 @@ class MujocoBus(Bus):
     def write_goals(self, goals: Mapping[int, int]) -> None:
         if not goals:
             return
-        idx = np.array([self._index(i) for i in goals])
+        idx = np.array(self._indices(goals))
         q = (np.array(list(goals.values()), float) - self.servo_map.zero[idx]) \
             * self.servo_map.sign[idx] / self.servo_map.ticks_per_rad
         self._goal[idx] = np.clip(q, self.servo_map.q_min[idx], self.servo_map.q_max[idx])
 
     def read_state(self, ids: Iterable[int]) -> dict[int, ServoState]:
-        idx = [self._index(i) for i in ids]
+        idx = self._indices(ids)
         ticks = self.present_ticks()
         force = self.data.actuator_force[self._act]
         load = 100.0 * self.servo_map.sign * force / self._stall

@@ -16,7 +16,6 @@ exception; ``reachable`` tells which inputs were clamped.
 
 from __future__ import annotations
 
-import math
 from typing import NamedTuple
 
 import numpy as np
@@ -84,7 +83,9 @@ def leg_ik(g: Geometry, side: str, sole: Vec, foot_rot: Rot = xm.IDENTITY) -> Le
     c_knee = (c * c - a * a - b * b) / (2.0 * a * b)
     reachable = (c_knee <= 1.0) & (c_knee >= -1.0)
     knee = xm.acos(c_knee)
-    ankle_a = xm.asin((a / c) * xm.sin(math.pi - knee))
+    # Angle at the ankle between the shin and the ankle → hip line. atan2, not the
+    # law-of-sines asin: that one picks the acute branch, wrong when thigh > shin.
+    ankle_a = xm.atan2(a * xm.sin(knee), b + a * xm.cos(knee))
     sz_ = xm.sign(rz)
     ankle_roll = xm.atan2(ry * sz_, rz * sz_)  # in (-pi/2, pi/2]
     ankle_pitch = -xm.atan2(rx, sz_ * xm.sqrt(ry * ry + rz * rz)) - ankle_a
@@ -119,9 +120,12 @@ def arm_ik(g: Geometry, hand: Vec) -> ArmIK:
     """
     u, f = g.upper_arm, g.forearm
     px, py, pz = hand
-    d2 = px * px + py * py + pz * pz
-    c_elbow = (d2 - u * u - f * f) / (2.0 * u * f)
+    d = xm.maximum(xm.sqrt(px * px + py * py + pz * pz), 1e-12)
+    c_elbow = (d * d - u * u - f * f) / (2.0 * u * f)
     reachable = (c_elbow <= 1.0) & (c_elbow >= -1.0)
+    # Unreachable: aim at the nearest reachable point along the shoulder → hand line.
+    k = xm.clip(d, abs(u - f), u + f) / d
+    px, py, pz = px * k, py * k, pz * k
     elbow = -xm.acos(c_elbow)
     vx = -f * xm.sin(elbow)
     vz = -u - f * xm.cos(elbow)  # < 0 for every elbow angle when f < u + f

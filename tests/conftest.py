@@ -1,0 +1,22 @@
+"""Shared fixtures: the bundled robot configs and gait presets (keep this file small)."""
+
+from __future__ import annotations
+
+import pytest
+
+from robot.config import GAITS_DIR, ROBOTS_DIR, Gait, RobotConfig, load_gait, load_robot
+
+ROBOT_FILES = sorted(p.name for p in ROBOTS_DIR.glob("*.toml"))
+GAIT_FILES = sorted(p.stem for p in GAITS_DIR.glob("*.toml"))
+
+
+@pytest.fixture(params=ROBOT_FILES)
+def any_robot(request: pytest.FixtureRequest) -> RobotConfig:
+    """Each bundled robot config in turn."""
+    return load_robot(ROBOTS_DIR / request.param)
+
+
+@pytest.fixture(params=GAIT_FILES)
+def any_gait(request: pytest.FixtureRequest) -> Gait:
+    """Each bundled gait preset in turn."""
+    return load_gait(request.param)

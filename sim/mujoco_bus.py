@@ -48,6 +48,29 @@ REANCHOR_LAG_S = 0.25  # realtime: behind the wall clock by more than this → r
 _TIME_EPS = 1e-9  # [s]
 
 
+def _check_display() -> None:
+    """BusError unless a window can open (MuJoCo's viewer exits the process otherwise)."""
+    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        raise BusError("--view needs a display; run without --view or use `biped render`")
+    import glfw
+
+    reporting, glfw.ERROR_REPORTING = glfw.ERROR_REPORTING, "ignore"
+    try:
+        ok = glfw.init()
+    finally:
+        glfw.ERROR_REPORTING = reporting
+    if not ok:
+        display = os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+        raise BusError(f"--view: cannot open display {display!r}; run without --view or "
+                       f"use `biped render`")
+
+
+def _launch_viewer(model: mujoco.MjModel, data: mujoco.MjData) -> Any:
+    import mujoco.viewer as mujoco_viewer
+
+    return mujoco_viewer.launch_passive(model, data)
+
+
 class SimClock:
     """``robot.clock.Clock`` on simulation time: ``sleep_until`` steps the physics."""
 
@@ -95,8 +118,8 @@ class MujocoBus(Bus):
     def open(self) -> None:
         if self._model is not None:
             return
-        if self.view and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-            raise BusError("--view needs a display; run without --view or use `biped render`")
+        if self.view:
+            _check_display()
         model = build_mjcf(self.robot, timestep=self.timestep).model()
         data = mujoco.MjData(model)
         mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
@@ -127,9 +150,7 @@ class MujocoBus(Bus):
         data.ctrl[self._act] = self._setpoint
         self._wall0 = time.monotonic() - data.time
         if self.view:
-            import mujoco.viewer as mujoco_viewer
-
-            self._viewer = mujoco_viewer.launch_passive(model, data)
+            self._viewer = _launch_viewer(model, data)
         log.info("sim bus open: %s, %d servos, timestep %.4f s", self.robot.name, n,
                  model.opt.timestep)
 

@@ -184,6 +184,15 @@ def test_view_without_a_display_is_a_clear_error(monkeypatch: pytest.MonkeyPatch
     assert not b.is_open
 
 
+def test_view_with_an_unreachable_display_is_a_clear_error(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """MuJoCo's viewer would exit the process; the bus checks the display first."""
+    monkeypatch.setenv("DISPLAY", ":4321")
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    with pytest.raises(BusError, match="cannot open display ':4321'"):
+        MujocoBus(ROBOT, view=True).open()
+
+
 def test_render_of_the_home_pose_is_not_blank(bus: MujocoBus) -> None:
     img = bus.render(160, 120)
     assert img.shape == (120, 160, 3) and img.dtype == np.uint8

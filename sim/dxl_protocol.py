@@ -208,9 +208,9 @@ def handle(servo_id: int, inst: int, params: bytes,
             err = WRITE_ERRORS[s.write(address, data)]
             reply(s, status(s.servo_id, err | _alert(s)), LEVEL_ALL)
     elif inst == INST_REBOOT:
-        if servo is not None:
-            servo.reboot()
+        if servo is not None:   # the status goes out first, then the servo restarts
             reply(servo, status(servo_id, _alert(servo)), LEVEL_ALL)
+            servo.reboot()
     elif inst in (INST_SYNC_READ, INST_FAST_SYNC_READ) and len(params) >= 4:
         address, length = word(params[0:2], "little"), word(params[2:4], "little")
         ids = tuple(params[4:])

@@ -116,6 +116,8 @@ def check(bus: SdkBus) -> list[str]:
         present = [sid for sid in ids if bus.ping(sid) is not None]
         if not present:
             raise wrong_baud_error(bus, ids)
+        # A second chance: one late reply should not read as a missing servo.
+        present += [sid for sid in ids if sid not in present and bus.ping(sid) is not None]
         missing = [sid for sid in ids if sid not in present]
         if missing:
             warnings.append(f"configured servos not answering: "

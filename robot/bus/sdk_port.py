@@ -18,11 +18,18 @@ except ImportError:  # not POSIX
     PORT_ERRORS = (OSError,)
 
 
+#: pyserial read timeout [s]: the SDKs poll ``read`` in a loop; with timeout 0 that loop
+#: spins a whole CPU core while waiting for a reply (starving a 2-core machine), with a
+#: short blocking read it sleeps in select() until the bytes it asked for arrive.
+READ_BLOCK_S = 0.001
+
+
 class TimedPort:
     """Mixin for an SDK ``PortHandler``: a configurable reply timeout [ms] instead of the
-    SDK's fixed 34 ms, a monotonic clock instead of ``time.time()``, and an input flush
-    before every packet (the Feetech SDK's ``clearPort`` only drains *output*, so a late
-    reply would be parsed as the answer to the next request).
+    SDK's fixed 34 ms, a monotonic clock instead of ``time.time()``, blocking reads instead
+    of a busy loop (READ_BLOCK_S), and an input flush before every packet (the Feetech
+    SDK's ``clearPort`` only drains *output*, so a late reply would be parsed as the answer
+    to the next request).
     """
 
     timeout_ms: float = 20.0
@@ -39,6 +46,11 @@ class TimedPort:
         """Reply deadline: wire time of ``packet_length`` bytes plus ``timeout_ms``."""
         self.packet_start_time = self.getCurrentTime()
         self.packet_timeout = self.tx_time_per_byte * packet_length + self.timeout_ms
+
+    def setupPort(self, cflag_baud: int) -> bool:
+        ok = bool(super().setupPort(cflag_baud))  # type: ignore[misc]
+        self.ser.timeout = READ_BLOCK_S
+        return ok
 
     def clearPort(self) -> None:
         self.ser.reset_input_buffer()

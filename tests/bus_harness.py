@@ -1,0 +1,86 @@
+"""Shared fixtures for the vendor-bus tests: a real SDK bus on an emulated chain (pty).
+
+Use from a test module with ``pytest_plugins = ("bus_harness",)``.
+"""
+
+from __future__ import annotations
+
+import signal
+from collections.abc import Callable, Iterator
+from types import FrameType
+
+import pytest
+
+from robot.bus.factory import make_bus
+from robot.bus.sdk_bus import SdkBus
+from robot.config import ROBOTS_DIR, RobotConfig, load_robot
+from sim.emulator import Emulator
+
+PROTOCOLS = ("dynamixel", "feetech")
+HANG_LIMIT_S = 30
+#: Reply timeout for tests [ms]: the emulator is a Python process on a shared machine.
+TEST_TIMEOUT_MS = 50.0
+
+
+def robot_for(protocol: str) -> RobotConfig:
+    return load_robot(ROBOTS_DIR / f"biped18-{protocol}.toml")
+
+
+def new_bus(emu: Emulator, robot: RobotConfig, **options: object) -> SdkBus:
+    """A closed vendor bus on the emulator's pty, built by the factory like the CLI does."""
+    options.setdefault("timeout_ms", TEST_TIMEOUT_MS)
+    bus = make_bus(emu.protocol, robot=robot, port=emu.port, **options)
+    assert isinstance(bus, SdkBus)
+    return bus
+
+
+def open_bus(emu: Emulator, robot: RobotConfig, **options: object) -> SdkBus:
+    bus = new_bus(emu, robot, **options)
+    bus.open()
+    return bus
+
+
+@pytest.fixture(autouse=True)
+def no_hang() -> Iterator[None]:
+    """Fail (rather than hang) any test that runs longer than HANG_LIMIT_S."""
+    def alarm(signum: int, frame: FrameType | None) -> None:
+        raise TimeoutError(f"test exceeded {HANG_LIMIT_S} s")
+
+    previous = signal.signal(signal.SIGALRM, alarm)
+    signal.alarm(HANG_LIMIT_S)
+    yield
+    signal.alarm(0)
+    signal.signal(signal.SIGALRM, previous)
+
+
+@pytest.fixture
+def bus_factory() -> Callable[..., SdkBus]:
+    """``bus_factory(emu, robot, open=True, **options)`` → a vendor bus on the emulator."""
+    def build(emu: Emulator, robot: RobotConfig, *, open: bool = True,
+              **options: object) -> SdkBus:
+        return open_bus(emu, robot, **options) if open else new_bus(emu, robot, **options)
+
+    return build
+
+
+@pytest.fixture(params=PROTOCOLS)
+def protocol(request: pytest.FixtureRequest) -> str:
+    return str(request.param)
+
+
+@pytest.fixture
+def robot(protocol: str) -> RobotConfig:
+    return robot_for(protocol)
+
+
+@pytest.fixture
+def emu(protocol: str, robot: RobotConfig) -> Iterator[Emulator]:
+    with Emulator(protocol, robot, seed=1) as e:
+        yield e
+
+
+@pytest.fixture
+def bus(emu: Emulator, robot: RobotConfig) -> Iterator[SdkBus]:
+    b = open_bus(emu, robot)
+    yield b
+    b.close()

@@ -27,7 +27,8 @@ def _speeds(max_speed: npt.ArrayLike, n: int) -> FloatArray:
 
 def slew_limit(q_prev: npt.ArrayLike, q_goal: npt.ArrayLike, max_speed: npt.ArrayLike,
                dt: float) -> FloatArray:
-    """``q_goal`` moved no further than ``max_speed * dt`` from ``q_prev`` per joint.
+    """``q_goal`` moved no further than ``max_speed * dt`` from ``q_prev`` per joint
+    (exactly ``q_goal`` where it is within reach).
 
     q_prev, q_goal: joint angles [rad]; max_speed: scalar or per joint [rad/s]; dt: [s] > 0.
     """
@@ -38,7 +39,8 @@ def slew_limit(q_prev: npt.ArrayLike, q_goal: npt.ArrayLike, max_speed: npt.Arra
     if not (dt > 0 and math.isfinite(dt)):
         raise ConfigError(f"slew_limit: dt must be a positive time [s], got {dt}")
     step = _speeds(max_speed, prev.size).reshape(prev.shape) * dt
-    return prev + np.clip(goal - prev, -step, step)
+    d = goal - prev
+    return np.where(np.abs(d) <= step, goal, prev + np.clip(d, -step, step))
 
 
 def min_jerk(s: npt.ArrayLike) -> FloatArray:

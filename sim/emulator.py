@@ -19,6 +19,14 @@ adapter and talk Dynamixel Protocol 2.0 (``sim.dxl_protocol``) or Feetech STS
 - Log: one :class:`Packet` per instruction packet with a valid checksum that at least one
   servo heard. Broadcast writes log id 254. Written values are decoded little-endian
   (signed for Dynamixel's signed registers); for bulk reads ``values`` maps id → address.
+- Servos: present position starts at the joint's ``zero_ticks`` (2048 without a robot),
+  position limits are the joint limits in ticks (rounded outward). Sync/bulk reads answer
+  in the order the ids appear in the packet; a missing servo silences the rest.
+- Closing the port (``set_faults(close_port=True)``) makes the SDK's next call raise
+  (``termios.error``/``SerialException``, EIO) and leaves ``PortHandler.is_using`` set.
+- dynamixel_sdk 4.1 does not byte-stuff what it sends (``addStuffing``'s result is
+  dropped when the packet grows); the emulator's parser still reads such packets by length.
+  Replies are stuffed, and the SDK unstuffs them.
 """
 
 from __future__ import annotations
@@ -62,8 +70,8 @@ def _limits(robot: RobotConfig | None, servo_id: int, resolution: int) -> tuple[
         return CENTER_TICKS, 0, resolution - 1
     per_rad = resolution / (2 * math.pi)
     ends = [joint.zero_ticks + joint.sign * q * per_rad for q in (joint.min_rad, joint.max_rad)]
-    lo = max(0, int(min(ends)))
-    hi = min(resolution - 1, int(max(ends) + 0.999999))
+    lo = max(0, math.floor(min(ends)))
+    hi = min(resolution - 1, math.ceil(max(ends)))
     return joint.zero_ticks, lo, hi
 
 

@@ -455,6 +455,10 @@ def test_biped_emulate_prints_a_pingable_port() -> None:
         ready, _, _ = select.select([proc.stdout], [], [], 15.0)
         assert ready, "biped emulate printed nothing"
         path = proc.stdout.readline().decode().strip()
+        if not path:
+            proc.wait(5.0)
+            assert proc.stderr is not None
+            pytest.fail(f"biped emulate exited: {proc.stderr.read().decode()[-800:]}")
         assert path.startswith("/dev/") and os.path.exists(path)
         port = dxl.PortHandler(path)
         assert port.openPort()

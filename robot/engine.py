@@ -7,6 +7,7 @@ joint limits; unreachable targets are clamped by the IK and counted, never NaN.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 from collections.abc import Mapping
@@ -18,11 +19,16 @@ import numpy.typing as npt
 from robot import gait
 from robot.config import JOINT_NAMES, RobotConfig
 from robot.ik import arm_ik, leg_ik
-from robot.params import GaitParams
+from robot.params import SPECS, GaitParams
 from robot.targets import BodyTargets, body_targets
 from robot.xmath import Num
 
 log = logging.getLogger(__name__)
+
+#: Time constant [s] with which live parameter changes are followed while the gait runs.
+#: Phase rates are integrated, but amplitudes (stride, foot height, ...) would otherwise
+#: step the targets within one tick.
+PARAM_TAU_S = 0.1
 
 
 def solve(t: BodyTargets, robot: RobotConfig) -> tuple[list[Num], Num]:
@@ -50,6 +56,8 @@ class GaitEngine:
 
     The envelope ramps the gait amplitude in after ``start()`` and out after ``stop()``,
     over ``ramp_cycles`` gait cycles; the phase starts at 0 (start of the right swing).
+    Parameter changes while the gait moves are followed smoothly (``PARAM_TAU_S``):
+    ``params`` is what was set, ``live_params`` what the last tick used.
     """
 
     def __init__(self, robot: RobotConfig, params: GaitParams) -> None:
@@ -57,6 +65,7 @@ class GaitEngine:
             raise ValueError("robot joints must be in canonical order")
         self.robot = robot
         self._params = params
+        self._live = params
         self.phase = gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0)
         self.time = 0.0
         self._ramp = 0.0          # linear ramp variable in [0, 1]
@@ -72,11 +81,34 @@ class GaitEngine:
 
     def set_params(self, changes: Mapping[str, Any], *, where: str = "parameter") -> GaitParams:
         """Validate and apply ``changes``; on error nothing changes (ConfigError)."""
-        self._params = self._params.replace(changes, where=where)
+        self.replace_params(self._params.replace(changes, where=where))
         return self._params
 
     def replace_params(self, params: GaitParams) -> None:
+        """Set new parameters: at once while stopped, else followed smoothly by ``tick``."""
         self._params = params
+        if self.stopped:
+            self._live = params
+
+    @property
+    def live_params(self) -> GaitParams:
+        """The parameters in effect now (approaching ``params`` after a live change)."""
+        return self._live
+
+    def _follow(self, dt: float) -> None:
+        """Move the live parameters towards the set ones (first order, ``PARAM_TAU_S``)."""
+        live, target = self._live, self._params
+        if live is target:
+            return
+        a = 1.0 - math.exp(-dt / PARAM_TAU_S)
+        moved: dict[str, float] = {}
+        for name, spec in SPECS.items():
+            cur, goal = getattr(live, name), getattr(target, name)
+            if cur != goal:
+                v = cur + a * (goal - cur)
+                moved[name] = goal if abs(goal - v) <= 1e-9 * (spec.hi - spec.lo) else v
+        self._live = target if all(moved[n] == getattr(target, n) for n in moved) \
+            else dataclasses.replace(live, **moved)
 
     # -- envelope ---------------------------------------------------------------------
     def start(self) -> None:
@@ -103,7 +135,7 @@ class GaitEngine:
     def pose(self, *, amplitude: float | None = None) -> list[float]:
         """Joint angles [rad] at the current phase (default: the current envelope)."""
         a = self.amplitude if amplitude is None else amplitude
-        p = self._params
+        p = self._live
         ch = gait.channels(self.phase, p, amplitude=a)
         q, ok = solve(body_targets(ch, p, self.robot.geometry, amplitude=a), self.robot)
         if not ok:
@@ -126,8 +158,10 @@ class GaitEngine:
             self.phase = saved
 
     def tick(self, dt: float) -> list[float]:
-        """Advance by ``dt`` [s] (phase and envelope) and return the joint angles [rad]."""
-        p = self._params
+        """Advance by ``dt`` [s] (parameters, phase and envelope) and return the joint
+        angles [rad]."""
+        self._follow(dt)
+        p = self._live
         ramp_s = p.ramp_cycles * p.cycle_s
         step = 1.0 if not math.isfinite(ramp_s) or ramp_s <= 0 else dt / ramp_s
         if self._running:

@@ -1,0 +1,282 @@
+"""GaitEngine and the robot mapping: limits, leg alternation, live changes, envelope."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from robot import gait
+from robot.config import Gait, RobotConfig, load_gait, load_robot
+from robot.engine import GaitEngine, solve
+from robot.ik import leg_fk_full
+from robot.params import SPECS, GaitParams
+from robot.targets import BodyTargets, body_targets, scale
+
+RATE = 200.0
+DT = 1.0 / RATE
+ROBOT = load_robot()
+WALKING = ("walk", "crouch", "high_step", "paper")
+
+
+def cycles(p: GaitParams, n: float) -> np.ndarray:
+    return np.arange(0.0, n * p.cycle_s, DT)
+
+
+def assert_in_limits(robot: RobotConfig, q: np.ndarray, what: str) -> None:
+    q = np.asarray(q, dtype=float)
+    assert np.all(np.isfinite(q)), what
+    for j, row in zip(robot.joints, q, strict=True):
+        assert j.min_rad - 1e-12 <= row.min() and row.max() <= j.max_rad + 1e-12, \
+            (what, j.name, float(row.min()), float(row.max()))
+
+
+def targets_of(p: GaitParams, times: np.ndarray, robot: RobotConfig = ROBOT) -> BodyTargets:
+    return body_targets(gait.curves(times, p), p, robot.geometry)
+
+
+# ----------------------------------------------------------------- 3. finite, in limits
+
+
+def test_preset_curves_are_finite_and_within_limits(any_robot: RobotConfig,
+                                                    any_gait: Gait) -> None:
+    p = any_gait.params
+    times = cycles(p, 3)
+    _, q = GaitEngine(any_robot, p).curves(times)
+    assert q.shape == (len(any_robot.joints), len(times))
+    assert_in_limits(any_robot, q, any_gait.name)
+    # The presets are designed inside the limits: the IK itself (before the engine's
+    # clamp) stays within them, and every target the robot presets ask for is reachable.
+    raw, ok = solve(targets_of(p, times, any_robot), any_robot)
+    assert_in_limits(any_robot, np.array(raw), f"{any_gait.name} (raw IK)")
+    if any_gait.name != "paper":   # the paper's rig values are previs, not for a robot
+        assert np.all(ok), any_gait.name
+
+
+def test_preset_ticks_through_start_steady_stop_are_within_limits(
+        any_robot: RobotConfig, any_gait: Gait) -> None:
+    p = any_gait.params
+    e = GaitEngine(any_robot, p)
+    qs = [e.start_pose()]
+    e.start()
+    ramp_ticks = math.ceil(p.ramp_cycles * p.cycle_s * RATE)
+    for _ in range(ramp_ticks + int(p.cycle_s * RATE) + 1):
+        qs.append(e.tick(DT))
+    e.stop()
+    while not e.stopped:
+        qs.append(e.tick(DT))
+        assert len(qs) < 4 * ramp_ticks + 2 * p.cycle_s * RATE, "stop never completed"
+    assert_in_limits(any_robot, np.array(qs).T, any_gait.name)
+    if any_gait.name != "paper":
+        assert e.unreachable_ticks == 0
+
+
+# ----------------------------------------------------------------- 4. legs alternate
+
+
+def lifted_runs(lift: np.ndarray) -> list[tuple[int, int]]:
+    """[start, end) index ranges where ``lift > 0``, excluding ranges cut by the ends."""
+    up = np.concatenate([[False], lift > 0, [False]])
+    edges = np.flatnonzero(np.diff(up.astype(int)))
+    runs = list(zip(edges[::2], edges[1::2], strict=True))
+    return [(a, b) for a, b in runs if a > 0 and b < len(lift)]
+
+
+@pytest.mark.parametrize("name", WALKING)
+def test_each_foot_moves_forward_while_lifted(name: str) -> None:
+    p = load_gait(name).params
+    times = cycles(p, 3)
+    t = targets_of(p, times)
+    stride = 2 * scale(ROBOT.geometry, p) * p.speed
+    for sole, lift, slgt in ((t.r_sole, t.lift_r, p.Slgt_R), (t.l_sole, t.lift_l, p.Slgt_L)):
+        x, lift = np.asarray(sole[0]), np.asarray(lift)
+        runs = lifted_runs(lift)
+        assert len(runs) >= 2
+        for a, b in runs:   # over each swing the foot travels (nearly) a full stride
+            assert x[b - 1] - x[a] > 0.8 * stride * slgt, (name, a, b)
+    # With the pelvis kept upright and unyawed (no lean, no spine pitch, no hip
+    # oscillation) the sole moves forward between any two lifted samples, and back while
+    # it alone carries the robot (the other foot lifted).
+    flat = p.replace({"torso_lean": 0.0, "spine_gain": 0.0, "Hosc": 0.0})
+    t = targets_of(flat, times)
+    lr, ll = np.asarray(t.lift_r) > 0, np.asarray(t.lift_l) > 0
+    for sole, up, other in ((t.r_sole, lr, ll), (t.l_sole, ll, lr)):
+        dx = np.diff(np.asarray(sole[0]))
+        assert np.all(dx[up[:-1] & up[1:]] > 0), name
+        assert np.all(dx[other[:-1] & other[1:]] < 0), name
+
+
+params_st = st.fixed_dictionaries({
+    n: st.floats(s.lo, s.hi, allow_nan=False) for n, s in SPECS.items()
+    if n not in ("delta_f", "speed", "torso_lean", "spine_gain", "Hosc")})
+
+
+@settings(max_examples=100, deadline=None)
+@given(params_st, st.floats(-1.0, 0.0), st.floats(0.05, 1.5),
+       st.lists(st.floats(0.0, 30.0), min_size=2, max_size=30))
+def test_feet_never_lifted_together_and_swing_forward(
+        values: dict[str, float], delta_f: float, speed: float, ts: list[float]) -> None:
+    p = GaitParams(**values).replace({"delta_f": delta_f, "speed": speed, "torso_lean": 0.0,
+                                      "spine_gain": 0.0, "Hosc": 0.0})
+    times = np.sort(np.array(ts))
+    t = targets_of(p, times)
+    lr, ll = np.asarray(t.lift_r), np.asarray(t.lift_l)
+    assert np.all(lr >= 0) and np.all(ll >= 0)                       # ground clamp
+    assert not np.any((lr > 0) & (ll > 0))
+    # Velocity of each sole from a tiny step: forward whenever that foot is lifted.
+    t2 = targets_of(p, times + 1e-6)
+    for a, b, lift in ((t.r_sole, t2.r_sole, lr), (t.l_sole, t2.l_sole, ll)):
+        v = np.asarray(b[0]) - np.asarray(a[0])
+        assert np.all(v[lift > 1e-9] > -1e-15)
+
+
+def test_march_keeps_the_feet_in_place() -> None:
+    p = load_gait("march").params
+    t = targets_of(p, cycles(p, 3))
+    for sole, lift in ((t.r_sole, t.lift_r), (t.l_sole, t.lift_l)):
+        assert np.ptp(np.asarray(sole[0])) < 1e-3
+        assert np.max(lift) > 0.01                                     # but they do lift
+    assert not np.any((np.asarray(t.lift_r) > 0) & (np.asarray(t.lift_l) > 0))
+
+
+# ----------------------------------------------------------------- 5. live changes
+
+
+def run(p: GaitParams, ticks: int, change: Mapping[str, float] | None = None,
+        at: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Channels and joint angles per tick at 200 Hz, ``change`` applied before tick ``at``."""
+    e = GaitEngine(ROBOT, p)
+    e.start()
+    chs, qs = [], []
+    for i in range(ticks):
+        if change and i == at:
+            e.set_params(change)
+        qs.append(e.tick(DT))
+        ch = gait.channels(e.phase, e.live_params, amplitude=e.amplitude)
+        chs.append([ch[n] for n in gait.CHANNELS])
+    return np.array(chs), np.array(qs)
+
+
+def max_step(x: np.ndarray) -> np.ndarray:
+    return np.abs(np.diff(x, axis=0)).max(axis=0)
+
+
+@pytest.mark.parametrize("change", [
+    {"vM": 0.5},
+    {"vM": 0.2},
+    {"Slgt_R": 0.9, "Slgt_L": 0.9},
+    {"Fhgt_R": 0.7, "Fhgt_L": 0.2},
+    {"vM": 0.45, "Slgt_R": 0.2, "Slgt_L": 0.7, "Fhgt_R": 0.6, "Fhgt_L": 0.6},
+])
+def test_live_changes_do_not_jump(change: dict[str, float]) -> None:
+    p = load_gait("walk").params
+    steady = math.ceil(p.ramp_cycles * p.cycle_s * RATE) + 20
+    n = steady + 3 * int(p.cycle_s * RATE)
+    ch_old, q_old = run(p, n)
+    ch_new, q_new = run(p.replace(change), n)
+    # Typical per-tick motion: one steady cycle of the old and of the new parameters.
+    win = slice(steady, steady + int(max(p.cycle_s, p.replace(change).cycle_s) * RATE) + 2)
+    typ_ch = np.maximum(max_step(ch_old[win]), max_step(ch_new[win]))
+    typ_q = np.maximum(max_step(q_old[win]), max_step(q_new[win]))
+    for at in (steady, steady + int(0.3 * p.cycle_s * RATE)):   # mid-stride changes
+        ch, q = run(p, n, change, at)
+        after = slice(at - 2, n)
+        assert np.all(max_step(ch[after]) <= 3 * typ_ch + 1e-9), \
+            [gait.CHANNELS[i] for i in np.flatnonzero(max_step(ch[after]) > 3 * typ_ch)]
+        assert np.all(max_step(q[after]) <= 3 * typ_q + 1e-9), \
+            [ROBOT.joint_names[i] for i in np.flatnonzero(max_step(q[after]) > 3 * typ_q)]
+        # Before the change the run is the unchanged one, tick for tick.
+        assert np.array_equal(ch[:at], ch_old[:at])
+
+
+def test_live_change_reaches_the_new_values() -> None:
+    p = load_gait("walk").params
+    e = GaitEngine(ROBOT, p)
+    e.start()
+    for _ in range(100):
+        e.tick(DT)
+    e.set_params({"Slgt_R": 0.9, "vM": 0.4})
+    assert e.params.Slgt_R == 0.9 and e.params.vM == 0.4        # what was set, at once
+    e.tick(DT)
+    assert p.Slgt_R < e.live_params.Slgt_R < 0.9               # followed, not stepped
+    for _ in range(int(5 * RATE)):
+        e.tick(DT)
+    assert e.live_params == e.params
+
+
+def test_changes_while_stopped_apply_at_once() -> None:
+    e = GaitEngine(ROBOT, load_gait("walk").params)
+    e.set_params({"Hhgt": -0.3})
+    assert e.live_params.Hhgt == -0.3
+    assert e.start_pose() == GaitEngine(ROBOT, e.params).start_pose()
+
+
+# ----------------------------------------------------------------- 6. envelope
+
+
+def smoothstep(x: float) -> float:
+    x = min(max(x, 0.0), 1.0)
+    return x * x * (3 - 2 * x)
+
+
+@pytest.mark.parametrize("name", ["walk", "high_step"])
+def test_envelope_ramps_in_and_out_over_ramp_cycles(name: str) -> None:
+    p = load_gait(name).params
+    ramp_s = p.ramp_cycles * p.cycle_s
+    e = GaitEngine(ROBOT, p)
+    assert e.amplitude == 0.0 and e.stopped
+    e.start()
+    amps = []
+    for _ in range(math.ceil(ramp_s * RATE) + 5):
+        e.tick(DT)
+        amps.append(e.amplitude)
+    k = np.arange(1, len(amps) + 1) * DT
+    assert np.allclose(amps, [smoothstep(x) for x in k / ramp_s], atol=1e-9)
+    assert amps[0] > 0.0 and np.all(np.diff(amps) >= 0)
+    assert amps[int(ramp_s * RATE) - 2] < 1.0 and amps[-1] == 1.0
+    e.stop()
+    downs = []
+    while not e.stopped:
+        e.tick(DT)
+        downs.append(e.amplitude)
+    assert np.all(np.diff(downs) <= 0) and downs[-1] == 0.0
+    assert abs(len(downs) - ramp_s * RATE) <= 2
+    # Ramped out: the pose is the start pose again, whatever the phase was.
+    assert e.tick(DT) == e.start_pose()
+    assert e.amplitude == 0.0
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.sampled_from(["walk", "crouch", "high_step", "march", "paper"]),
+       st.lists(st.floats(-100, 100), min_size=5, max_size=5))
+def test_zero_amplitude_pose_is_the_start_pose(name: str, phase: list[float]) -> None:
+    e = GaitEngine(ROBOT, load_gait(name).params)
+    start = e.start_pose()
+    e.phase = gait.Phase(*phase)
+    assert np.allclose(e.pose(amplitude=0.0), start, atol=1e-12, rtol=0)
+    assert e.phase == gait.Phase(*phase)                       # start_pose leaves it alone
+    assert e.start_pose() == start
+
+
+def test_start_pose_has_both_feet_flat_on_the_ground(any_robot: RobotConfig,
+                                                     any_gait: Gait) -> None:
+    p = any_gait.params
+    g = any_robot.geometry
+    q = GaitEngine(any_robot, p).start_pose()
+    r_sole, r_rot = leg_fk_full(g, "r", tuple(q[0:6]))
+    l_sole, l_rot = leg_fk_full(g, "l", tuple(q[6:12]))
+    # Both feet have the same orientation, and it is the pelvis's inverse (level feet).
+    assert np.allclose(r_rot, l_rot, atol=1e-9)
+    level = np.array(r_rot).reshape(3, 3)       # pelvis → level frame = R_foot^T
+    r_level = level.T @ np.array(r_sole)
+    l_level = level.T @ np.array(l_sole)
+    hip_h = p.stance * g.leg_length + g.ankle_height + scale(g, p) * p.Hhgt
+    assert r_level[2] == pytest.approx(-hip_h, abs=1e-9)
+    assert l_level[2] == pytest.approx(-hip_h, abs=1e-9)
+    t = body_targets(gait.channels(gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0), p, amplitude=0.0),
+                     p, g, amplitude=0.0)
+    assert t.lift_r == 0.0 and t.lift_l == 0.0

@@ -377,8 +377,21 @@ def parse_gait(data: Mapping[str, Any], *, source: str = "<memory>") -> Gait:
 def gait_to_toml(gait: Gait) -> str:
     """Serialise a gait so that ``parse_gait`` reads it back unchanged."""
     p = gait.params.as_dict()
-    lines = [f'name = "{gait.name}"', f"fps = {p['fps']!r}", "", "[params]"]
+    lines = [f"name = {_toml_string(gait.name)}", f"fps = {p['fps']!r}", "", "[params]"]
     lines += [f"{n} = {p[n]!r}" for n, s in SPECS.items() if s.paper and n != "fps"]
     lines += ["", "[mapping]"]
     lines += [f"{n} = {p[n]!r}" for n, s in SPECS.items() if not s.paper]
     return "\n".join(lines) + "\n"
+
+
+def _toml_string(text: str) -> str:
+    """A TOML basic string: quotes, backslashes and control characters escaped."""
+    out = []
+    for ch in text:
+        if ch in '"\\':
+            out.append("\\" + ch)
+        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
+            out.append(f"\\u{ord(ch):04X}")
+        else:
+            out.append(ch)
+    return '"' + "".join(out) + '"'

@@ -30,28 +30,25 @@ from robot.params import ALIASES, SPECS, GaitParams
 BASE_ROBOT = (ROBOTS_DIR / "biped18-dynamixel.toml").read_text()
 
 
-def robot_error(tmp_path: Path, edit: Callable[[str], str]) -> str:
-    path = tmp_path / "broken-robot.toml"
-    text = edit(BASE_ROBOT)
-    assert text != BASE_ROBOT, "the edit did not apply"
+def load_error(loader: Callable[[Path], object], path: Path, text: str) -> str:
+    """Write ``text`` to ``path``, load it and return the one-line ConfigError message."""
     path.write_text(text)
     with pytest.raises(ConfigError) as info:
-        load_robot(path)
+        loader(path)
     msg = str(info.value)
     assert "\n" not in msg
     assert msg.startswith(f"{path}: "), msg
     return msg
+
+
+def robot_error(tmp_path: Path, edit: Callable[[str], str]) -> str:
+    text = edit(BASE_ROBOT)
+    assert text != BASE_ROBOT, "the edit did not apply"
+    return load_error(load_robot, tmp_path / "broken-robot.toml", text)
 
 
 def gait_error(tmp_path: Path, text: str) -> str:
-    path = tmp_path / "broken-gait.toml"
-    path.write_text(text)
-    with pytest.raises(ConfigError) as info:
-        load_gait(path)
-    msg = str(info.value)
-    assert "\n" not in msg
-    assert msg.startswith(f"{path}: "), msg
-    return msg
+    return load_error(load_gait, tmp_path / "broken-gait.toml", text)
 
 
 def sub(old: str, new: str, count: int = 1) -> Callable[[str], str]:

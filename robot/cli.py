@@ -24,6 +24,9 @@ COMMANDS: tuple[str, ...] = (
     "emulate",
     "bench",
     "mjcf",
+    "panel",
+    "render",
+    "plot",
 )
 
 

@@ -1,0 +1,273 @@
+"""The panel's controller: owns the bus, the current parameters and at most one Streamer
+run in a worker thread; every HTTP request goes through it (thread-safe).
+
+A Streamer run is one-shot, so "start" after a stop starts a new run (a new GaitEngine
+with the current parameters) on the same open bus.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections import deque
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from robot.bus.base import Bus
+from robot.config import RobotConfig
+from robot.engine import GaitEngine
+from robot.errors import BipedError
+from robot.panel.figure import views
+from robot.panel.presets import PresetStore
+from robot.params import GROUPS, SPECS, GaitParams
+from robot.servo_map import ServoMap
+from robot.streamer import Streamer, Telemetry
+
+log = logging.getLogger(__name__)
+
+RATE_WINDOW = 50  # ticks over which the loop rate is measured
+
+
+class PanelStateError(BipedError):
+    """The request does not fit the loop's state (e.g. start while running)."""
+
+
+@dataclass(frozen=True)
+class LoopOptions:
+    """rate_hz: control rate [Hz]; read_every: read back every N ticks; hold: keep torque
+    on at the rest pose after a stop."""
+
+    rate_hz: float = 200.0
+    read_every: int = 10
+    hold: bool = False
+
+
+class PanelController:
+    """Start/stop/estop, live parameters, presets and a telemetry snapshot for the panel.
+
+    ``monitor_factory`` (sim only) returns a per-tick callback → dict of sim metrics
+    (e.g. {"fell": bool, ...}); it runs in the loop's thread.
+    """
+
+    def __init__(self, robot: RobotConfig, bus: Bus, params: GaitParams, *,
+                 options: LoopOptions = LoopOptions(), presets: PresetStore | None = None,
+                 monitor_factory: Callable[[], Callable[[Telemetry], dict[str, Any]]] | None
+                 = None) -> None:
+        self.robot = robot
+        self.bus = bus
+        self.options = options
+        self.presets = presets or PresetStore()
+        self._monitor_factory = monitor_factory
+        self._map = ServoMap(robot)
+        self._params = params
+        self._lock = threading.RLock()
+        self._streamer: Streamer | None = None
+        self._thread: threading.Thread | None = None
+        self._tel: dict[str, Any] = {"state": "idle"}
+        self._sim: dict[str, Any] = {}
+        self._ticks: deque[tuple[int, float]] = deque(maxlen=RATE_WINDOW)
+        self.runs = 0
+
+    # -- parameters --------------------------------------------------------------------
+    @property
+    def params(self) -> GaitParams:
+        return self._params
+
+    @property
+    def streamer(self) -> Streamer | None:
+        return self._streamer
+
+    def set_params(self, changes: Mapping[str, Any]) -> GaitParams:
+        """Validate all of ``changes`` (ConfigError, nothing changes) and apply them: at the
+        loop's next tick when running, else to the next run."""
+        with self._lock:
+            if self.running and self._streamer is not None:
+                new = self._streamer.set_params(changes, where="panel")
+            else:
+                new = self._params.replace(changes, where="panel")
+            self._params = new
+            return new
+
+    def load_preset(self, name: object) -> GaitParams:
+        gait = self.presets.load(name)
+        return self.set_params(gait.params.as_dict())
+
+    def save_preset(self, name: object, *, overwrite: bool = False) -> str:
+        return str(self.presets.save(name, self._params, overwrite=overwrite))
+
+    # -- the loop ------------------------------------------------------------------------
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    def start(self) -> None:
+        """Start a new run with the current parameters (PanelStateError if one runs)."""
+        with self._lock:
+            if self.running:
+                raise PanelStateError("the gait is already running; stop it first")
+            if not self.bus.is_open:
+                self.bus.open()
+            engine = GaitEngine(self.robot, self._params)
+            monitor = self._monitor_factory() if self._monitor_factory else None
+            self._ticks.clear()
+            self._sim = {}
+
+            def observe(tel: Telemetry) -> None:
+                self._observe(tel, monitor)
+            o = self.options
+            self._streamer = Streamer(self._map, self.bus, engine, rate_hz=o.rate_hz,
+                                      read_every=o.read_every, hold_at_end=o.hold,
+                                      observer=observe)
+            self._tel = {"state": "starting"}
+            self.runs += 1
+            self._thread = threading.Thread(target=self._run, args=(self._streamer,),
+                                            name=f"gait-run-{self.runs}", daemon=True)
+            self._thread.start()
+
+    def _run(self, streamer: Streamer) -> None:
+        try:
+            stats = streamer.run(seconds=None)
+            log.info("run ended: %s", stats.stop_reason)
+        except BipedError as e:
+            log.error("run failed: %s", e)
+        except Exception:
+            log.exception("run crashed")
+        finally:
+            self._observe(streamer.telemetry, None)
+
+    def stop(self) -> None:
+        """Safe stop: ramp the gait out, go to rest, torque off (or hold)."""
+        with self._lock:
+            if not self.running or self._streamer is None:
+                raise PanelStateError("the gait is not running")
+            self._streamer.request_stop("panel stop")
+
+    def emergency_stop(self) -> None:
+        """Torque off at once: ends a run within one tick; with no run, torque off now."""
+        with self._lock:
+            if self.running and self._streamer is not None:
+                self._streamer.emergency_stop()
+                return
+            if self.bus.is_open:
+                self.bus.set_torque(list(self._map.ids), enabled=False)
+            self._tel = {**self._tel, "state": "estop", "stop_reason": "emergency stop"}
+
+    def reset_sim(self) -> None:
+        """Simulation only, while stopped: put the robot back on its feet (the ``home``
+        keyframe, torque off), keeping the simulation clock."""
+        with self._lock:
+            if self.running:
+                raise PanelStateError("stop the gait before resetting the simulation")
+            if getattr(self.bus, "kind", "") != "sim":
+                raise PanelStateError("reset applies to the simulated bus only")
+            import mujoco
+
+            bus: Any = self.bus
+            model, data = bus.model, bus.data
+            t = float(data.time)
+            self.bus.set_torque(list(self._map.ids), enabled=False)
+            mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+            data.time = t
+            mujoco.mj_forward(model, data)
+            self._sim = {}
+            self._tel = {"state": "idle", "stop_reason": "simulation reset"}
+
+    def wait(self, timeout: float | None = None) -> bool:
+        """Wait for the current run to end; True if none is running afterwards."""
+        t = self._thread
+        if t is not None:
+            t.join(timeout)
+        return not self.running
+
+    def shutdown(self, timeout: float = 10.0) -> None:
+        """Safe stop and wait; emergency stop if the ramp-out takes longer than
+        ``timeout`` [s]; close the bus."""
+        if self.running and self._streamer is not None:
+            self._streamer.request_stop("panel shutdown")
+            if not self.wait(timeout):
+                self._streamer.emergency_stop()
+                self.wait(2.0)
+        self.bus.close()
+
+    # -- telemetry -------------------------------------------------------------------
+    def _observe(self, tel: Telemetry, monitor: Callable[[Telemetry], dict[str, Any]] | None
+                 ) -> None:
+        """Loop thread: copy what the panel shows (cheap; FK is done on request)."""
+        snap: dict[str, Any] = {
+            "t": tel.t, "state": tel.state, "tick": tel.tick, "q_cmd": tel.q_cmd,
+            "q_present": tel.q_present, "servo": tel.servo,
+            "period_error_ms": tel.period_error_ms, "overruns": tel.overruns,
+            "amplitude": tel.amplitude, "stop_reason": tel.stop_reason}
+        if not self._ticks or self._ticks[-1][0] != tel.tick:
+            self._ticks.append((tel.tick, tel.t))
+        sim = monitor(tel) if monitor is not None else None
+        with self._lock:
+            self._tel = snap
+            if sim is not None:
+                self._sim = sim
+
+    def loop_rate_hz(self) -> float:
+        """Measured ticks per second of the loop's clock over the last ticks [Hz]."""
+        ticks = list(self._ticks)
+        if len(ticks) < 2 or ticks[-1][1] <= ticks[0][1]:
+            return 0.0
+        return (ticks[-1][0] - ticks[0][0]) / (ticks[-1][1] - ticks[0][1])
+
+    def state(self) -> dict[str, Any]:
+        """A JSON-ready snapshot: loop state and timing, servos, sim metrics, stick figure."""
+        with self._lock:
+            tel, sim, running = dict(self._tel), dict(self._sim), self.running
+        names = self.robot.joint_names
+        servos = [{"id": j.servo_id, "joint": j.name,
+                   "temperature": s.temperature if s else None,
+                   "load": s.load if s else None,
+                   "errors": sorted(s.errors) if s else []}
+                  for j in self.robot.joints
+                  for s in [tel.get("servo", {}).get(j.servo_id)]]
+        q_cmd, q_present = tel.get("q_cmd") or [], tel.get("q_present")
+        figure = {"cmd": views(self.robot, q_cmd) if len(q_cmd) == len(names) else None,
+                  "present": views(self.robot, q_present)
+                  if q_present and len(q_present) == len(names) else None}
+        return {
+            "running": running, "state": tel.get("state", "idle"), "t": tel.get("t", 0.0),
+            "tick": tel.get("tick", 0), "rate_hz": self.options.rate_hz,
+            "loop_hz": self.loop_rate_hz(), "period_error_ms": tel.get("period_error_ms", 0.0),
+            "overruns": tel.get("overruns", 0), "amplitude": tel.get("amplitude", 0.0),
+            "stop_reason": tel.get("stop_reason"), "joints": list(names),
+            "q_cmd": q_cmd, "q_present": q_present, "servos": servos, "sim": sim or None,
+            "figure": figure, "wall_time": time.time()}
+
+    def describe(self) -> dict[str, Any]:
+        """Parameters with their specs, grouped as the paper groups its sliders."""
+        p = self._params.as_dict()
+        return {
+            "params": p,
+            "groups": [{"name": g, "params": [
+                {"name": n, "value": p[n], "lo": s.lo, "hi": s.hi, "unit": s.unit,
+                 "default": s.default, "doc": s.doc, "paper": s.paper}
+                for n, s in SPECS.items() if s.group == g]} for g in GROUPS],
+        }
+
+
+def sim_monitor_factory(bus: Any) -> Callable[[], Callable[[Telemetry], dict[str, Any]]]:
+    """Per-run WalkMonitor on a MujocoBus: fell or not, torso height, tilt, distance."""
+    from sim.metrics import WalkMonitor
+
+    def factory() -> Callable[[Telemetry], dict[str, Any]]:
+        monitor = WalkMonitor(standing_height=bus.standing_height)
+        last = [-1]
+
+        def watch(tel: Telemetry) -> dict[str, Any]:
+            if tel.tick != last[0]:
+                last[0] = tel.tick
+                pos, quat = bus.base_pose()
+                monitor.update(tel.t, pos, quat, bus.upright_angle())
+            s = monitor.summary(1.0)
+            return {"fell": s["fell"], "fell_at_s": s["fell_at_s"],
+                    "distance_m": s["distance_m"], "heading_deg": s["heading_change_deg"],
+                    "torso_height_m": float(bus.base_pose()[0][2]),
+                    "tilt_deg": float(bus.upright_angle() * 57.29577951308232)}
+        return watch
+    return factory

@@ -21,9 +21,15 @@ class TickLimits:
                                    strict=True):
                 self.by_id[sid] = (max(int(lo), 0), min(int(hi), sm.resolution - 1))
 
-    def check(self, sid: int, ticks: int, who: str) -> int:
-        """``ticks`` as an int if allowed for servo ``sid`` (named ``who``), else BusError."""
+    def check(self, sid: int, ticks: int) -> int:
+        """``ticks`` as an int if allowed for servo ``sid``, else BusError. Hot path: runs
+        for every servo on every control tick, so messages are built only on failure."""
         t = int(ticks)
+        limits = self.by_id.get(sid)
+        if limits is not None and limits[0] <= t <= limits[1] and t == ticks:
+            return t
+        joint = self.robot.joint_by_id(sid) if self.robot else None
+        who = f"id {sid} ({joint.name})" if joint else f"id {sid}"
         if t != ticks:
             raise BusError(f"write_goals: goal for {who} must be whole ticks, got {ticks!r}")
         if sid not in self.by_id:
@@ -33,8 +39,6 @@ class TickLimits:
             raise BusError(f"write_goals: id {sid} is not a servo of robot {self.robot.name}; "
                            f"valid ids: {', '.join(map(str, sorted(self.by_id)))}")
         lo, hi = self.by_id[sid]
-        if not lo <= t <= hi:
-            raise BusError(f"write_goals: goal {t} ticks for {who} is outside its limits "
-                           f"[{lo}, {hi}] ticks; refusing to move it (clamp first, e.g. "
-                           "ServoMap.goals)")
-        return t
+        raise BusError(f"write_goals: goal {t} ticks for {who} is outside its limits "
+                       f"[{lo}, {hi}] ticks; refusing to move it (clamp first, e.g. "
+                       "ServoMap.goals)")

@@ -61,6 +61,7 @@ class SdkBus(Bus):
         self.table: dict[str, Register] = TABLES[self.family]
         self.health: list[str] = []
         self.limits = TickLimits(robot)
+        self._goal_size = self.table["goal_position"].size
         first, last = (self.table[n] for n in self.state_block)
         self._block_start = first.address
         self._reader = BlockSyncRead(self.sdk, first.address,
@@ -266,15 +267,15 @@ class SdkBus(Bus):
     def write_goals(self, goals: Mapping[int, int]) -> None:
         if not goals:
             return
-        size = self.table["goal_position"].size
-        params = [(sid, list(self.limits.check(sid, t, self.who(sid)).to_bytes(size, "little")))
+        check, size, writer = self.limits.check, self._goal_size, self._writer
+        params = [(sid, check(sid, t).to_bytes(size, "little"))
                   for sid, t in goals.items()]
 
         def send() -> tuple[None, int, int]:
-            self._writer.clearParam()
+            writer.clearParam()
             for sid, data in params:
-                self._writer.addParam(sid, data)
-            return None, self._writer.txPacket(), 0
+                writer.addParam(sid, data)
+            return None, writer.txPacket(), 0
 
         self._transact("sync write goal_position", None, send)
 

@@ -8,11 +8,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from typing import NoReturn
 
 import numpy as np
 import numpy.typing as npt
 
 from robot.config import RobotConfig
+from robot.errors import BipedError
 
 
 class ServoMap:
@@ -51,9 +53,20 @@ class ServoMap:
         return np.clip(np.asarray(q, dtype=float), self.q_min, self.q_max)
 
     def to_ticks(self, q: npt.ArrayLike) -> npt.NDArray[np.int64]:
-        """Joint angles [rad] → goal ticks, clamped to the limits (never outside them)."""
-        raw = self.zero + self.sign * np.asarray(q, dtype=float) * self.ticks_per_rad
-        return np.clip(np.rint(raw).astype(np.int64), self.tick_min, self.tick_max)
+        """Joint angles [rad] → goal ticks, clamped to the limits (never outside them).
+
+        Clamped before the integer cast, so huge or infinite angles land on the right
+        limit; NaN raises BipedError naming the joint.
+        """
+        with np.errstate(over="ignore"):  # huge angles become ±inf, then clamp
+            raw = self.zero + self.sign * np.asarray(q, dtype=float) * self.ticks_per_rad
+        if np.isnan(raw).any():
+            self._nan(int(np.flatnonzero(np.isnan(raw))[0]) % len(self.names))
+        return np.rint(np.clip(raw, self.tick_min, self.tick_max)).astype(np.int64)
+
+    def _nan(self, i: int) -> NoReturn:
+        raise BipedError(f"servo_map: joint {self.names[i]} (servo id {self.ids[i]}): goal "
+                         "angle is NaN; refusing to send it")
 
     def to_rad(self, ticks: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Ticks → joint angles [rad] (not clamped: a read-back may be outside limits)."""
@@ -63,9 +76,11 @@ class ServoMap:
         """Joint angles [rad] → ``{servo_id: ticks}`` ready for ``Bus.write_goals``,
         clamped to the tick limits. Pure Python: this runs every control tick."""
         out: dict[int, int] = {}
-        for (sid, zero, gain, lo, hi), v in zip(self._rows, q, strict=True):
-            t = round(zero + gain * v)
-            out[sid] = lo if t < lo else hi if t > hi else t
+        for i, ((sid, zero, gain, lo, hi), v) in enumerate(zip(self._rows, q, strict=True)):
+            t = zero + gain * v  # clamp before round(): round(inf) raises
+            if t != t:
+                self._nan(i)
+            out[sid] = lo if t < lo else hi if t > hi else round(t)
         return out
 
     def from_positions(self, positions: Mapping[int, int]) -> npt.NDArray[np.float64]:

@@ -19,9 +19,9 @@ from robot.commands.common import gait_from, robot_from
 from robot.commands.walk import add_walk_args, parse_sets
 from robot.config import GAITS_DIR
 from robot.errors import ConfigError
-from robot.panel.controller import LoopOptions, PanelController, sim_monitor_factory
+from robot.panel.controller import LoopOptions, make_controller
 from robot.panel.presets import PresetStore
-from robot.panel.server import build_server, is_loopback
+from robot.panel.server import build_server, is_loopback, serve_in_thread
 
 log = logging.getLogger(__name__)
 
@@ -57,27 +57,23 @@ def run(args: argparse.Namespace) -> int:
         token = secrets.token_urlsafe(18)
     options: dict[str, Any] = {"realtime": True, "view": args.view} if kind == "sim" else {}
     bus = make_bus(kind, robot=robot, port=args.port, baud=args.baud, **options)
-    bus.open()
-    controller = PanelController(
+    controller = make_controller(
         robot, bus, params,
         options=LoopOptions(rate_hz=args.rate, read_every=args.read_every, hold=args.hold),
-        presets=PresetStore(Path(args.presets_dir)),
-        monitor_factory=sim_monitor_factory(bus) if kind == "sim" else None)
+        presets=PresetStore(Path(args.presets_dir)))
     try:
         server = build_server(controller, host=args.host, port=args.http_port, token=token)
     except OSError as e:
-        bus.close()
         raise ConfigError(f"--http-port {args.http_port}: cannot serve on {args.host}: "
                           f"{e.strerror or e}") from e
-    host, port = str(server.server_address[0]), int(server.server_address[1])
-    shown = f"[{host}]" if ":" in host else host
-    url = f"http://{shown}:{port}/" + (f"?token={token}" if token else "")
+    _, base = serve_in_thread(server)
+    if not is_loopback(args.host):
+        base = base.replace("127.0.0.1", args.host).replace("[::1]", f"[{args.host}]")
+    url = base + (f"?token={token}" if token else "")
     print(f"biped panel: {robot.name} on the {kind} bus at {args.rate:g} Hz; open {url}",
           flush=True)
     if token and not args.token:
         print(f"biped panel: access token {token}", flush=True)
-    serving = threading.Thread(target=server.serve_forever, name="panel-http", daemon=True)
-    serving.start()
 
     def on_term(_signum: int, _frame: Any) -> None:
         raise KeyboardInterrupt

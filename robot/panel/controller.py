@@ -251,6 +251,15 @@ class PanelController:
         }
 
 
+def make_controller(robot: RobotConfig, bus: Bus, params: GaitParams, *,
+                    options: LoopOptions = LoopOptions(),
+                    presets: PresetStore | None = None) -> PanelController:
+    """A controller for ``bus``, with fall detection when it is the simulated bus."""
+    factory = sim_monitor_factory(bus) if bus.kind == "sim" else None
+    return PanelController(robot, bus, params, options=options, presets=presets,
+                           monitor_factory=factory)
+
+
 def sim_monitor_factory(bus: Any) -> Callable[[], Callable[[Telemetry], dict[str, Any]]]:
     """Per-run WalkMonitor on a MujocoBus: fell or not, torso height, tilt, distance."""
     from sim.metrics import WalkMonitor

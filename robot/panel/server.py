@@ -20,6 +20,7 @@ import hmac
 import json
 import logging
 import socket
+import threading
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from importlib import resources
@@ -154,6 +155,17 @@ def build_server(controller: PanelController, *, host: str = "127.0.0.1", port: 
 
     server_class = _Server6 if ":" in host else _Server
     return server_class((host, port), Handler)
+
+
+def serve_in_thread(server: ThreadingHTTPServer) -> tuple[threading.Thread, str]:
+    """Run ``server.serve_forever`` in a daemon thread; returns it and the base URL."""
+    host, port = str(server.server_address[0]), int(server.server_address[1])
+    if host in ("0.0.0.0", "::"):
+        host = "127.0.0.1" if host == "0.0.0.0" else "::1"
+    shown = f"[{host}]" if ":" in host else host
+    thread = threading.Thread(target=server.serve_forever, name="panel-http", daemon=True)
+    thread.start()
+    return thread, f"http://{shown}:{port}/"
 
 
 class _Server(ThreadingHTTPServer):

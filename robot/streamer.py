@@ -203,10 +203,10 @@ class Streamer:
         self._wait_deadline()
         try:
             self.bus.write_goals(self.map.goals(q.tolist()))
-            self.watchdog.bus_ok()
+            self.watchdog.bus_ok("write")
         except BusError as e:
             self._bus_errors += 1
-            self.watchdog.bus_failed(e)
+            self.watchdog.bus_failed("write", e)
         self._q_last = q
         self._ticks += 1
         tel = self.telemetry
@@ -216,7 +216,7 @@ class Streamer:
         if self._ticks % self.read_every == 0:
             try:
                 states = self.bus.read_state(self.map.ids)
-                self.watchdog.bus_ok()
+                self.watchdog.bus_ok("read")
                 tel.servo = states
                 tel.q_present = self.map.from_positions(
                     {i: s.position for i, s in states.items()}).tolist()
@@ -224,7 +224,7 @@ class Streamer:
                 self.watchdog.check(states, q)
             except BusError as e:
                 self._bus_errors += 1
-                self.watchdog.bus_failed(e)
+                self.watchdog.bus_failed("read", e)
         self._notify()
 
     def _wait_deadline(self) -> None:

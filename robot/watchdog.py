@@ -39,7 +39,7 @@ class Watchdog:
         self.cfg = cfg
         self.map = servo_map
         self.robot = robot
-        self._bus_streak = 0
+        self._bus_streak = {"write": 0, "read": 0}
         self._overrun_streak = 0
         self._follow_streak = np.zeros(len(servo_map.ids), dtype=int)
 
@@ -47,13 +47,17 @@ class Watchdog:
         j = self.robot.joint_by_id(servo_id) if self.robot else None
         return f"servo {servo_id}" + (f" ({j.name})" if j else "")
 
-    def bus_ok(self) -> None:
-        self._bus_streak = 0
+    def bus_ok(self, kind: str) -> None:
+        """A ``kind`` ("write" or "read") transaction succeeded."""
+        self._bus_streak[kind] = 0
 
-    def bus_failed(self, error: BusError) -> None:
-        self._bus_streak += 1
-        if self._bus_streak >= self.cfg.bus_error_streak:
-            raise SafetyStop(f"{self._bus_streak} bus errors in a row; last: {error}") from error
+    def bus_failed(self, kind: str, error: BusError) -> None:
+        """Writes and read-backs keep separate streaks: goals that still go out do not
+        excuse a robot that can no longer be monitored."""
+        self._bus_streak[kind] += 1
+        n = self._bus_streak[kind]
+        if n >= self.cfg.bus_error_streak:
+            raise SafetyStop(f"{n} bus errors in a row ({kind}); last: {error}") from error
 
     def on_time(self) -> None:
         self._overrun_streak = 0

@@ -7,14 +7,19 @@ import argparse
 import json
 import logging
 import signal
-import sys
 import time
 from collections.abc import Callable
 from typing import Any
 
 from robot.bus.factory import make_bus
-from robot.commands.common import (add_bus_args, add_robot_args, gait_from, positive_float,
-                                   positive_int, robot_from)
+from robot.commands.common import (
+    add_bus_args,
+    add_robot_args,
+    gait_from,
+    positive_float,
+    positive_int,
+    robot_from,
+)
 from robot.engine import GaitEngine
 from robot.errors import ConfigError
 from robot.recorder import Recorder
@@ -84,7 +89,8 @@ def run(args: argparse.Namespace) -> int:
     kind = args.bus or "sim"
     if kind != "sim" and (args.view or args.realtime):
         raise ConfigError("--view and --realtime apply to --bus sim only")
-    options: dict[str, Any] = {"realtime": args.realtime, "view": args.view} if kind == "sim" else {}
+    options: dict[str, Any] = (
+        {"realtime": args.realtime, "view": args.view} if kind == "sim" else {})
     bus = make_bus(kind, robot=robot, port=args.port, baud=args.baud, **options)
     recorder = Recorder(args.record, robot.joint_names, robot.ids) if args.record else None
     engine = GaitEngine(robot, params)
@@ -140,18 +146,21 @@ def run(args: argparse.Namespace) -> int:
 
 
 def format_summary(r: dict[str, Any]) -> str:
-    lines = [f"{r['robot']} walked gait '{r['gait']}' for {r['seconds']:g} s on the {r['bus']} bus"]
+    lines = [f"{r['robot']} walked gait '{r['gait']}' for {r['seconds']:g} s "
+             f"on the {r['bus']} bus"]
     if "distance_m" in r:
+        fell = f"YES at {r['fell_at_s']:.1f} s" if r["fell"] else "no"
         lines += [
             f"  distance      {r['distance_m']:+.3f} m forward ({r['speed_m_s']:.3f} m/s)",
             f"  lateral drift {r['lateral_drift_m']:+.3f} m",
             f"  heading       {r['heading_change_deg']:+.1f} deg",
-            f"  fell          {'YES at %.1f s' % r['fell_at_s'] if r['fell'] else 'no'}"
-            f" (lowest torso {r['min_torso_height_m']:.3f} m, max tilt {r['max_tilt_deg']:.1f} deg)",
+            f"  fell          {fell} (lowest torso {r['min_torso_height_m']:.3f} m,"
+            f" max tilt {r['max_tilt_deg']:.1f} deg)",
         ]
     lines += [
-        f"  loop          {r['ticks']} ticks at {r['rate_hz']:g} Hz (achieved {r['achieved_hz']:.1f} Hz),"
-        f" period error p50 {r['period_error_p50_ms']:.3f} ms, p99 {r['period_error_p99_ms']:.3f} ms,"
+        f"  loop          {r['ticks']} ticks at {r['rate_hz']:g} Hz"
+        f" (achieved {r['achieved_hz']:.1f} Hz), period error"
+        f" p50 {r['period_error_p50_ms']:.3f} ms, p99 {r['period_error_p99_ms']:.3f} ms,"
         f" {r['overruns']} overruns, {r['bus_errors']} bus errors",
         f"  realtime      x{r['realtime_factor']:.1f}",
         f"  stopped       {r['stop_reason']}",

@@ -1,0 +1,166 @@
+"""The streamer against the pty emulator with the real vendor SDKs (both protocols)."""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from bus_harness import open_bus
+
+from robot.bus.tables import TABLES
+from robot.config import RobotConfig, load_gait
+from robot.engine import GaitEngine
+from robot.servo_map import ServoMap
+from robot.streamer import Streamer, Telemetry
+from robot.watchdog import WatchdogConfig
+from sim.emulator import Emulator, Packet
+
+pytest_plugins = ("bus_harness",)
+
+RATE = 200.0
+
+
+def _streamer(bus: object, robot: RobotConfig, **kw: object) -> Streamer:
+    engine = GaitEngine(robot, load_gait("walk").params)
+    return Streamer(ServoMap(robot), bus, engine, rate_hz=RATE, **kw)  # type: ignore[arg-type]
+
+
+def _goal_writes(log: list[Packet], robot: RobotConfig) -> list[Packet]:
+    family = "dynamixel_x" if robot.bus.kind == "dynamixel" else "feetech_sts"
+    addr = TABLES[family]["goal_position"].address
+    return [p for p in log if p.instruction == "sync_write" and p.address == addr]
+
+
+def _torque_writes(log: list[Packet], robot: RobotConfig) -> list[Packet]:
+    family = "dynamixel_x" if robot.bus.kind == "dynamixel" else "feetech_sts"
+    addr = TABLES[family]["torque_enable"].address
+    return [p for p in log if p.instruction in ("write", "sync_write") and p.address == addr]
+
+
+def test_one_sync_write_per_tick_within_limits_and_slew(emu: Emulator, robot: RobotConfig) -> None:
+    bus = open_bus(emu, robot)
+    emu.log(clear=True)
+    try:
+        stats = _streamer(bus, robot, read_every=10).run(seconds=0.4)
+    finally:
+        bus.close()
+    log = emu.log()
+    goals = _goal_writes(log, robot)
+    assert stats.ticks > 50
+    assert len(goals) == stats.ticks                       # exactly one packet per tick
+    smap = ServoMap(robot)
+    ticks = np.array([[p.values[i] for i in smap.ids] for p in goals])
+    assert (ticks >= smap.tick_min).all() and (ticks <= smap.tick_max).all()
+    max_step = smap.max_speed / RATE * smap.ticks_per_rad + 1.0   # +1 tick of rounding
+    assert (np.abs(np.diff(ticks, axis=0)) <= max_step).all()
+    torque = _torque_writes(log, robot)
+    first_goal, last_goal = goals[0].t, goals[-1].t
+    on = [p for p in torque if all(v == 1 for v in p.values.values())]
+    off = [p for p in torque if all(v == 0 for v in p.values.values())]
+    assert on and max(p.t for p in on) <= first_goal          # torque on before any goal
+    assert off and min(p.t for p in off) >= last_goal         # torque off after the last
+    assert {i for p in off for i in p.ids} == set(robot.ids)
+    assert all(emu.registers(i)["torque_enable"] == 0 for i in robot.ids)
+
+
+def test_exception_in_loop_leaves_torque_off(emu: Emulator, robot: RobotConfig) -> None:
+    bus = open_bus(emu, robot)
+
+    def explode(tel: Telemetry) -> None:
+        if tel.tick == 30:
+            raise RuntimeError("boom in the loop")
+
+    try:
+        with pytest.raises(RuntimeError, match="boom"):
+            _streamer(bus, robot, observer=explode).run(seconds=5)
+        assert all(emu.registers(i)["torque_enable"] == 0 for i in robot.ids)
+    finally:
+        bus.close()
+
+
+@pytest.mark.parametrize("fault", ["overheating", "overload", "vanish", "drop_all"])
+def test_watchdog_stops_safely_on_injected_faults(emu: Emulator, robot: RobotConfig,
+                                                  fault: str) -> None:
+    bus = open_bus(emu, robot)
+    victim = robot.joint("l_knee").servo_id
+    injected = {"done": False}
+
+    def inject(tel: Telemetry) -> None:
+        if tel.tick == 40 and not injected["done"]:
+            injected["done"] = True
+            if fault in ("overheating", "overload"):
+                emu.set_faults(hw_error={victim: fault})
+            elif fault == "vanish":
+                emu.set_faults(vanish={victim: 0.0})
+            else:
+                emu.set_faults(drop_rate=1.0)
+
+    streamer = _streamer(bus, robot, read_every=5, observer=inject,
+                         watchdog=WatchdogConfig(bus_error_streak=3))
+    try:
+        t0 = time.monotonic()
+        stats = streamer.run(seconds=30)
+        assert time.monotonic() - t0 < 20                # stopped long before the 30 s walk
+    finally:
+        emu.clear_faults()
+        bus.close()
+    assert stats.stop_reason.startswith("watchdog")
+    if fault in ("overheating", "overload"):
+        assert fault in stats.stop_reason and "l_knee" in stats.stop_reason
+    else:
+        assert "bus errors" in stats.stop_reason
+    # Whatever answered is torque-off now (a vanished servo cannot be reached, by definition).
+    reachable = [i for i in robot.ids if fault == "overheating" or i != victim]
+    if fault != "drop_all":
+        assert all(emu.registers(i)["torque_enable"] == 0 for i in reachable)
+
+
+def test_sigint_ramps_out_and_leaves_torque_off(emu: Emulator, robot: RobotConfig) -> None:
+    env = {**os.environ, "MUJOCO_GL": "egl"}
+    cmd = [sys.executable, "-m", "robot.cli", "walk", "--bus", robot.bus.kind,
+           "--robot", robot.source, "--port", emu.port, "--seconds", "60", "--json"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=env)
+    try:
+        deadline = time.monotonic() + 15
+        while time.monotonic() < deadline:     # wait until the gait streams
+            if len(_goal_writes(emu.log(), robot)) > 100:
+                break
+            time.sleep(0.1)
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=20)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0, err
+    assert "signal SIGINT" in out
+    assert all(emu.registers(i)["torque_enable"] == 0 for i in robot.ids)
+    goals = _goal_writes(emu.log(), robot)
+    smap = ServoMap(robot)
+    last = np.array([goals[-1].values[i] for i in smap.ids])
+    rest = smap.to_ticks(smap.clamp(smap.vector(robot.rest)))
+    assert np.abs(last - rest).max() <= 1                    # ramped back to the rest pose
+
+
+def test_watchdog_follow_error_unit(robot: RobotConfig) -> None:
+    from robot.bus.base import ServoState
+    from robot.errors import SafetyStop
+    from robot.watchdog import Watchdog
+
+    smap = ServoMap(robot)
+    wd = Watchdog(WatchdogConfig(follow_reads=3), smap, robot=robot)
+    q = np.zeros(len(smap.ids))
+    stuck = {i: ServoState(i, int(smap.to_ticks(q)[k])) for k, i in enumerate(smap.ids)}
+    q_cmd = q.copy()
+    q_cmd[3] = 1.0                                           # r_knee commanded 1 rad away
+    wd.check(stuck, q_cmd)
+    wd.check(stuck, q_cmd)
+    with pytest.raises(SafetyStop, match="r_knee.*stopped following"):
+        wd.check(stuck, q_cmd)
+    assert math.isfinite(float(q_cmd.sum()))

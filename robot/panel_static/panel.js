@@ -25,13 +25,14 @@ function say(text, error) {
 
 function fmt(v, d = 3) { return v === null || v === undefined ? "–" : Number(v).toFixed(d); }
 
-function showParams(params) {
+function showParams(params, force) {
+  // Inputs being edited keep their text unless forced (after a refused value).
   for (const [name, v] of Object.entries(params)) {
     const w = inputs[name];
     if (!w) continue;
-    if (document.activeElement !== w.number) w.number.value = +v.toPrecision(6);
-    if (document.activeElement !== w.range) w.range.value = v;
-    w.row.classList.remove("bad");
+    if (force || document.activeElement !== w.number) w.number.value = +v.toPrecision(6);
+    if (force || document.activeElement !== w.range) w.range.value = v;
+    if (!force) w.row.classList.remove("bad");
   }
 }
 
@@ -46,7 +47,7 @@ async function sendParams(changes) {
     for (const n of Object.keys(changes)) if (inputs[n]) inputs[n].row.classList.add("bad");
     say(e.message, true);
     const cur = await api("GET", "/api/params");
-    showParams(cur.params);
+    showParams(cur.params, true);
   } finally {
     busy = false;
     if (queued) { const q = queued; queued = null; sendParams(q); }

@@ -1,0 +1,133 @@
+"""End to end in real headless Chromium (Debian's, driven by Playwright): the panel on the
+MuJoCo bus; drag a slider and see it reach the running loop; stop, start, emergency stop."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+
+import numpy as np
+import pytest
+from playwright.sync_api import Page, sync_playwright
+
+from robot.config import DEFAULT_ROBOT, load_gait, load_robot
+from robot.panel.controller import LoopOptions, PanelController, make_controller
+from robot.panel.server import build_server, serve_in_thread
+from sim.mujoco_bus import MujocoBus
+
+CHROMIUM = "/usr/bin/chromium"
+ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+        "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+
+
+def wait_for(pred: Callable[[], bool], timeout: float = 10.0) -> bool:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if pred():
+            return True
+        time.sleep(0.02)
+    return False
+
+
+@pytest.fixture(scope="module")
+def running() -> Iterator[tuple[PanelController, str]]:
+    robot = load_robot(DEFAULT_ROBOT)
+    controller = make_controller(robot, MujocoBus(robot, realtime=True),
+                                 load_gait("walk").params,
+                                 options=LoopOptions(rate_hz=100.0, read_every=5))
+    server = build_server(controller, port=0)
+    _, base = serve_in_thread(server)
+    controller.start()
+    yield controller, base
+    server.shutdown()
+    server.server_close()
+    controller.emergency_stop()
+    controller.shutdown()
+
+
+@pytest.fixture(scope="module")
+def page(running: tuple[PanelController, str]) -> Iterator[Page]:
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        pg = browser.new_page(viewport={"width": 1400, "height": 950})
+        errors: list[str] = []
+        pg.on("pageerror", lambda e: errors.append(str(e)))
+        pg.goto(running[1])
+        pg.wait_for_selector("#range-Slgt_R")
+        yield pg
+        browser.close()
+        assert not errors, errors
+
+
+def hip_pitch_swing(controller: PanelController, seconds: float) -> float:
+    """Peak-to-peak of the commanded right hip pitch over ``seconds`` [rad]."""
+    i = controller.robot.joint_names.index("r_hip_pitch")
+    seen: list[float] = []
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        q = controller.state()["q_cmd"]
+        if q:
+            seen.append(q[i])
+        time.sleep(0.01)
+    return float(np.ptp(seen))
+
+
+def test_slider_reaches_the_running_loop(running: tuple[PanelController, str],
+                                         page: Page) -> None:
+    controller, _ = running
+    assert wait_for(lambda: controller.state()["state"] == "walking")
+    streamer = controller.streamer
+    assert streamer is not None
+    s0 = streamer.engine.params.Slgt_R  # the preset's (about 0.5; range [0, 3])
+    s1 = s0 + 0.7
+    cycle = streamer.engine.params.cycle_s
+    before = hip_pitch_swing(controller, cycle)
+    box = page.locator("#range-Slgt_R").bounding_box()
+    assert box is not None
+    y = box["y"] + box["height"] / 2
+    # Drag the thumb from s0 to s1 (the thumb's centre is inset by ~8 px at the ends).
+    def x_of(v: float) -> float:
+        return box["x"] + 8 + (box["width"] - 16) * v / 3
+    page.mouse.move(x_of(s0), y)
+    page.mouse.down()
+    page.mouse.move(x_of((s0 + s1) / 2), y, steps=4)
+    page.mouse.move(x_of(s1), y, steps=4)
+    page.mouse.up()
+    assert wait_for(lambda: abs(streamer.engine.params.Slgt_R - s1) < 0.1, 3.0), \
+        streamer.engine.params.Slgt_R
+    shown = float(page.input_value("#num-Slgt_R"))
+    assert wait_for(lambda: streamer.engine.params.Slgt_R == controller.params.Slgt_R)
+    assert shown == pytest.approx(streamer.engine.params.Slgt_R, abs=0.01)
+    after = hip_pitch_swing(controller, cycle)
+    assert after > before * 1.3 + 0.02, (before, after)
+
+
+def test_number_box_refuses_out_of_range(running: tuple[PanelController, str],
+                                         page: Page) -> None:
+    controller, _ = running
+    before = controller.params
+    page.fill("#num-vM", "7")
+    page.press("#num-vM", "Enter")
+    page.wait_for_selector("#message.error")
+    assert "vM = 7 is outside [0, 2]" in page.inner_text("#message")
+    assert controller.params == before
+    page.wait_for_function(f"document.getElementById('num-vM').value == '{before.vM:g}'")
+
+
+def test_stop_start_estop_buttons(running: tuple[PanelController, str], page: Page) -> None:
+    controller, _ = running
+    seen: set[str] = set()
+    page.click("#stop")
+    assert wait_for(lambda: seen.add(controller.state()["state"]) or not controller.running)
+    assert seen & {"ramp_out", "rest"} and controller.state()["state"] == "stopped"
+    page.wait_for_function("document.getElementById('state').textContent.startsWith('stopped')")
+    page.click("#start")
+    assert wait_for(lambda: controller.state()["state"] == "walking")
+    page.wait_for_function("document.getElementById('state').textContent == 'walking'")
+    bus = controller.bus
+    assert isinstance(bus, MujocoBus) and (bus.model.actuator_gainprm[:, 0] > 0).all()
+    page.click("#estop")
+    assert controller.wait(1.0)
+    assert controller.state()["state"] == "estop"
+    assert (bus.model.actuator_gainprm[:, 0] == 0).all()
+    page.wait_for_function("document.getElementById('state').textContent.startsWith('estop')")

@@ -34,7 +34,8 @@ def running() -> Iterator[tuple[PanelController, str]]:
     robot = load_robot(DEFAULT_ROBOT)
     controller = make_controller(robot, MujocoBus(robot, realtime=True),
                                  load_gait("walk").params,
-                                 options=LoopOptions(rate_hz=100.0, read_every=5))
+                                 options=LoopOptions(rate_hz=100.0, read_every=5),
+                                 preset="walk")
     server = build_server(controller, port=0)
     _, base = serve_in_thread(server)
     controller.start()
@@ -75,6 +76,7 @@ def hip_pitch_swing(controller: PanelController, seconds: float) -> float:
 def test_slider_reaches_the_running_loop(running: tuple[PanelController, str],
                                          page: Page) -> None:
     controller, _ = running
+    assert page.input_value("#preset") == "walk"
     assert wait_for(lambda: controller.state()["state"] == "walking")
     streamer = controller.streamer
     assert streamer is not None

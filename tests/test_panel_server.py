@@ -48,7 +48,7 @@ def panel(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[PanelContr
     controller = make_controller(robot, MujocoBus(robot, realtime=True),
                                  load_gait("walk").params,
                                  options=LoopOptions(rate_hz=100.0, read_every=5),
-                                 presets=presets)
+                                 presets=presets, preset="walk")
     server = build_server(controller, port=0)
     _, base = serve_in_thread(server)
     controller.start()
@@ -145,6 +145,7 @@ def test_presets_list_and_load(panel: tuple[PanelController, Call]) -> None:
     status, d = call("POST", "/api/preset", {"name": "march"})
     assert status == 200 and d["params"] == load_gait("march").params.as_dict()
     assert controller.params == load_gait("march").params
+    assert call("GET", "/api/params")[1]["preset"] == "march"
     for bad in ("no_such_preset", "../walk", None):
         status, d = call("POST", "/api/preset", {"name": bad})
         assert status == 400 and "preset" in d["error"]

@@ -48,7 +48,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
 
 def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
-    params = gait_from(args).params.replace(parse_sets(args.set), where="--set")
+    gait = gait_from(args)
+    params = gait.params.replace(parse_sets(args.set), where="--set")
     kind = args.bus or "sim"
     if kind != "sim" and args.view:
         raise ConfigError("--view applies to --bus sim only")
@@ -60,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
     controller = make_controller(
         robot, bus, params,
         options=LoopOptions(rate_hz=args.rate, read_every=args.read_every, hold=args.hold),
-        presets=PresetStore(Path(args.presets_dir)))
+        presets=PresetStore(Path(args.presets_dir)), preset=gait.name)
     try:
         server = build_server(controller, host=args.host, port=args.http_port, token=token)
     except OSError as e:

@@ -54,7 +54,7 @@ class PanelController:
     def __init__(self, robot: RobotConfig, bus: Bus, params: GaitParams, *,
                  options: LoopOptions = LoopOptions(), presets: PresetStore | None = None,
                  monitor_factory: Callable[[], Callable[[Telemetry], dict[str, Any]]] | None
-                 = None) -> None:
+                 = None, preset: str | None = None) -> None:
         self.robot = robot
         self.bus = bus
         self.options = options
@@ -62,6 +62,7 @@ class PanelController:
         self._monitor_factory = monitor_factory
         self._map = ServoMap(robot)
         self._params = params
+        self.preset = preset  # name of the last preset loaded (shown by the picker)
         self._lock = threading.RLock()
         self._streamer: Streamer | None = None
         self._thread: threading.Thread | None = None
@@ -92,7 +93,9 @@ class PanelController:
 
     def load_preset(self, name: object) -> GaitParams:
         gait = self.presets.load(name)
-        return self.set_params(gait.params.as_dict())
+        new = self.set_params(gait.params.as_dict())
+        self.preset = str(name)
+        return new
 
     def save_preset(self, name: object, *, overwrite: bool = False) -> str:
         return str(self.presets.save(name, self._params, overwrite=overwrite))
@@ -243,7 +246,7 @@ class PanelController:
         """Parameters with their specs, grouped as the paper groups its sliders."""
         p = self._params.as_dict()
         return {
-            "params": p,
+            "params": p, "preset": self.preset,
             "groups": [{"name": g, "params": [
                 {"name": n, "value": p[n], "lo": s.lo, "hi": s.hi, "unit": s.unit,
                  "default": s.default, "doc": s.doc, "paper": s.paper}
@@ -253,11 +256,12 @@ class PanelController:
 
 def make_controller(robot: RobotConfig, bus: Bus, params: GaitParams, *,
                     options: LoopOptions = LoopOptions(),
-                    presets: PresetStore | None = None) -> PanelController:
+                    presets: PresetStore | None = None,
+                    preset: str | None = None) -> PanelController:
     """A controller for ``bus``, with fall detection when it is the simulated bus."""
     factory = sim_monitor_factory(bus) if bus.kind == "sim" else None
     return PanelController(robot, bus, params, options=options, presets=presets,
-                           monitor_factory=factory)
+                           monitor_factory=factory, preset=preset)
 
 
 def sim_monitor_factory(bus: Any) -> Callable[[], Callable[[Telemetry], dict[str, Any]]]:

@@ -176,8 +176,9 @@ function action(id, path, body, after) {
 }
 
 async function main() {
-  buildParams(await api("GET", "/api/params"));
-  await loadPresets();
+  const desc = await api("GET", "/api/params");
+  buildParams(desc);
+  await loadPresets(desc.preset);
   action("start", "/api/start");
   action("stop", "/api/stop");
   action("estop", "/api/estop");

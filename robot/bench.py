@@ -59,3 +59,11 @@ def run_core_bench(*, quick: bool = False) -> dict[str, Any]:
         "tick": bench_tick(ticks=2000 if quick else 20000),
         "vectorised": bench_vectorised(frames=100_000 if quick else 1_000_000),
     }
+
+
+def run_bus_section(*, quick: bool = False) -> dict[str, Any]:
+    """Our bus driver vs the raw SDK group calls, over the pty emulator (both protocols)."""
+    from robot.bench_bus import run_bus_bench
+
+    cycles = 100 if quick else 500
+    return {p: run_bus_bench(p, cycles=cycles) for p in ("dynamixel", "feetech")}

@@ -54,6 +54,8 @@ def main(argv: list[str] | None = None) -> int:
     except BipedError as e:
         print(f"biped {args.command}: error: {e}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        return 0  # stdout closed early (e.g. piped into `head`)
     except KeyboardInterrupt:
         print(f"biped {args.command}: interrupted", file=sys.stderr)
         return 130

@@ -9,6 +9,8 @@ from typing import Any
 
 SECTIONS: dict[str, str] = {
     "core": "robot.bench:run_core_bench",
+    "bus": "robot.bench:run_bus_section",
+    "loop": "robot.bench_loop:run_loop_bench",
 }
 
 

@@ -13,7 +13,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	MUJOCO_GL=egl $(BIN)/biped curves --gait walk --seconds 4 --rate 100 --out walk.csv --plot walk.png
+	MUJOCO_GL=egl $(BIN)/biped walk --seconds 10
 
 lint: $(STAMP)
 	$(BIN)/ruff check robot sim tests

@@ -8,7 +8,8 @@ The paper animates a Maya rig (Y up, Z forward, rig units). Here, once:
   (``-sin + delta_f``) so delta_f means the same for both feet;
 - foot heights below the ground are stance: clamped at the ground;
 - lateral sway of the pelvis in step with the stride (weight over the stance foot);
-- steering: ``speed`` scales the stride, ``turn`` yaws the feet (hip yaw) and
+- steering: ``speed`` scales the stride, ``turn`` yaws the feet (hip yaw) about the
+  body's vertical axis (orientation and position) and
   ``side_step`` moves them sideways, both in step with the stride;
 - eq 14/15: the up-leg translations move the pelvis: their mean shifts it forward, their
   difference yaws it, ``UpLeg_tY`` sets the hip height;
@@ -51,6 +52,11 @@ class BodyTargets(NamedTuple):
     lift_l: Num
 
 
+def _yawed(v: tuple[Num, Num, Num], yaw: Num) -> tuple[Num, Num, Num]:
+    c, s = xm.cos(yaw), xm.sin(yaw)
+    return (c * v[0] - s * v[1], s * v[0] + c * v[1], v[2])
+
+
 def scale(g: Geometry, p: GaitParams) -> float:
     """Metres per rig unit."""
     return g.leg_length / p.rig_leg
@@ -86,8 +92,15 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
              -hip_h + lift_l)
     w_r = xm.clip(ty, 0.0, 1.0)
     w_l = xm.clip(ty_l, 0.0, 1.0)
-    r_rot = xm.rz_ry(-0.5 * p.turn * tz, -p.toe_gain * ch["RightToe_tY"] * w_r)
-    l_rot = xm.rz_ry(0.5 * p.turn * tz, -p.toe_gain * ch["LeftToe_tY"] * w_l)
+    yaw_r = -0.5 * p.turn * tz
+    yaw_l = 0.5 * p.turn * tz
+    r_rot = xm.rz_ry(yaw_r, -p.toe_gain * ch["RightToe_tY"] * w_r)
+    l_rot = xm.rz_ry(yaw_l, -p.toe_gain * ch["LeftToe_tY"] * w_l)
+    if p.turn != 0.0:
+        # Turning: the body rotates about its own vertical axis over the planted foot, so
+        # each foot's position turns with its yaw too (otherwise it would have to slip).
+        r_pos = _yawed(r_pos, yaw_r)
+        l_pos = _yawed(l_pos, yaw_l)
 
     r_sole = xm.apply_t(pelvis_rot, (r_pos[0] - px, r_pos[1] - py, r_pos[2]))
     l_sole = xm.apply_t(pelvis_rot, (l_pos[0] - px, l_pos[1] - py, l_pos[2]))

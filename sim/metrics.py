@@ -29,6 +29,7 @@ class WalkMonitor:
     start_yaw: float = 0.0
     last_xy: np.ndarray = field(default_factory=lambda: np.zeros(2))
     last_yaw: float = 0.0
+    heading: float = 0.0  # unwrapped yaw change since the start [rad]
     fell: bool = False
     fell_at: float | None = None
     min_height: float = math.inf
@@ -37,9 +38,11 @@ class WalkMonitor:
     def update(self, t: float, pos: np.ndarray, quat: np.ndarray, tilt: float) -> None:
         if self.start_xy is None:
             self.start_xy = pos[:2].copy()
-            self.start_yaw = yaw_of(quat)
+            self.start_yaw = self.last_yaw = yaw_of(quat)
         self.last_xy = pos[:2].copy()
-        self.last_yaw = yaw_of(quat)
+        yaw = yaw_of(quat)
+        self.heading += math.atan2(math.sin(yaw - self.last_yaw), math.cos(yaw - self.last_yaw))
+        self.last_yaw = yaw
         self.min_height = min(self.min_height, float(pos[2]))
         self.max_tilt = max(self.max_tilt, tilt)
         if not self.fell and (pos[2] < FALL_HEIGHT_RATIO * self.standing_height
@@ -52,14 +55,12 @@ class WalkMonitor:
         c, s = math.cos(self.start_yaw), math.sin(self.start_yaw)
         forward = float(c * d[0] + s * d[1])
         lateral = float(-s * d[0] + c * d[1])
-        dyaw = math.atan2(math.sin(self.last_yaw - self.start_yaw),
-                          math.cos(self.last_yaw - self.start_yaw))
         return {
             "distance_m": forward,
             "speed_m_s": forward / walk_seconds if walk_seconds > 0 else 0.0,
             "displacement_m": float(np.hypot(*d)),
             "lateral_drift_m": lateral,
-            "heading_change_deg": math.degrees(dyaw),
+            "heading_change_deg": math.degrees(self.heading),  # unwrapped: 2 turns = 720
             "fell": self.fell,
             "fell_at_s": self.fell_at,
             "min_torso_height_m": self.min_height,

@@ -7,6 +7,7 @@ streamer); 60 simulated seconds take a few wall seconds.
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 
@@ -48,12 +49,14 @@ def test_presets_stay_up_60s(capsys: pytest.CaptureFixture[str], gait: str) -> N
         assert r["displacement_m"] <= 0.10
 
 
-@pytest.mark.parametrize("turn,sign", [(0.15, 1.0), (-0.15, -1.0)])
+@pytest.mark.parametrize("turn", [0.1, -0.1])
 def test_turn_parameter_turns_the_commanded_way(capsys: pytest.CaptureFixture[str],
-                                               turn: float, sign: float) -> None:
-    r = walk(capsys, "--seconds", "20", "--set", f"turn={turn}")
+                                               turn: float) -> None:
+    r = walk(capsys, "--seconds", "10", "--set", f"turn={turn}")
     assert r["fell"] is False
-    assert sign * r["heading_change_deg"] > 20.0
+    # 0.1 rad per step, two steps per ~0.87 s cycle: ~2 rad in 10 s if no foot slipped;
+    # ask for at least a third of it, in the commanded direction (+ = left).
+    assert math.copysign(1.0, turn) * math.radians(r["heading_change_deg"]) > 0.7
 
 
 def test_bad_set_is_refused_before_anything_moves(capsys: pytest.CaptureFixture[str]) -> None:

@@ -112,7 +112,7 @@ def test_each_foot_moves_forward_while_lifted(name: str) -> None:
 
 params_st = st.fixed_dictionaries({
     n: st.floats(s.lo, s.hi, allow_nan=False) for n, s in SPECS.items()
-    if n not in ("delta_f", "speed", "torso_lean", "spine_gain", "Hosc")})
+    if n not in ("delta_f", "speed", "torso_lean", "spine_gain", "Hosc", "turn")})
 
 
 @settings(max_examples=100, deadline=None)
@@ -120,8 +120,9 @@ params_st = st.fixed_dictionaries({
        st.lists(st.floats(0.0, 30.0), min_size=2, max_size=30))
 def test_feet_never_lifted_together_and_swing_forward(
         values: dict[str, float], delta_f: float, speed: float, ts: list[float]) -> None:
+    # Straight walking: turning rotates the feet about the body axis, which bends x.
     p = GaitParams(**values).replace({"delta_f": delta_f, "speed": speed, "torso_lean": 0.0,
-                                      "spine_gain": 0.0, "Hosc": 0.0})
+                                      "spine_gain": 0.0, "Hosc": 0.0, "turn": 0.0})
     times = np.sort(np.array(ts))
     t = targets_of(p, times)
     lr, ll = np.asarray(t.lift_r), np.asarray(t.lift_l)
@@ -138,7 +139,8 @@ def test_march_keeps_the_feet_in_place() -> None:
     p = load_gait("march").params
     t = targets_of(p, cycles(p, 3))
     for sole, lift in ((t.r_sole, t.lift_r), (t.l_sole, t.lift_l)):
-        assert np.ptp(np.asarray(sole[0])) < 1e-3
+        # only the preset's ~2 mm backward trim stride (see configs/gaits/march.toml)
+        assert np.ptp(np.asarray(sole[0])) < 5e-3
         assert np.max(lift) > 0.01                                     # but they do lift
     assert not np.any((np.asarray(t.lift_r) > 0) & (np.asarray(t.lift_l) > 0))
 

@@ -53,8 +53,7 @@ def test_preset_curves_are_finite_and_within_limits(any_robot: RobotConfig,
     # clamp) stays within them, and every target the robot presets ask for is reachable.
     raw, ok = solve(targets_of(p, times, any_robot), any_robot)
     assert_in_limits(any_robot, np.array(raw), f"{any_gait.name} (raw IK)")
-    if any_gait.name != "paper":   # the paper's rig values are previs, not for a robot
-        assert np.all(ok), any_gait.name
+    assert np.all(ok), any_gait.name
 
 
 def test_preset_ticks_through_start_steady_stop_are_within_limits(
@@ -71,8 +70,7 @@ def test_preset_ticks_through_start_steady_stop_are_within_limits(
         qs.append(e.tick(DT))
         assert len(qs) < 4 * ramp_ticks + 2 * p.cycle_s * RATE, "stop never completed"
     assert_in_limits(any_robot, np.array(qs).T, any_gait.name)
-    if any_gait.name != "paper":
-        assert e.unreachable_ticks == 0
+    assert e.unreachable_ticks == 0
 
 
 # ----------------------------------------------------------------- 4. legs alternate

@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import os
+
+os.environ.setdefault("MUJOCO_GL", "egl")  # headless: before anything imports mujoco
+
 import pytest
 
 from robot.config import GAITS_DIR, ROBOTS_DIR, Gait, RobotConfig, load_gait, load_robot

@@ -6,6 +6,7 @@ import argparse
 
 from robot.config import DEFAULT_GAIT, DEFAULT_ROBOT, Gait, RobotConfig, load_gait, load_robot
 from robot.errors import ConfigError
+from robot.params import GaitParams
 
 
 def positive_float(text: str) -> float:
@@ -72,3 +73,28 @@ def parse_ids(text: str) -> list[int]:
     if bad:
         raise ConfigError(f"--ids: id {bad[0]} is outside [0, 252]")
     return sorted(set(ids))
+
+
+def add_set_arg(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="override a gait parameter (repeatable), e.g. --set turn=0.2")
+
+
+def parse_sets(items: list[str]) -> dict[str, float]:
+    """``["turn=0.2", ...]`` → ``{"turn": 0.2}``; ConfigError naming a malformed item."""
+    out: dict[str, float] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        try:
+            if not sep:
+                raise ValueError
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise ConfigError(f"--set {item!r}: expected NAME=NUMBER, e.g. turn=0.2") from None
+    return out
+
+
+def params_from(args: argparse.Namespace) -> tuple[Gait, GaitParams]:
+    """The ``--gait`` preset and its parameters with every ``--set`` applied (validated)."""
+    gait = gait_from(args)
+    return gait, gait.params.replace(parse_sets(args.set), where="--set")

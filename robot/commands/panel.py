@@ -15,8 +15,8 @@ from pathlib import Path
 from typing import Any
 
 from robot.bus.factory import make_bus
-from robot.commands.common import gait_from, robot_from
-from robot.commands.walk import add_walk_args, parse_sets
+from robot.commands.common import add_set_arg, params_from, robot_from
+from robot.commands.walk import add_walk_args
 from robot.config import GAITS_DIR
 from robot.errors import ConfigError
 from robot.panel.controller import LoopOptions, make_controller
@@ -32,8 +32,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                                    "every gait parameter, presets, start/stop/emergency stop, "
                                    "a live stick figure and telemetry.")
     add_walk_args(p)
-    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                   help="override a gait parameter at start (repeatable)")
+    add_set_arg(p)
     p.add_argument("--host", default="127.0.0.1", help="address to serve on (default: "
                    "%(default)s; anything else needs a token)")
     p.add_argument("--http-port", type=int, default=8080, help="HTTP port (default: "
@@ -48,8 +47,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
 
 def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
-    gait = gait_from(args)
-    params = gait.params.replace(parse_sets(args.set), where="--set")
+    gait, params = params_from(args)
     kind = args.bus or "sim"
     if kind != "sim" and args.view:
         raise ConfigError("--view applies to --bus sim only")

@@ -8,12 +8,12 @@ import logging
 
 from robot.commands.common import (
     add_robot_args,
-    gait_from,
+    add_set_arg,
+    params_from,
     positive_float,
     positive_int,
     robot_from,
 )
-from robot.commands.walk import parse_sets
 
 log = logging.getLogger(__name__)
 
@@ -30,8 +30,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--fps", type=positive_float, default=30.0, help="video frames per second")
     p.add_argument("--rate", type=positive_float, default=200.0, help="control rate [Hz]")
     p.add_argument("--camera", default="track", help="MuJoCo camera (default: %(default)s)")
-    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                   help="override a gait parameter (repeatable)")
+    add_set_arg(p)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     return p
 
@@ -43,8 +42,7 @@ def run(args: argparse.Namespace) -> int:
                     rate_hz=args.rate, camera=args.camera)
     check_output(args.out, spec)
     robot = robot_from(args)
-    gait = gait_from(args)
-    params = gait.params.replace(parse_sets(args.set), where="--set")
+    gait, params = params_from(args)
     result = render_walk(robot, params, args.out, spec=spec, progress=not args.quiet)
     fell = ", the robot FELL" if result.fell else ""
     print(f"wrote {result.path}: {result.frames} frames, {result.seconds:.2f} s at "

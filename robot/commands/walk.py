@@ -15,7 +15,8 @@ from robot.bus.factory import make_bus
 from robot.commands.common import (
     add_bus_args,
     add_robot_args,
-    gait_from,
+    add_set_arg,
+    params_from,
     positive_float,
     positive_int,
     robot_from,
@@ -48,22 +49,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--seconds", type=positive_float, default=10.0, help="gait duration [s]")
     p.add_argument("--record", metavar="PATH", help="per-tick record (.csv or .jsonl)")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
-    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                   help="override a gait parameter (repeatable), e.g. --set turn=0.2")
+    add_set_arg(p)
     return p
-
-
-def parse_sets(items: list[str]) -> dict[str, float]:
-    out: dict[str, float] = {}
-    for item in items:
-        name, sep, value = item.partition("=")
-        try:
-            if not sep:
-                raise ValueError
-            out[name.strip()] = float(value)
-        except ValueError:
-            raise ConfigError(f"--set {item!r}: expected NAME=NUMBER, e.g. turn=0.2") from None
-    return out
 
 
 def install_signals(streamer: Streamer) -> Callable[[], None]:
@@ -84,8 +71,7 @@ def install_signals(streamer: Streamer) -> Callable[[], None]:
 
 def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
-    gait = gait_from(args)
-    params = gait.params.replace(parse_sets(args.set), where="--set")
+    gait, params = params_from(args)
     kind = args.bus or "sim"
     if kind != "sim" and (args.view or args.realtime):
         raise ConfigError("--view and --realtime apply to --bus sim only")

@@ -15,7 +15,7 @@ FORMATS = (".csv", ".jsonl")
 
 
 class Recorder:
-    """Writes time, commanded and present joint positions, loop timing, temperatures and
+    """Writes time since the first tick [s], commanded and present joint positions, loop timing, temperatures and
     loads (present values only on read-back ticks, blank / null otherwise)."""
 
     def __init__(self, path: str | Path, joint_names: tuple[str, ...],
@@ -29,6 +29,7 @@ class Recorder:
         self._file: IO[str] | None = None
         self._csv: Any = None
         self._last_tick = -1
+        self._t0: float | None = None
 
     def header(self) -> list[str]:
         cols = ["t", "state", "tick", "period_error_ms", "overruns", "amplitude"]
@@ -52,12 +53,14 @@ class Recorder:
         if self._file is None or tel.tick == self._last_tick:
             return
         self._last_tick = tel.tick
+        if self._t0 is None:
+            self._t0 = tel.t
         fresh = tel.fresh and tel.q_present is not None
         present = tel.q_present if fresh and tel.q_present else [math.nan] * len(self.names)
         servo = tel.servo if fresh else {}
         temps = [servo[i].temperature if i in servo else None for i in self.ids]
         loads = [servo[i].load if i in servo else None for i in self.ids]
-        row = [tel.t, tel.state, tel.tick, tel.period_error_ms, tel.overruns, tel.amplitude,
+        row = [tel.t - self._t0, tel.state, tel.tick, tel.period_error_ms, tel.overruns, tel.amplitude,
                *tel.q_cmd, *present, *temps, *loads]
         if self._csv is not None:
             self._csv.writerow(["" if v is None or (isinstance(v, float) and math.isnan(v))

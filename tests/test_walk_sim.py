@@ -64,3 +64,13 @@ def test_bad_set_is_refused_before_anything_moves(capsys: pytest.CaptureFixture[
     captured = capsys.readouterr()
     assert captured.out == ""
     assert "Slgt_R" in captured.err and "outside" in captured.err
+
+
+def test_side_step_and_backward_steer_the_commanded_way(capsys: pytest.CaptureFixture[str]) -> None:
+    side = walk(capsys, "--seconds", "10", "--set", "side_step=0.02", "--set", "speed=0")
+    assert side["fell"] is False
+    assert side["lateral_drift_m"] > 0.1            # + = left
+    assert abs(side["distance_m"]) < 0.5 * side["lateral_drift_m"]
+    back = walk(capsys, "--seconds", "10", "--set", "speed=-1")
+    assert back["fell"] is False
+    assert back["distance_m"] < -0.5

@@ -15,8 +15,9 @@ FORMATS = (".csv", ".jsonl")
 
 
 class Recorder:
-    """Writes time since the first tick [s], commanded and present joint positions, loop timing, temperatures and
-    loads (present values only on read-back ticks, blank / null otherwise)."""
+    """Writes time since the first tick [s], commanded and present joint positions, loop
+    timing, temperatures and loads (present values only on read-back ticks, blank / null
+    otherwise)."""
 
     def __init__(self, path: str | Path, joint_names: tuple[str, ...],
                  ids: tuple[int, ...]) -> None:

@@ -87,6 +87,7 @@ class Streamer:
         self.engine = engine
         self.rate_hz = rate_hz
         self.dt = 1.0 / rate_hz
+        self._step = robot_map.max_speed * self.dt  # slew limit per tick [rad]
         self.read_every = max(1, read_every)
         self.clock: Clock = clock or getattr(bus, "clock", None) or MonotonicClock()
         self.hold_at_end = hold_at_end
@@ -197,12 +198,11 @@ class Streamer:
     def _send(self, q: np.ndarray, *, state: str) -> None:
         """Clamp, slew-limit, write; wait for the deadline; read back every Nth tick."""
         assert self._q_last is not None
-        q = self.map.clamp(q)
-        step = self.map.max_speed * self.dt
-        q = np.clip(q, self._q_last - step, self._q_last + step)
+        q = np.clip(self.map.clamp(q), self._q_last - self._step, self._q_last + self._step)
+        q_list = q.tolist()
         self._wait_deadline()
         try:
-            self.bus.write_goals(self.map.goals(q.tolist()))
+            self.bus.write_goals(self.map.goals(q_list))
             self.watchdog.bus_ok("write")
         except BusError as e:
             self._bus_errors += 1
@@ -210,7 +210,7 @@ class Streamer:
         self._q_last = q
         self._ticks += 1
         tel = self.telemetry
-        tel.tick, tel.state, tel.q_cmd = self._ticks, state, q.tolist()
+        tel.tick, tel.state, tel.q_cmd = self._ticks, state, q_list
         tel.amplitude = self.engine.amplitude
         tel.fresh = False
         if self._ticks % self.read_every == 0:

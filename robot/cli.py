@@ -12,7 +12,7 @@ import logging
 import os
 import sys
 
-from robot.errors import BipedError
+from robot.errors import BipedError, SafetyStop
 
 # Order is the order of `biped --help`.
 COMMANDS: tuple[str, ...] = (
@@ -51,6 +51,9 @@ def main(argv: list[str] | None = None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     try:
         return int(args._run(args) or 0)
+    except SafetyStop as e:   # e.g. a run refused to start: a safety stop, exit 1
+        print(f"biped {args.command}: safety stop: {e}", file=sys.stderr)
+        return 1
     except BipedError as e:
         print(f"biped {args.command}: error: {e}", file=sys.stderr)
         return 2

@@ -24,3 +24,7 @@ class BusError(BipedError):
 
 class SafetyStop(BipedError):
     """The watchdog stopped the robot; the message gives the reason."""
+
+
+class StartRefused(SafetyStop):
+    """A run refused to start before torque-on (nothing moved, torque untouched)."""

@@ -39,7 +39,12 @@ class Recorder:
         return cols
 
     def open(self) -> Recorder:
-        self._file = self.path.open("w", newline="")
+        """Create the file (ConfigError naming the path if it cannot be written)."""
+        try:
+            self._file = self.path.open("w", newline="")
+        except OSError as e:
+            raise ConfigError(f"--record {self.path}: cannot write it: "
+                              f"{e.strerror or e}") from None
         if self.path.suffix == ".csv":
             self._csv = csv.writer(self._file)
             self._csv.writerow(self.header())
@@ -47,8 +52,16 @@ class Recorder:
 
     def close(self) -> None:
         if self._file is not None:
-            self._file.close()
-            self._file = None
+            file, self._file = self._file, None
+            file.close()
+
+    def close_quietly(self) -> str | None:
+        """Close; the error as one line if the last writes failed (e.g. disk full)."""
+        try:
+            self.close()
+        except OSError as e:
+            return f"{self.path}: {e.strerror or e}"
+        return None
 
     def __call__(self, tel: Telemetry) -> None:
         if self._file is None or tel.tick == self._last_tick:

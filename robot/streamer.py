@@ -1,11 +1,23 @@
 """The fixed-rate control loop: absolute deadlines, ramps, safety, watchdog, telemetry.
 
-One run: read the present pose → torque on → ramp (slew-limited) to the gait's start pose
-→ ramp the gait amplitude in → stream → on stop ramp the gait out → ramp to the rest pose
-→ torque off (or hold). Every tick: clamp to joint limits, limit the slew rate to each
-servo's max speed, ONE sync write. Every ``read_every`` ticks: read back and feed the
-watchdog. Parameter changes (``set_params``, thread-safe) are validated by the caller's
-thread and applied at the start of the next tick.
+There is one loop: ``_send`` (clamp to the joint limits, limit the slew rate to each
+servo's max speed, wait for the next absolute deadline, ONE sync write, every
+``read_every`` ticks a read-back for the watchdog). A walk (``run``) and a move to a pose
+(``move_to``) are sequences of ``_send``; both start and end the same way:
+
+start: read the present pose → refuse (nothing moves, torque untouched) if a joint is
+  outside its limits by more than one slew step → goal := present → torque on → arm the
+  servos' own bus watchdog where they have one.
+end, by cause (docs/hardware.md, "What happens when"):
+  completed / operator stop (``request_stop``, first Ctrl-C or SIGTERM): ramp the gait out,
+    ramp to rest, then torque off, or hold with ``hold_at_end``;
+  emergency stop (second signal, panel E-stop): torque off at once;
+  a fault the robot can still be driven through (an observer raised, e.g. a full disk
+    under ``--record``; the loop cannot keep its rate): ramp out, rest, torque off;
+  an exception in the gait engine: ramp straight to rest, torque off;
+  a fault that makes driving unsafe or impossible (hardware error flag, over-temperature,
+    a servo not following, a dead bus, any other exception): torque off at once.
+A fault always ends with torque off, ``hold_at_end`` or not.
 """
 
 from __future__ import annotations
@@ -14,65 +26,45 @@ import logging
 import threading
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from robot.bus.base import Bus, ServoState
+from robot.bus.base import Bus
 from robot.clock import Clock, MonotonicClock
 from robot.engine import GaitEngine
-from robot.errors import BusError, SafetyStop
+from robot.errors import BusError, SafetyStop, StartRefused
+from robot.latency import SampleStats
 from robot.params import GaitParams
 from robot.ramp import ramp
 from robot.servo_map import ServoMap
+from robot.telemetry import LoopStats, Telemetry, TickObserver
 from robot.watchdog import Watchdog, WatchdogConfig
+
+__all__ = ["LoopStats", "Streamer", "Telemetry", "TickObserver"]
 
 log = logging.getLogger(__name__)
 
 
-@dataclass
-class Telemetry:
-    """A snapshot of the loop for the CLI, the panel and recorders (joint order).
-
-    state: "idle" | "ramp_in" | "walking" | "ramp_out" | "rest" | "stopped" | "estop";
-    period_error_ms: lateness of the last tick start [ms].
-    """
-
-    t: float = 0.0
-    state: str = "idle"
-    tick: int = 0
-    q_cmd: list[float] = field(default_factory=list)
-    q_present: list[float] | None = None
-    servo: dict[int, ServoState] = field(default_factory=dict)
-    period_error_ms: float = 0.0
-    overruns: int = 0
-    amplitude: float = 0.0
-    stop_reason: str | None = None
-    fresh: bool = False  # True on ticks that read the servos back
-
-
-@dataclass
-class LoopStats:
-    """Loop statistics after a run. period errors are tick-start lateness [ms]."""
-
-    ticks: int
-    rate_hz: float
-    duration_s: float
-    achieved_hz: float
-    period_error_p50_ms: float
-    period_error_p99_ms: float
-    period_error_max_ms: float
-    overruns: int
-    bus_errors: int
-    wall_s: float
-    stop_reason: str
-
-    def as_dict(self) -> dict[str, Any]:
-        return dict(self.__dict__)
-
-
-TickObserver = Callable[[Telemetry], None]
+def check_inside_limits(smap: ServoMap, present: np.ndarray, *, tolerance: Any,
+                        source: str) -> np.ndarray:
+    """``present`` [rad] clamped to the joint limits; StartRefused (naming the joint, how far
+    out it is and the fix) if a joint is further outside than ``tolerance`` [rad] (scalar or
+    per joint): its first goal would jump it."""
+    inside = smap.clamp(present)
+    beyond = np.abs(present - inside) - tolerance
+    if (beyond > 0).any():
+        i = int(np.argmax(beyond))
+        name, q, lim = smap.names[i], float(present[i]), float(inside[i])
+        side = "max_rad" if q > lim else "min_rad"
+        others = int((beyond > 0).sum()) - 1
+        more = f" (and {others} more joint{'s' * (others > 1)})" if others else ""
+        raise StartRefused(
+            f"refusing to start: {name} (servo id {smap.ids[i]}) is at {q:.3f} rad, "
+            f"{abs(q - lim):.3f} rad ({np.degrees(abs(q - lim)):.1f} deg) beyond its "
+            f"{side} {lim:.3f}{more}; move it inside its limits by hand with torque off "
+            f"(`biped torque off`), or check its zero_ticks, sign and limits in {source}")
+    return inside
 
 
 class Streamer:
@@ -91,15 +83,17 @@ class Streamer:
         self.read_every = max(1, read_every)
         self.clock: Clock = clock or getattr(bus, "clock", None) or MonotonicClock()
         self.hold_at_end = hold_at_end
-        self.watchdog = Watchdog(watchdog or WatchdogConfig(), robot_map, robot=engine.robot)
+        self.watchdog_config = watchdog or WatchdogConfig()
+        self.watchdog = Watchdog(self.watchdog_config, robot_map, robot=engine.robot)
         self.observer = observer
         self.telemetry = Telemetry()
         self._lock = threading.Lock()
         self._pending: dict[str, float] = {}
         self._stop = threading.Event()
         self._estop = threading.Event()
-        self._q_last: np.ndarray | None = None
-        self._errors: list[float] = []
+        self._fault: str | None = None
+        self._q_last: np.ndarray = np.zeros(len(robot_map.ids))
+        self._lateness = SampleStats()
         self._overruns = 0
         self._bus_errors = 0
         self._next = 0.0
@@ -121,25 +115,66 @@ class Streamer:
             self.telemetry.stop_reason = self.telemetry.stop_reason or reason
         self._stop.set()
 
-    def emergency_stop(self) -> None:
+    def emergency_stop(self, reason: str = "emergency stop") -> None:
         """Torque off at once (the loop ends within one tick)."""
-        self.telemetry.stop_reason = "emergency stop"
+        self.telemetry.stop_reason = reason
         self._estop.set()
         self._stop.set()
 
-    # -- the loop ------------------------------------------------------------------------
+    @property
+    def stopping(self) -> bool:
+        """A stop (safe or emergency) has been requested or a fault occurred."""
+        return self._stop.is_set()
+
+    # -- runs ----------------------------------------------------------------------------
     def run(self, *, seconds: float | None = None) -> LoopStats:
-        """Run until ``seconds`` of gait have passed or a stop is requested."""
+        """Walk until ``seconds`` of gait have passed or a stop is requested."""
+        return self._session(lambda: self._walk(seconds))
+
+    def move_to(self, q_goal: Any, *, max_speed: Any = None) -> LoopStats:
+        """Ramp (minimum jerk, slew-limited) from the present pose to ``q_goal`` [rad],
+        clamped to the limits; peak speed ``max_speed`` [rad/s] (capped by each joint's).
+        A stop request ends the ramp where it is."""
+        speed = self.map.max_speed if max_speed is None else np.minimum(self.map.max_speed,
+                                                                        max_speed)
+        return self._session(lambda: self._ramp_to(q_goal, state="pose", interruptible=True,
+                                                   max_speed=speed))
+
+    def _session(self, motion: Callable[[], None]) -> LoopStats:
         wall0 = time.perf_counter()
-        ids = list(self.map.ids)
         t_start = self.clock.now()
-        reason = "completed"
+        ids = list(self.map.ids)
+        present = self.map.from_positions(self.bus.read_positions(ids))
+        q0 = self._check_start(present)          # StartRefused: nothing moved, torque untouched
         try:
-            present = self.map.from_positions(self.bus.read_positions(ids))
+            self.bus.write_goals(self.map.goals(q0.tolist()))  # no snap to a stale goal
             self.bus.set_torque(ids, enabled=True)
-            self._q_last = np.asarray(present, dtype=float)
+            self._q_last = q0
             self._next = self.clock.now()
-            self._ramp_to(self.engine.start_pose(), state="ramp_in")
+            self._arm_failsafe()
+            motion()
+        except SafetyStop as e:                  # the watchdog: unsafe or impossible to drive
+            self._set_fault(f"watchdog: {e}")
+        except Exception as e:
+            log.exception("the control loop failed")
+            self._set_fault(f"exception: {type(e).__name__}: {e}")
+        except BaseException:                    # KeyboardInterrupt, SystemExit: no ramp
+            self._finish(torque_off=True)
+            raise
+        estop = self._estop.is_set()
+        holding = self.hold_at_end and self._fault is None and not estop
+        self._finish(torque_off=not holding)
+        reason = self._fault or self.telemetry.stop_reason or "completed"
+        self.telemetry.stop_reason = reason
+        return self._stats(t_start, wall0, reason, holding=holding, estop=estop)
+
+    def _check_start(self, present: np.ndarray) -> np.ndarray:
+        return check_inside_limits(self.map, present, tolerance=self._step,
+                                   source=self.engine.robot.source)
+
+    def _walk(self, seconds: float | None) -> None:
+        self._ramp_to(self.engine.start_pose(), state="ramp_in", interruptible=True)
+        if not self._stop.is_set():
             self.engine.start()
             t_gait = self.clock.now()
             while not self._estop.is_set():
@@ -149,34 +184,47 @@ class Streamer:
                 if self.engine.stopped:
                     break
                 self._apply_pending()
-                q = self.engine.tick(self.dt)
-                state = "walking" if self.engine.running else "ramp_out"
-                self._send(np.asarray(q), state=state)
-            if not self._estop.is_set():
-                self._ramp_to(self.map.clamp(self.map.vector(self.engine.robot.rest)),
-                              state="rest")
-            reason = self.telemetry.stop_reason or "completed"
-        except SafetyStop as e:
-            reason = f"watchdog: {e}"
-            log.error("safe stop: %s", e)
-            self.telemetry.stop_reason = reason
-        except BaseException as e:
-            reason = f"exception: {type(e).__name__}: {e}"
-            self.telemetry.stop_reason = reason
-            self._finish(torque_off=True)
-            raise
-        self._finish(torque_off=self._estop.is_set() or not self.hold_at_end)
-        return self._stats(t_start, wall0, reason)
+                try:
+                    q = self.engine.tick(self.dt)
+                except Exception as e:           # the gait is unusable: straight to rest
+                    log.exception("the gait engine failed")
+                    self._set_fault(f"exception in the gait engine: {type(e).__name__}: {e}")
+                    break
+                self._send(np.asarray(q), state="walking" if self.engine.running
+                           else "ramp_out")
+        if not self._estop.is_set():
+            self._ramp_to(self.map.vector(self.engine.robot.rest), state="rest")
+
+    def _set_fault(self, reason: str) -> None:
+        """Record the first fault and request a stop (its ramp-out, if any, follows)."""
+        if self._fault is None:
+            self._fault = reason
+            log.error("safe stop: %s", reason)
+        self.request_stop(reason)
+
+    def _arm_failsafe(self) -> None:
+        timeout = self.watchdog_config.failsafe_s
+        arm = getattr(self.bus, "arm_failsafe", None)
+        if timeout and arm is not None:
+            armed = arm(self.map.ids, timeout_s=timeout)
+            if armed is not None:
+                log.info("servo bus watchdog armed: %.2f s", armed)
 
     def _finish(self, *, torque_off: bool) -> None:
         self.telemetry.state = "estop" if self._estop.is_set() else "stopped"
+        disarm = getattr(self.bus, "disarm_failsafe", None)
+        try:
+            if disarm is not None and self.watchdog_config.failsafe_s:
+                disarm(self.map.ids)
+        except BusError as e:
+            log.error("could not disarm the servo bus watchdog: %s", e)
         if torque_off:
             try:
                 self.bus.set_torque(list(self.map.ids), enabled=False)
             except BusError as e:
                 log.error("could not disable torque: %s", e)
         else:
-            log.info("holding the rest pose with torque on (hold_at_end)")
+            log.info("holding the last pose with torque on (hold_at_end)")
         self._notify()
 
     def _apply_pending(self) -> None:
@@ -186,18 +234,19 @@ class Streamer:
             changes, self._pending = self._pending, {}
         self.engine.set_params(changes)
 
-    def _ramp_to(self, q_goal: Any, *, state: str) -> None:
-        assert self._q_last is not None
-        path = ramp(self._q_last, self.map.clamp(q_goal), self.map.max_speed, self.rate_hz,
+    def _ramp_to(self, q_goal: Any, *, state: str, interruptible: bool = False,
+                 max_speed: Any = None) -> None:
+        speed = self.map.max_speed if max_speed is None else max_speed
+        path = ramp(self._q_last, self.map.clamp(q_goal), speed, self.rate_hz,
                     min_duration=0.3)
         for q in path[1:]:
-            if self._estop.is_set():
+            if self._estop.is_set() or (interruptible and self._stop.is_set()):
                 return
             self._send(q, state=state)
 
+    # -- the one loop --------------------------------------------------------------------
     def _send(self, q: np.ndarray, *, state: str) -> None:
-        """Clamp, slew-limit, write; wait for the deadline; read back every Nth tick."""
-        assert self._q_last is not None
+        """Clamp, slew-limit, wait for the deadline, write; read back every Nth tick."""
         q = np.clip(self.map.clamp(q), self._q_last - self._step, self._q_last + self._step)
         q_list = q.tolist()
         self._wait_deadline()
@@ -237,26 +286,37 @@ class Streamer:
             missed = int(late // self.dt)
             self._overruns += missed
             self._next += missed * self.dt
-            self.watchdog.overrun()
+            try:
+                self.watchdog.overrun()
+            except SafetyStop as e:              # the bus still works: ramp out and stop
+                self._set_fault(f"watchdog: {e}")
         else:
             self.watchdog.on_time()
-        self._errors.append(late)
+        self._lateness.add(late)
         self.telemetry.t = now
         self.telemetry.period_error_ms = late * 1e3
         self.telemetry.overruns = self._overruns
 
     def _notify(self) -> None:
-        if self.observer is not None:
+        if self.observer is None:
+            return
+        try:
             self.observer(self.telemetry)
+        except Exception as e:                   # e.g. a full disk under --record
+            self.observer = None
+            log.exception("an observer of the loop failed; it is detached")
+            self._set_fault(f"exception in an observer: {type(e).__name__}: {e}")
 
-    def _stats(self, t_start: float, wall0: float, reason: str) -> LoopStats:
-        err = np.asarray(self._errors or [0.0]) * 1e3
+    def _stats(self, t_start: float, wall0: float, reason: str, *, holding: bool,
+               estop: bool) -> LoopStats:
+        lat = self._lateness
         duration = max(self.clock.now() - t_start, 1e-9)
         return LoopStats(
             ticks=self._ticks, rate_hz=self.rate_hz, duration_s=duration,
             achieved_hz=self._ticks / duration,
-            period_error_p50_ms=float(np.percentile(err, 50)),
-            period_error_p99_ms=float(np.percentile(err, 99)),
-            period_error_max_ms=float(err.max()), overruns=self._overruns,
-            bus_errors=self._bus_errors, wall_s=time.perf_counter() - wall0,
-            stop_reason=reason)
+            period_error_p50_ms=lat.percentile(50) * 1e3,
+            period_error_p99_ms=lat.percentile(99) * 1e3,
+            period_error_max_ms=max(lat.max, 0.0) * 1e3 if lat.count else 0.0,
+            overruns=self._overruns, bus_errors=self._bus_errors,
+            wall_s=time.perf_counter() - wall0, stop_reason=reason,
+            fault=self._fault is not None, holding=holding, estop=estop)

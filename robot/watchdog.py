@@ -23,7 +23,9 @@ class WatchdogConfig:
     bus_error_streak: consecutive failed bus transactions before a stop;
     overrun_streak: consecutive overrunning ticks before a stop;
     max_temperature_c: [°C]; follow_error_rad: commanded - present beyond which a servo
-    is "not following" [rad]; follow_reads: consecutive read-backs it must persist.
+    is "not following" [rad]; follow_reads: consecutive read-backs it must persist;
+    failsafe_s: the servos' own bus watchdog, armed while streaming: with no packet for
+    this long [s] they stop by themselves (None: leave it off).
     """
 
     bus_error_streak: int = 5
@@ -31,6 +33,7 @@ class WatchdogConfig:
     max_temperature_c: float = 70.0
     follow_error_rad: float = 0.6
     follow_reads: int = 5
+    failsafe_s: float | None = 0.5
 
 
 class Watchdog:

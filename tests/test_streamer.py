@@ -53,7 +53,11 @@ def test_one_sync_write_per_tick_within_limits_and_slew(emu: Emulator, robot: Ro
     log = emu.log()
     goals = _goal_writes(log, robot)
     assert stats.ticks > 50
-    assert len(goals) == stats.ticks                       # exactly one packet per tick
+    # goal := present before torque-on (no snap to a stale goal), then one packet per tick
+    assert len(goals) == stats.ticks + 1
+    hold, goals = goals[0], goals[1:]
+    assert hold.values == {i: emu_zero for i, emu_zero in
+                           zip(robot.ids, [j.zero_ticks for j in robot.joints], strict=True)}
     smap = ServoMap(robot)
     ticks = np.array([[p.values[i] for i in smap.ids] for p in goals])
     assert (ticks >= smap.tick_min).all() and (ticks <= smap.tick_max).all()
@@ -63,7 +67,8 @@ def test_one_sync_write_per_tick_within_limits_and_slew(emu: Emulator, robot: Ro
     first_goal, last_goal = goals[0].t, goals[-1].t
     on = [p for p in torque if all(v == 1 for v in p.values.values())]
     off = [p for p in torque if all(v == 0 for v in p.values.values())]
-    assert on and max(p.t for p in on) <= first_goal          # torque on before any goal
+    assert on and hold.t <= min(p.t for p in on)              # held goal before torque on
+    assert max(p.t for p in on) <= first_goal                 # torque on before streaming
     assert off and min(p.t for p in off) >= last_goal         # torque off after the last
     assert {i for p in off for i in p.ids} == set(robot.ids)
     assert all(emu.registers(i)["torque_enable"] == 0 for i in robot.ids)
@@ -77,9 +82,15 @@ def test_exception_in_loop_leaves_torque_off(emu: Emulator, robot: RobotConfig) 
             raise RuntimeError("boom in the loop")
 
     try:
-        with pytest.raises(RuntimeError, match="boom"):
-            _streamer(bus, robot, observer=explode).run(seconds=5)
+        stats = _streamer(bus, robot, observer=explode, hold_at_end=True).run(seconds=5)
+        # An observer's exception ramps out to rest and ends torque off, even with hold.
+        assert stats.fault and "boom in the loop" in stats.stop_reason
+        assert not stats.holding
+        assert stats.ticks < 5 * RATE
         assert all(emu.registers(i)["torque_enable"] == 0 for i in robot.ids)
+        smap = ServoMap(robot)
+        rest = smap.goals(smap.clamp(smap.vector(robot.rest)).tolist())
+        assert {i: emu.registers(i)["goal_position"] for i in robot.ids} == rest
     finally:
         bus.close()
 
@@ -138,7 +149,7 @@ def test_sigint_ramps_out_and_leaves_torque_off(emu: Emulator, robot: RobotConfi
     finally:
         if proc.poll() is None:
             proc.kill()
-    assert proc.returncode == 0, err
+    assert proc.returncode == 130, err
     assert "signal SIGINT" in out
     assert all(emu.registers(i)["torque_enable"] == 0 for i in robot.ids)
     goals = _goal_writes(emu.log(), robot)

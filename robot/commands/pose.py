@@ -1,8 +1,10 @@
 """`biped pose rest|zero`: ramp smoothly from where the robot is to a named pose, then hold.
 
-Reads the present position, enables torque holding it (no snap to a stale goal), then
-streams a minimum-jerk ramp (robot.ramp) at a fixed rate on absolute monotonic deadlines.
-Torque stays ON at the end; Ctrl-C stops the ramp and holds where it is.
+Runs the one streaming loop (``Streamer.move_to``): reads the present pose, refuses to start
+if a joint is outside its limits, sets goal := present and torque on (no snap to a stale
+goal), then a minimum-jerk ramp at a fixed rate on absolute deadlines, clamped and
+slew-limited, with the watchdog. Torque stays ON at the end. Ctrl-C (or SIGTERM) stops the
+ramp and holds where it is; a second one, or any fault, turns torque off.
 """
 
 from __future__ import annotations
@@ -13,19 +15,18 @@ import logging
 import numpy as np
 import numpy.typing as npt
 
-from robot.bus.base import Bus
 from robot.bus.factory import make_bus
-from robot.clock import Clock, MonotonicClock
 from robot.commands.common import add_bus_args, add_robot_args, positive_float, robot_from
+from robot.commands.signals import SignalLatch, stop_on_signals
 from robot.config import RobotConfig
-from robot.ramp import ramp
+from robot.engine import GaitEngine
+from robot.params import GaitParams
 from robot.servo_map import ServoMap
+from robot.streamer import LoopStats, Streamer
 
 log = logging.getLogger(__name__)
 
 POSES = ("rest", "zero")
-#: Beyond this [rad] outside its limits, a joint's first goal (at the limit) is a visible jump.
-OUTSIDE_WARN_RAD = 0.05
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -46,58 +47,28 @@ def pose_target(robot: RobotConfig, name: str, servo_map: ServoMap) -> npt.NDArr
     return servo_map.clamp(q)
 
 
-def hold_present(bus: Bus, servo_map: ServoMap) -> npt.NDArray[np.float64]:
-    """Goal := present position (clamped to the limits), then torque on. Returns it [rad]."""
-    q_now = servo_map.from_positions(bus.read_positions(servo_map.ids))
-    q_hold = servo_map.clamp(q_now)
-    for name, a, b in zip(servo_map.names, q_now, q_hold, strict=True):
-        if abs(a - b) > OUTSIDE_WARN_RAD:
-            log.warning("%s is at %.3f rad, outside its limits: it will move to %.3f rad",
-                        name, a, b)
-    bus.write_goals(servo_map.goals(q_hold.tolist()))
-    bus.set_torque(servo_map.ids, enabled=True)
-    return q_hold
-
-
-def stream(bus: Bus, servo_map: ServoMap, path: npt.NDArray[np.float64], rate_hz: float, *,
-           clock: Clock | None = None) -> int:
-    """Write ``path[1:]`` at ``rate_hz`` on absolute deadlines; returns rows written.
-
-    clock: default the bus's own ``clock`` if it has one (simulation time), else monotonic.
-    When late by more than a period the schedule is shifted rather than caught up with a
-    burst of goals (a burst would exceed the slew limit in real time).
-    """
-    clock = clock or getattr(bus, "clock", None) or MonotonicClock()
-    period = 1.0 / rate_hz
-    t0 = clock.now()
-    for k in range(1, len(path)):
-        deadline = t0 + k * period
-        lag = clock.now() - deadline
-        if lag > period:
-            t0 += lag
-        else:
-            clock.sleep_until(deadline)
-        bus.write_goals(servo_map.goals(path[k].tolist()))
-    return len(path) - 1
-
-
 def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
     sm = ServoMap(robot)
     bus = make_bus(args.bus, robot=robot, port=args.port, baud=args.baud)
-    bus.open()
+    streamer = Streamer(sm, bus, GaitEngine(robot, GaitParams()), rate_hz=args.rate,
+                        hold_at_end=True)
+    latch = SignalLatch()
+    stats: LoopStats | None = None
     try:
-        q_start = hold_present(bus, sm)
-        path = ramp(q_start, pose_target(robot, args.pose, sm),
-                    np.minimum(sm.max_speed, args.speed), args.rate)
-        print(f"torque ON; ramping to {args.pose} over {(len(path) - 1) / args.rate:.2f} s "
-              f"({len(path) - 1} steps at {args.rate:g} Hz)")
-        try:
-            stream(bus, sm, path, args.rate)
-        except KeyboardInterrupt:
-            print("interrupted: ramp stopped; holding the last goal, torque stays ON")
-            return 130
-        print(f"at {args.pose} pose; torque left ON (`biped torque off` to release)")
-        return 0
+        bus.open()
+        print(f"torque ON; ramping to {args.pose} (peak {args.speed:g} rad/s, "
+              f"{args.rate:g} Hz)", flush=True)
+        with stop_on_signals(streamer, latch):
+            stats = streamer.move_to(pose_target(robot, args.pose, sm), max_speed=args.speed)
     finally:
-        bus.close(torque_off=False)
+        bus.close(torque_off=False)  # the streamer has left torque as its end requires
+    if stats.fault or stats.estop:
+        print(f"stopped: {stats.stop_reason}; torque OFF")
+    elif latch.first is not None:
+        print(f"interrupted ({stats.stop_reason}): ramp stopped; holding the last goal, "
+              "torque stays ON (`biped torque off` to release)")
+    else:
+        print(f"at {args.pose} pose after {stats.duration_s:.2f} s ({stats.ticks} steps); "
+              "torque left ON (`biped torque off` to release)")
+    return latch.exit_code(stats)

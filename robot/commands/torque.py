@@ -6,8 +6,11 @@ import argparse
 
 from robot.bus.factory import make_bus
 from robot.commands.common import add_bus_args, add_robot_args, robot_from
-from robot.commands.pose import hold_present
 from robot.servo_map import ServoMap
+from robot.streamer import check_inside_limits
+
+#: How far outside its limits [rad] a joint may be and still be held where it is (clamped).
+HOLD_TOLERANCE_RAD = 0.02
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -25,7 +28,11 @@ def run(args: argparse.Namespace) -> int:
     bus.open()
     try:
         if args.state == "on":
-            hold_present(bus, ServoMap(robot))
+            sm = ServoMap(robot)
+            q = sm.from_positions(bus.read_positions(sm.ids))
+            q = check_inside_limits(sm, q, tolerance=HOLD_TOLERANCE_RAD, source=robot.source)
+            bus.write_goals(sm.goals(q.tolist()))   # goal := present: no snap at torque-on
+            bus.set_torque(sm.ids, enabled=True)
             print(f"torque ON on {len(robot.ids)} servos, holding their present position")
         else:
             bus.set_torque(robot.ids, enabled=False)

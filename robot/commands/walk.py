@@ -6,7 +6,6 @@ from __future__ import annotations
 import argparse
 import json
 import logging
-import signal
 import time
 from collections.abc import Callable
 from typing import Any
@@ -21,11 +20,12 @@ from robot.commands.common import (
     positive_int,
     robot_from,
 )
+from robot.commands.signals import SignalLatch, stop_on_signals
 from robot.engine import GaitEngine
 from robot.errors import ConfigError
 from robot.recorder import Recorder
 from robot.servo_map import ServoMap
-from robot.streamer import Streamer, Telemetry
+from robot.streamer import LoopStats, Streamer, Telemetry
 
 log = logging.getLogger(__name__)
 
@@ -53,22 +53,6 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     return p
 
 
-def install_signals(streamer: Streamer) -> Callable[[], None]:
-    """SIGINT/SIGTERM: first → safe stop (ramp out, rest, torque off); second → torque off."""
-    def handler(signum: int, _frame: Any) -> None:
-        if streamer.telemetry.stop_reason and signum == signal.SIGINT:
-            streamer.emergency_stop()
-        else:
-            streamer.request_stop(f"signal {signal.Signals(signum).name}")
-
-    old = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
-
-    def restore() -> None:
-        for s, h in old.items():
-            signal.signal(s, h)
-    return restore
-
-
 def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
     gait, params = params_from(args)
@@ -83,8 +67,13 @@ def run(args: argparse.Namespace) -> int:
     smap = ServoMap(robot)
     monitor = None
     observers: list[Callable[[Telemetry], None]] = []
+    if recorder is not None:
+        observers.append(recorder.open())    # an unwritable path fails before the bus opens
+    latch = SignalLatch()
+    stats: LoopStats | None = None
     wall0 = time.perf_counter()
-    with bus:
+    try:
+        bus.open()
         if kind == "sim":
             from sim.metrics import WalkMonitor
 
@@ -94,22 +83,21 @@ def run(args: argparse.Namespace) -> int:
             def watch(tel: Telemetry) -> None:
                 pos, quat = sim_bus.base_pose()
                 monitor.update(tel.t, pos, quat, sim_bus.upright_angle())
-            observers.append(watch)
-        if recorder is not None:
-            observers.append(recorder.open())
+            observers.insert(0, watch)
 
         def observe(tel: Telemetry) -> None:
             for o in observers:
                 o(tel)
         streamer = Streamer(smap, bus, engine, rate_hz=args.rate, read_every=args.read_every,
                             hold_at_end=args.hold, observer=observe)
-        restore = install_signals(streamer)
-        try:
+        with stop_on_signals(streamer, latch):
             stats = streamer.run(seconds=args.seconds)
-        finally:
-            restore()
-            if recorder is not None:
-                recorder.close()
+    finally:
+        # The streamer has already left the servos as its end requires (holding, or torque
+        # off); a refused start left them untouched. Closing must not undo either.
+        bus.close(torque_off=False)
+        record_error = recorder.close_quietly() if recorder is not None else None
+    assert stats is not None
     wall = time.perf_counter() - wall0
     result: dict[str, Any] = {"robot": robot.name, "gait": gait.name, "bus": kind,
                               "seconds": args.seconds}
@@ -122,13 +110,18 @@ def run(args: argparse.Namespace) -> int:
         "period_error_max_ms": stats.period_error_max_ms,
         "overruns": stats.overruns, "bus_errors": stats.bus_errors,
         "realtime_factor": stats.duration_s / wall if wall > 0 else 0.0,
-        "stop_reason": stats.stop_reason,
+        "stop_reason": stats.stop_reason, "fault": stats.fault, "holding": stats.holding,
     })
+    code = latch.exit_code(stats)
+    if record_error is not None:
+        result["record_error"] = record_error
+        code = code or 1
+    result["exit_code"] = code
     if args.json:
         print(json.dumps(result))
     else:
         print(format_summary(result))
-    return 0 if not stats.stop_reason.startswith(("watchdog", "exception")) else 1
+    return code
 
 
 def format_summary(r: dict[str, Any]) -> str:
@@ -150,7 +143,10 @@ def format_summary(r: dict[str, Any]) -> str:
         f" {r['overruns']} overruns, {r['bus_errors']} bus errors",
         f"  realtime      x{r['realtime_factor']:.1f}",
         f"  stopped       {r['stop_reason']}",
+        f"  servos        {'holding the rest pose, torque ON' if r['holding'] else 'torque off'}",
     ]
+    if r.get("record_error"):
+        lines.append(f"  record        FAILED: {r['record_error']}")
     return "\n".join(lines)
 
 

@@ -1,0 +1,61 @@
+"""What the streaming loop reports: a per-tick snapshot and the statistics of a run."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from robot.bus.base import ServoState
+
+
+@dataclass
+class Telemetry:
+    """A snapshot of the loop for the CLI, the panel and recorders (joint order).
+
+    state: "idle" | "ramp_in" | "walking" | "ramp_out" | "rest" | "pose" | "stopped" |
+    "estop"; period_error_ms: lateness of the last tick start [ms].
+    """
+
+    t: float = 0.0
+    state: str = "idle"
+    tick: int = 0
+    q_cmd: list[float] = field(default_factory=list)
+    q_present: list[float] | None = None
+    servo: dict[int, ServoState] = field(default_factory=dict)
+    period_error_ms: float = 0.0
+    overruns: int = 0
+    amplitude: float = 0.0
+    stop_reason: str | None = None
+    fresh: bool = False  # True on ticks that read the servos back
+
+
+TickObserver = Callable[[Telemetry], None]
+
+
+@dataclass
+class LoopStats:
+    """Loop statistics after a run. Period errors are tick-start lateness [ms].
+
+    fault: the run ended on a fault (watchdog, exception, failed observer): exit code 1;
+    holding: it ended with torque left on (``hold_at_end`` and no fault or emergency stop);
+    estop: it ended by an emergency stop (torque off at once).
+    """
+
+    ticks: int
+    rate_hz: float
+    duration_s: float
+    achieved_hz: float
+    period_error_p50_ms: float
+    period_error_p99_ms: float
+    period_error_max_ms: float
+    overruns: int
+    bus_errors: int
+    wall_s: float
+    stop_reason: str
+    fault: bool = False
+    holding: bool = False
+    estop: bool = False
+
+    def as_dict(self) -> dict[str, Any]:
+        return dict(self.__dict__)

@@ -5,18 +5,26 @@ call :meth:`EmulatedServo.read` / :meth:`EmulatedServo.write` with raw addresses
 Motion is evaluated lazily: call :meth:`EmulatedServo.update` with the current time [s]
 before touching the table; present position then moves toward goal position at the model's
 no-load speed while torque is enabled.
+
+Communication watchdog (Dynamixel X "Bus Watchdog", ``tables.COMM_WATCHDOG``): the chain
+calls :meth:`EmulatedServo.hear` for every instruction packet addressed to the servo (its id,
+broadcast, or listed in a sync/bulk packet; the manual counts "all the Instruction Packet",
+which may include packets for other ids: the stricter reading is modelled, so a host that
+forgets a servo sees it trip). When the register is armed (1..127), torque is on and the gap
+since the last packet exceeds the setting, :meth:`update` stops the servo at the moment the
+gap ran out (goal := present), the register reads -1 and goal writes are refused with a
+range error until 0 (or a new setting) is written. Torque is left as it was.
 """
 
 from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import NamedTuple
 
 from robot.bus.tables import (
     BAUD_CODES,
+    COMM_WATCHDOG,
     ERROR_BITS,
     MODELS,
     RETURN_DELAY_UNIT_S,
@@ -33,7 +41,7 @@ READ_ONLY: frozenset[str] = frozenset({
 })
 #: Dynamixel registers holding two's-complement signed values.
 DXL_SIGNED: frozenset[str] = frozenset({
-    "homing_offset", "goal_position", "present_load", "present_velocity", "present_position",
+    "bus_watchdog", "homing_offset", "goal_position", "present_load", "present_velocity", "present_position",
 })
 #: Allowed raw values of a few registers [inclusive range]; others accept any value.
 VALID_RANGE: dict[str, tuple[int, int]] = {
@@ -117,6 +125,8 @@ class EmulatedServo:
             self.set(name, v)
         self._pos = float(spec.zero_ticks)
         self._t = now
+        self.watchdog = COMM_WATCHDOG[self.family]
+        self.heard = now    # time of the last instruction packet addressed to this servo [s]
 
     # ------------------------------------------------------------------ raw access
     def get(self, name: str) -> int:
@@ -160,11 +170,38 @@ class EmulatedServo:
         return "hardware_error_status" if self.family == "dynamixel_x" else "status"
 
     # ------------------------------------------------------------------ behaviour
+    def hear(self, now: float) -> None:
+        """An instruction packet addressed to this servo arrived at ``now`` [s]."""
+        self.heard = now
+
+    @property
+    def watchdog_tripped(self) -> bool:
+        wd = self.watchdog
+        return wd is not None and self.get(wd.register) == wd.tripped
+
+    def _watchdog_deadline(self) -> float | None:
+        """When the armed watchdog trips if nothing is heard [s], else None."""
+        wd = self.watchdog
+        if wd is None or not self.get("torque_enable"):
+            return None
+        steps = self.get(wd.register)
+        if not wd.steps[0] <= steps <= wd.steps[1]:
+            return None
+        return self.heard + steps * wd.unit_s
+
     def update(self, now: float) -> None:
-        """Advance the position model to ``now`` [s, time.monotonic()]."""
+        """Advance the position model (and the watchdog) to ``now`` [s, time.monotonic()]."""
+        self._assert_faults()
+        deadline = self._watchdog_deadline()
+        if self.watchdog is not None and deadline is not None and deadline < now:
+            self._advance(max(deadline, self._t))
+            self.set("goal_position", round(self._pos))   # stop where it is
+            self.set(self.watchdog.register, self.watchdog.tripped)
+        self._advance(now)
+
+    def _advance(self, now: float) -> None:
         dt = max(0.0, now - self._t)
         self._t = now
-        self._assert_faults()
         goal = self.get("goal_position")
         if self.get("torque_enable"):
             step = self.speed_tps * dt
@@ -242,14 +279,22 @@ class EmulatedServo:
             return WriteError.RANGE
         if name == "baud_rate" and value not in BAUD_CODES[self.family]:
             return WriteError.RANGE
+        wd = self.watchdog
+        if wd is not None and name == wd.register and not (
+                value == wd.off or wd.steps[0] <= value <= wd.steps[1]):
+            return WriteError.RANGE
+        if name == "goal_position" and self.watchdog_tripped:
+            return WriteError.RANGE     # goals are read-only until the watchdog is cleared
         if name == "goal_position" and self.family == "dynamixel_x":
             if not self.get("min_position_limit") <= value <= self.get("max_position_limit"):
                 return WriteError.LIMIT
         return WriteError.NONE
 
     def reboot(self) -> None:
-        """Dynamixel reboot: clear latched errors and torque; goal := present."""
+        """Dynamixel reboot: clear latched errors, torque and the watchdog; goal := present."""
         self.set("hardware_error_status", 0)
+        if self.watchdog is not None:
+            self.set(self.watchdog.register, self.watchdog.off)
         self.set("torque_enable", 0)
         self.set("goal_position", round(self._pos))
         self._assert_faults()
@@ -261,101 +306,3 @@ def decode_value(family: str, address: int, data: bytes) -> int:
         reg.address == address and reg.size == len(data) and name in DXL_SIGNED
         for name, reg in TABLES[family].items())
     return int.from_bytes(data, "little", signed=signed)
-
-
-# ---------------------------------------------------------------------- codec → chain
-
-
-class Reply(NamedTuple):
-    """One status packet to send: from ``servo_id``, after ``delay_s`` [s] of return delay."""
-
-    servo_id: int
-    data: bytes
-    delay_s: float
-
-
-class Handled(NamedTuple):
-    """What a codec made of one instruction packet: the log fields plus the replies."""
-
-    instruction: str
-    ids: tuple[int, ...]
-    address: int | None
-    values: dict[int, int]
-    length: int | None
-    replies: list[Reply]
-
-
-def chain_replies(hearing: Mapping[int, EmulatedServo], items: Sequence[tuple[int, int, int]],
-                  read_status: Callable[[EmulatedServo, int, int], bytes]) -> list[Reply]:
-    """Status packets for (id, address, length) reads in request order (sync/bulk read).
-
-    A missing servo is silent and, as on a real chain, silences every servo after it.
-    """
-    replies = []
-    for sid, address, n in items:
-        servo = hearing.get(sid)
-        if servo is None:
-            break
-        replies.append(Reply(sid, read_status(servo, address, n), servo.return_delay_s))
-    return replies
-
-
-def sync_write(family: str, address: int, length: int, chunk: bytes,
-               hearing: Mapping[int, EmulatedServo]) -> dict[int, int]:
-    """Apply ``(id, data[length])*`` to the servos that hear it; return id → value written."""
-    values: dict[int, int] = {}
-    step = 1 + length
-    for i in range(0, len(chunk) - step + 1, step):
-        sid, data = chunk[i], chunk[i + 1:i + step]
-        values[sid] = decode_value(family, address, data)
-        if sid in hearing:
-            hearing[sid].write(address, data)
-    return values
-
-
-class FrameParser:
-    """Incremental instruction-packet parser; subclasses give the framing rules.
-
-    ``feed`` returns every complete (servo_id, instruction, params); packets failing the
-    checksum are counted in ``bad_checksum`` and skipped (resync one byte later).
-    """
-
-    header: bytes = b""
-    prefix_len: int = 0
-
-    def __init__(self) -> None:
-        self.buf = bytearray()
-        self.bad_checksum = 0
-
-    def total_length(self, prefix: bytes) -> int | None:
-        """Whole packet length [bytes] from its first ``prefix_len`` bytes; None: no packet."""
-        raise NotImplementedError
-
-    def decode(self, packet: bytes) -> tuple[int, int, bytes] | None:
-        """(servo_id, instruction, params), or None when the checksum is wrong."""
-        raise NotImplementedError
-
-    def feed(self, data: bytes) -> list[tuple[int, int, bytes]]:
-        self.buf += data
-        out: list[tuple[int, int, bytes]] = []
-        while True:
-            start = self.buf.find(self.header)
-            if start < 0:
-                del self.buf[:max(0, len(self.buf) - (len(self.header) - 1))]
-                return out
-            del self.buf[:start]
-            if len(self.buf) < self.prefix_len:
-                return out
-            total = self.total_length(bytes(self.buf[:self.prefix_len]))
-            if total is None:
-                del self.buf[:1]
-                continue
-            if len(self.buf) < total:
-                return out
-            frame = self.decode(bytes(self.buf[:total]))
-            if frame is None:
-                self.bad_checksum += 1
-                del self.buf[:1]
-                continue
-            del self.buf[:total]
-            out.append(frame)

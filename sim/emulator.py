@@ -16,6 +16,11 @@ adapter and talk Dynamixel Protocol 2.0 (``sim.dxl_protocol``) or Feetech STS
 - Hardware faults: Dynamixel X latches ``hardware_error_status`` until reboot and drops
   torque (shutdown), every status packet then carries the alert bit 0x80; Feetech's
   ``status`` register follows the injected condition live and is the reply's error byte.
+- Bus Watchdog (Dynamixel X): each servo keeps the time of the last instruction packet
+  addressed to it; armed, torque on and silent for longer than the setting, it stops
+  (goal := present), the register reads -1 and goal writes get a Data Range Error until
+  0 is written; torque stays on. Evaluated lazily like motion, so ``registers()`` after a
+  silent gap shows the trip. Feetech STS has no such register (see ``tables.COMM_WATCHDOG``).
 - Log: one :class:`Packet` per instruction packet with a valid checksum that at least one
   servo heard. Broadcast writes log id 254. Written values are decoded little-endian
   (signed for Dynamixel's signed registers); for bulk reads ``values`` maps id → address.

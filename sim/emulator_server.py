@@ -123,6 +123,10 @@ class _ChainServer:
             for s in hearing.values():
                 s.update(now)
             h = self.codec.handle(servo_id, inst, params, hearing)
+            addressed = hearing.values() if self.codec.BROADCAST_ID in h.ids else (
+                hearing[i] for i in h.ids if i in hearing)
+            for s in addressed:
+                s.hear(now)
             self.counters["rx_packets"] += 1
             self.counters[h.instruction] = self.counters.get(h.instruction, 0) + 1
             self.log.append(Packet(now, h.instruction, h.ids, h.address, h.values, h.length))

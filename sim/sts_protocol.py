@@ -15,15 +15,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from sim.emulated_servo import (
-    EmulatedServo,
-    FrameParser,
-    Handled,
-    Reply,
-    chain_replies,
-    decode_value,
-    sync_write,
-)
+from sim.emulated_servo import EmulatedServo, decode_value
+from sim.wire import FrameParser, Handled, Reply, chain_replies, sync_write
 
 HEADER = b"\xff\xff"
 HEADER_BYTE = 0xFF

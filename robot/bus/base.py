@@ -83,6 +83,20 @@ class Bus(ABC):
     def read_state(self, ids: Iterable[int]) -> dict[int, ServoState]:
         """Present state of ``ids`` by sync read. Raises BusError naming a missing id."""
 
+    def arm_failsafe(self, ids: Iterable[int], *, timeout_s: float) -> float | None:
+        """Arm the servos' own communication watchdog: if no packet arrives for
+        ``timeout_s`` [s] they stop moving. Returns the timeout actually armed [s] (rounded
+        to the servo's unit), or None when the servos have no such watchdog.
+
+        This default is for buses without one (the MuJoCo bus): it does nothing.
+        """
+        return None
+
+    def disarm_failsafe(self, ids: Iterable[int]) -> None:
+        """Disarm it (and clear a tripped watchdog) so the servos accept goals again; no-op
+        when there is none. This default is for buses without one: it does nothing."""
+        return None
+
     def read_positions(self, ids: Iterable[int]) -> dict[int, int]:
         """Present positions [ticks] of ``ids``."""
         return {i: s.position for i, s in self.read_state(ids).items()}

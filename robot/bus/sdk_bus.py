@@ -16,12 +16,19 @@ from collections.abc import Callable, Iterable, Mapping
 from types import ModuleType
 from typing import Any, ClassVar
 
-from robot.bus import health
+from robot.bus import failsafe, health
 from robot.bus.base import Bus, ServoInfo, ServoState
 from robot.bus.limits import TickLimits
 from robot.bus.sdk_port import PORT_ERRORS
 from robot.bus.sync_read import BlockSyncRead, Reply
-from robot.bus.tables import BAUD_CODES, RETURN_DELAY_UNIT_S, TABLES, Register, model_name
+from robot.bus.tables import (
+    BAUD_CODES,
+    COMM_WATCHDOG,
+    RETURN_DELAY_UNIT_S,
+    TABLES,
+    Register,
+    model_name,
+)
 from robot.config import RobotConfig
 from robot.errors import BusError
 
@@ -70,6 +77,7 @@ class SdkBus(Bus):
         self._ph: Any = None
         self._writer: Any = None
         self._torqued: set[int] = set()
+        self.failsafe_armed: set[int] = set()   # ids whose communication watchdog we armed
         self._lock = threading.RLock()
 
     # ------------------------------------------------------------------ hooks
@@ -136,25 +144,36 @@ class SdkBus(Bus):
         port, self._port = self._port, None
         if port is None:
             return
+        wd = COMM_WATCHDOG[self.family]
+        if wd is not None and self.failsafe_armed and port.is_open:
+            self._close_write(port, wd.register, wd.off, sorted(self.failsafe_armed),
+                              "the failsafe stays armed")
+        self.failsafe_armed.clear()
         ids = sorted(set(self.robot.ids if self.robot else ()) | self._torqued)
         if torque_off and ids and port.is_open:
-            try:
-                port.is_using = False
-                reg = self.table["torque_enable"]
-                group = self.sdk.GroupSyncWrite(port, self._ph, reg.address, reg.size)
-                for sid in ids:
-                    group.addParam(sid, [0])
-                result = group.txPacket()
-                if result != self.sdk.COMM_SUCCESS:
-                    log.warning("torque off on close failed: %s", self._ph.getTxRxResult(result))
-            except PORT_ERRORS as e:
-                log.warning("torque off on close failed (port error: %s); servos %s may still "
-                            "hold torque", e, ids)
+            self._close_write(port, "torque_enable", 0, ids, "they may still hold torque")
         try:
             if port.is_open:
                 port.closePort()
         except PORT_ERRORS as e:
             log.debug("closing %s: %s", self.port_name, e)
+
+    def _close_write(self, port: Any, name: str, value: int, ids: list[int],
+                     consequence: str) -> None:
+        """One sync write of ``name`` = ``value`` while closing; failures are only logged."""
+        try:
+            port.is_using = False
+            reg = self.table[name]
+            group = self.sdk.GroupSyncWrite(port, self._ph, reg.address, reg.size)
+            for sid in ids:
+                group.addParam(sid, list(value.to_bytes(reg.size, "little")))
+            result = group.txPacket()
+            if result != self.sdk.COMM_SUCCESS:
+                log.warning("%s=%d on close failed: %s; servos %s: %s", name, value,
+                            self._ph.getTxRxResult(result), ids, consequence)
+        except PORT_ERRORS as e:
+            log.warning("%s=%d on close failed (port error: %s); servos %s: %s", name, value,
+                        e, ids, consequence)
 
     # ------------------------------------------------------------------ messages
     def who(self, sid: int) -> str:
@@ -251,18 +270,35 @@ class SdkBus(Bus):
                 baud=self.baud))
         return found
 
-    def set_torque(self, ids: Iterable[int], *, enabled: bool) -> None:
+    @staticmethod
+    def each(ids: Iterable[int], action: Callable[[int], None]) -> None:
+        """``action(sid)`` for every id, in order, even after one fails; then raise the
+        first failure (counting the others)."""
         failures: list[BusError] = []
         for sid in sorted(set(ids)):
             try:
-                self.write_register(sid, "torque_enable", int(enabled))
+                action(sid)
             except BusError as e:
                 failures.append(e)
-            else:
-                (self._torqued.add if enabled else self._torqued.discard)(sid)
         if failures:
             more = f" (and {len(failures) - 1} more servos)" if len(failures) > 1 else ""
             raise BusError(f"{failures[0]}{more}") from failures[0]
+
+    def set_torque(self, ids: Iterable[int], *, enabled: bool) -> None:
+        def one(sid: int) -> None:
+            self.write_register(sid, "torque_enable", int(enabled))
+            (self._torqued.add if enabled else self._torqued.discard)(sid)
+
+        self.each(ids, one)
+
+    def arm_failsafe(self, ids: Iterable[int], *, timeout_s: float) -> float | None:
+        wd = COMM_WATCHDOG[self.family]
+        return None if wd is None else failsafe.arm(self, wd, ids, timeout_s)
+
+    def disarm_failsafe(self, ids: Iterable[int]) -> None:
+        wd = COMM_WATCHDOG[self.family]
+        if wd is not None:
+            failsafe.disarm(self, wd, ids)
 
     def write_goals(self, goals: Mapping[int, int]) -> None:
         if not goals:

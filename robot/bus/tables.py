@@ -45,6 +45,7 @@ DYNAMIXEL_X: dict[str, Register] = {
     "led": Register(65, 1),
     "status_return_level": Register(68, 1),
     "hardware_error_status": Register(70, 1),
+    "bus_watchdog": Register(98, 1),
     "profile_acceleration": Register(108, 4),
     "profile_velocity": Register(112, 4),
     "goal_position": Register(116, 4),
@@ -130,6 +131,47 @@ BAUD_CODES: dict[str, dict[int, int]] = {
 
 # Unit of one "return delay" register step [s]: Dynamixel X 2 µs, Feetech STS 2 µs.
 RETURN_DELAY_UNIT_S: dict[str, float] = {"dynamixel_x": 2e-6, "feetech_sts": 2e-6}
+
+
+class CommWatchdog(NamedTuple):
+    """A servo's own communication watchdog (fail-safe when the host goes silent).
+
+    register: name in the family's table; unit_s: one register step [s]; steps: the
+    arming range [steps, inclusive]; off: the value that disarms it and clears a trip;
+    tripped: the (signed) value the register reads after a trip; min_firmware: first
+    firmware version that has it.
+    """
+
+    register: str
+    unit_s: float
+    steps: tuple[int, int]
+    off: int
+    tripped: int
+    min_firmware: int
+
+    @property
+    def range_s(self) -> tuple[float, float]:
+        """Shortest and longest timeout it can arm [s]."""
+        return self.steps[0] * self.unit_s, self.steps[1] * self.unit_s
+
+
+# ROBOTIS e-Manual, X series control table, "Bus Watchdog(98)" (RAM, 1 byte, RW, initial 0;
+# https://emanual.robotis.com/docs/en/dxl/x/xl430-w250/#bus-watchdog): 0 disables it and
+# clears a trip, 1..127 arms it in units of 20 ms, -1 is "Bus Watchdog Error". It watches
+# the gap between instruction packets while Torque Enable(64) is 1; when the gap exceeds
+# the setting the servo stops, the register becomes -1 and the Goal values (PWM 100,
+# Current 102, Velocity 104, Position 116) turn read-only: writing one is answered with a
+# Data Range Error (Protocol 2.0 status error 4) until 0 is written. Torque stays on: the
+# manual never says it is dropped (a trip is no Hardware Error Status bit, so no
+# shutdown), and its example (steps 7-8) clears the error with 0 and the servo moves on
+# the next goal without a new Torque Enable. Available from firmware v38.
+# Feetech STS/SMS: the memory table (FT-SMS-STS-emanual; LeRobot's
+# STS_SMS_SERIES_CONTROL_TABLE; feetech-servo-sdk has no table) has no communication
+# watchdog: with the host gone an STS servo keeps its last goal and holds it with torque.
+COMM_WATCHDOG: dict[str, CommWatchdog | None] = {
+    "dynamixel_x": CommWatchdog("bus_watchdog", 0.020, (1, 127), 0, -1, 38),
+    "feetech_sts": None,
+}
 
 
 class ServoModel(NamedTuple):

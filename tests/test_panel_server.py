@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -164,8 +165,9 @@ def test_save_preset(panel: tuple[PanelController, Call]) -> None:
     assert load_gait(saved).params == controller.params
     assert call("POST", "/api/save", {"name": "my_walk"})[0] == 409
     assert call("POST", "/api/save", {"name": "my_walk", "overwrite": True})[0] == 200
-    status, d = call("POST", "/api/save", {"name": "walk"})
-    assert status == 409 and "bundled" in d["error"]
+    for overwrite in (False, True):
+        status, d = call("POST", "/api/save", {"name": "walk", "overwrite": overwrite})
+        assert status == 409 and "bundled" in d["error"]
     for bad in ("../evil", "a/b", "", " x", "x" * 60, 5):
         status, d = call("POST", "/api/save", {"name": bad})
         assert status == 400 and "preset name" in d["error"]
@@ -226,7 +228,10 @@ def test_token_required_beyond_loopback() -> None:
     server = build_server(controller, host="0.0.0.0", port=0, token="s3cret")
     _, base = serve_in_thread(server)
     try:
-        for path in ("/", "/api/state", "/api/params"):
+        for path in ("/", "/panel.js", "/panel.css"):  # public: no secret in them
+            status, text = http(base, "GET", path)
+            assert status == 200 and "s3cret" not in text
+        for path in ("/api/state", "/api/params"):
             assert http(base, "GET", path)[0] == 401
             assert http(base, "GET", path, headers={"Authorization": "Bearer nope"})[0] == 401
             assert http(base, "GET", path, headers={"Authorization": "Bearer s3cret"})[0] == 200
@@ -249,15 +254,22 @@ def test_biped_panel_command_prints_token_and_stops_on_sigterm(tmp_path: Path) -
     try:
         assert proc.stdout is not None
         line = proc.stdout.readline()
-        assert "open http://0.0.0.0:" in line and "?token=" in line, line
+        m = re.search(r" open (http://\S+)(?: \(this machine: (\S+)\))?$", line)
+        assert m is not None, line
+        url, local = m[1], m[2] or m[1]  # a LAN address, and loopback (the same without LAN)
+        port = local.split("/")[2].split(":")[1]
+        assert local.startswith(f"http://127.0.0.1:{port}/?token="), line
+        assert "0.0.0.0" not in url and f":{port}/?token=" in url, line
         token = proc.stdout.readline().split()[-1]
-        base = "http://127.0.0.1:" + line.split("http://0.0.0.0:")[1].split("/")[0] + "/"
+        assert url.endswith(f"?token={token}") and len(token) >= 20
+        base = url.split("?")[0]  # what a phone opens
         assert http(base, "GET", "/api/state")[0] == 401
+        assert http(base, "GET", "/")[0] == 200
         auth = {"Authorization": f"Bearer {token}"}
         assert wait_for(lambda: http(base, "GET", "/api/state", headers=auth)[1]["running"])
         proc.send_signal(signal.SIGTERM)
         out, _ = proc.communicate(timeout=15)
-        assert proc.returncode == 0 and "stopping" in out
+        assert proc.returncode == 143 and "stopping" in out
     finally:
         if proc.poll() is None:
             proc.kill()

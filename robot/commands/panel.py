@@ -1,7 +1,9 @@
 """`biped panel`: the live puppeteering web panel (same options as `biped walk`).
 
 Starts the gait loop (on the sim bus paced to the wall clock) and serves the page and its
-JSON API until Ctrl-C, then stops safely (ramp out, rest, torque off).
+JSON API. The first SIGINT/SIGTERM starts a safe stop (ramp out, rest, then torque off, or
+hold with ``--hold``); a second one stops at once with torque off. Either way the bus is
+closed before the process exits: 130 after SIGINT, 143 after SIGTERM, 2 for bad options.
 """
 
 from __future__ import annotations
@@ -9,21 +11,30 @@ from __future__ import annotations
 import argparse
 import logging
 import secrets
-import signal
-import threading
+import time
 from pathlib import Path
 from typing import Any
 
 from robot.bus.factory import make_bus
 from robot.commands.common import add_set_arg, params_from, robot_from
+from robot.commands.signals import SignalLatch, stop_on_signals
 from robot.commands.walk import add_walk_args
-from robot.config import GAITS_DIR
 from robot.errors import ConfigError
 from robot.panel.controller import LoopOptions, make_controller
-from robot.panel.presets import PresetStore
-from robot.panel.server import build_server, is_loopback, serve_in_thread
+from robot.panel.presets import PresetStore, user_presets_dir
+from robot.panel.server import build_server, is_loopback, panel_url, serve_in_thread
 
 log = logging.getLogger(__name__)
+
+
+def port_number(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        v = -1
+    if not 0 <= v <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a port number in [0, 65535], got {text!r}")
+    return v
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
@@ -34,15 +45,30 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     add_walk_args(p)
     add_set_arg(p)
     p.add_argument("--host", default="127.0.0.1", help="address to serve on (default: "
-                   "%(default)s; anything else needs a token)")
-    p.add_argument("--http-port", type=int, default=8080, help="HTTP port (default: "
+                   "%(default)s; anything else needs a token; 0.0.0.0 for a phone)")
+    p.add_argument("--http-port", type=port_number, default=8080, help="HTTP port (default: "
                    "%(default)s; 0 picks a free one)")
     p.add_argument("--token", default=None, help="access token (generated and printed when "
                    "serving beyond loopback without one)")
-    p.add_argument("--presets-dir", default=str(GAITS_DIR), metavar="DIR",
-                   help="where 'save as preset' writes (default: %(default)s)")
+    p.add_argument("--presets-dir", default=None, metavar="DIR",
+                   help=f"where 'save as preset' writes (default: {user_presets_dir()})")
     p.add_argument("--no-start", action="store_true", help="serve without starting the gait")
     return p
+
+
+class _Deferred:
+    """Signal target that only records: the main thread acts on it, because a handler
+    must not use the bus the main thread may be in the middle of using."""
+
+    def __init__(self) -> None:
+        self.stop = False
+        self.abort = False
+
+    def request_stop(self, reason: str = "") -> None:
+        self.stop = True
+
+    def emergency_stop(self, reason: str = "") -> None:
+        self.stop = self.abort = True
 
 
 def run(args: argparse.Namespace) -> int:
@@ -54,38 +80,40 @@ def run(args: argparse.Namespace) -> int:
     token = args.token
     if token is None and not is_loopback(args.host):
         token = secrets.token_urlsafe(18)
+    presets = PresetStore(Path(args.presets_dir)) if args.presets_dir else PresetStore()
     options: dict[str, Any] = {"realtime": True, "view": args.view} if kind == "sim" else {}
     bus = make_bus(kind, robot=robot, port=args.port, baud=args.baud, **options)
     controller = make_controller(
         robot, bus, params,
         options=LoopOptions(rate_hz=args.rate, read_every=args.read_every, hold=args.hold),
-        presets=PresetStore(Path(args.presets_dir)), preset=gait.name)
+        presets=presets, preset=gait.name)
     try:
         server = build_server(controller, host=args.host, port=args.http_port, token=token)
     except OSError as e:
         raise ConfigError(f"--http-port {args.http_port}: cannot serve on {args.host}: "
                           f"{e.strerror or e}") from e
-    _, base = serve_in_thread(server)
-    if not is_loopback(args.host):
-        base = base.replace("127.0.0.1", args.host).replace("[::1]", f"[{args.host}]")
-    url = base + (f"?token={token}" if token else "")
-    print(f"biped panel: {robot.name} on the {kind} bus at {args.rate:g} Hz; open {url}",
-          flush=True)
-    if token and not args.token:
-        print(f"biped panel: access token {token}", flush=True)
-
-    def on_term(_signum: int, _frame: Any) -> None:
-        raise KeyboardInterrupt
-    old_term = signal.signal(signal.SIGTERM, on_term)
-    try:
-        if not args.no_start:
-            controller.start()
-        threading.Event().wait()
-    except KeyboardInterrupt:
-        print("biped panel: stopping (ramp out, rest, torque off)", flush=True)
-    finally:
-        signal.signal(signal.SIGTERM, old_term)
-        server.shutdown()
-        server.server_close()
-        controller.shutdown()
-    return 0
+    signals, latch = _Deferred(), SignalLatch()
+    with stop_on_signals(signals, latch):
+        try:
+            _, local = serve_in_thread(server)
+            query = f"?token={token}" if token else ""
+            url = panel_url(args.host, int(server.server_address[1]))
+            also = f" (this machine: {local}{query})" if url != local else ""
+            print(f"biped panel: {robot.name} on the {kind} bus at {args.rate:g} Hz; open "
+                  f"{url}{query}{also}", flush=True)
+            if token and not args.token:
+                print(f"biped panel: access token {token}", flush=True)
+            if not args.no_start:
+                controller.start()
+            while not signals.stop:
+                time.sleep(0.1)
+            end = "hold" if args.hold else "torque off"
+            print(f"biped panel: stopping (ramp out, rest, {end}; again: torque off now)",
+                  flush=True)
+        finally:
+            controller.shutdown(abort=lambda: signals.abort)
+            server.shutdown()
+            server.server_close()
+    print("biped panel: stopped; torque " + ("left ON (holding)" if controller.holding and
+                                             not signals.abort else "off"), flush=True)
+    return latch.exit_code(None)

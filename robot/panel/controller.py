@@ -2,12 +2,14 @@
 run in a worker thread; every HTTP request goes through it (thread-safe).
 
 A Streamer run is one-shot, so "start" after a stop starts a new run (a new GaitEngine
-with the current parameters) on the same open bus.
+with the current parameters) on the same open bus. The run's thread is not a daemon: the
+process cannot end under it before ``shutdown`` has stopped it and closed the bus.
 """
 
 from __future__ import annotations
 
 import logging
+import math
 import threading
 import time
 from collections import deque
@@ -21,9 +23,10 @@ from robot.engine import GaitEngine
 from robot.errors import BipedError
 from robot.panel.figure import views
 from robot.panel.presets import PresetStore
+from robot.panel.sim_monitor import sim_monitor_factory
 from robot.params import GROUPS, SPECS, GaitParams
 from robot.servo_map import ServoMap
-from robot.streamer import Streamer, Telemetry
+from robot.streamer import LoopStats, Streamer, Telemetry
 
 log = logging.getLogger(__name__)
 
@@ -70,6 +73,9 @@ class PanelController:
         self._sim: dict[str, Any] = {}
         self._ticks: deque[tuple[int, float]] = deque(maxlen=RATE_WINDOW)
         self.runs = 0
+        self.last_stats: LoopStats | None = None  # of the last run that returned
+        self._holding = False  # torque left on by the last run (hold, no fault or estop)
+        self._closing = False
 
     # -- parameters --------------------------------------------------------------------
     @property
@@ -108,6 +114,8 @@ class PanelController:
     def start(self) -> None:
         """Start a new run with the current parameters (PanelStateError if one runs)."""
         with self._lock:
+            if self._closing:
+                raise PanelStateError("the panel is shutting down")
             if self.running:
                 raise PanelStateError("the gait is already running; stop it first")
             if not self.bus.is_open:
@@ -125,14 +133,18 @@ class PanelController:
                                       observer=observe)
             self._tel = {"state": "starting"}
             self.runs += 1
+            self._holding = False
             self._thread = threading.Thread(target=self._run, args=(self._streamer,),
-                                            name=f"gait-run-{self.runs}", daemon=True)
+                                            name=f"gait-run-{self.runs}", daemon=False)
             self._thread.start()
 
     def _run(self, streamer: Streamer) -> None:
         try:
             stats = streamer.run(seconds=None)
             log.info("run ended: %s", stats.stop_reason)
+            with self._lock:
+                self.last_stats = stats
+                self._holding = bool(getattr(stats, "holding", False))
         except BipedError as e:
             log.error("run failed: %s", e)
         except Exception:
@@ -153,6 +165,7 @@ class PanelController:
             if self.running and self._streamer is not None:
                 self._streamer.emergency_stop()
                 return
+            self._holding = False
             if self.bus.is_open:
                 self.bus.set_torque(list(self._map.ids), enabled=False)
             self._tel = {**self._tel, "state": "estop", "stop_reason": "emergency stop"}
@@ -171,6 +184,7 @@ class PanelController:
             model, data = bus.model, bus.data
             t = float(data.time)
             self.bus.set_torque(list(self._map.ids), enabled=False)
+            self._holding = False
             mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
             data.time = t
             mujoco.mj_forward(model, data)
@@ -184,15 +198,40 @@ class PanelController:
             t.join(timeout)
         return not self.running
 
-    def shutdown(self, timeout: float = 10.0) -> None:
-        """Safe stop and wait; emergency stop if the ramp-out takes longer than
-        ``timeout`` [s]; close the bus."""
-        if self.running and self._streamer is not None:
-            self._streamer.request_stop("panel shutdown")
-            if not self.wait(timeout):
-                self._streamer.emergency_stop()
-                self.wait(2.0)
-        self.bus.close()
+    @property
+    def holding(self) -> bool:
+        """The last run ended with torque left on (``--hold``, no fault, no estop since)."""
+        return self._holding
+
+    def stop_budget_s(self) -> float:
+        """How long a safe stop may take before it counts as stuck [s]: the gait's
+        ramp-out plus 10 s for the move to rest."""
+        p = self._streamer.engine.params if self._streamer is not None else self._params
+        ramp_s = p.ramp_cycles * p.cycle_s
+        return (ramp_s if math.isfinite(ramp_s) else 0.0) + 10.0
+
+    def shutdown(self, timeout: float | None = None, *,
+                 abort: Callable[[], bool] = lambda: False) -> None:
+        """Refuse new runs; safe-stop a run (ramp out, rest) and wait for it, or stop it
+        at once (emergency stop) when ``abort()`` becomes true (e.g. a second signal) or
+        after ``timeout`` [s] (default ``stop_budget_s()``). Then close the bus, leaving
+        torque on only if the last run ended holding and nothing aborted."""
+        with self._lock:
+            self._closing = True
+            streamer = self._streamer if self.running else None
+        if streamer is not None:
+            streamer.request_stop("panel shutdown")
+            budget = self.stop_budget_s() if timeout is None else timeout
+            end = time.monotonic() + budget
+            while not self.wait(0.05):
+                if abort() or time.monotonic() > end:
+                    log.warning("emergency stop: %s", "aborted" if abort()
+                                else f"the safe stop took longer than {budget:.1f} s")
+                    streamer.emergency_stop()
+                    if not self.wait(2.0):
+                        log.error("the gait thread did not end; closing the bus anyway")
+                    break
+        self.bus.close(torque_off=not (self._holding and not abort()))
 
     # -- telemetry -------------------------------------------------------------------
     def _observe(self, tel: Telemetry, monitor: Callable[[Telemetry], dict[str, Any]] | None
@@ -262,25 +301,3 @@ def make_controller(robot: RobotConfig, bus: Bus, params: GaitParams, *,
     factory = sim_monitor_factory(bus) if bus.kind == "sim" else None
     return PanelController(robot, bus, params, options=options, presets=presets,
                            monitor_factory=factory, preset=preset)
-
-
-def sim_monitor_factory(bus: Any) -> Callable[[], Callable[[Telemetry], dict[str, Any]]]:
-    """Per-run WalkMonitor on a MujocoBus: fell or not, torso height, tilt, distance."""
-    from sim.metrics import WalkMonitor
-
-    def factory() -> Callable[[Telemetry], dict[str, Any]]:
-        monitor = WalkMonitor(standing_height=bus.standing_height)
-        last = [-1]
-
-        def watch(tel: Telemetry) -> dict[str, Any]:
-            if tel.tick != last[0]:
-                last[0] = tel.tick
-                pos, quat = bus.base_pose()
-                monitor.update(tel.t, pos, quat, bus.upright_angle())
-            s = monitor.summary(1.0)
-            return {"fell": s["fell"], "fell_at_s": s["fell_at_s"],
-                    "distance_m": s["distance_m"], "heading_deg": s["heading_change_deg"],
-                    "torso_height_m": float(bus.base_pose()[0][2]),
-                    "tilt_deg": float(bus.upright_angle() * 57.29577951308232)}
-        return watch
-    return factory

@@ -1,15 +1,18 @@
 """Gait presets for the panel: list, load and save (validated TOML via gait_to_toml).
 
-Bundled presets live in ``configs/gaits``; a panel may save into its own ``presets_dir``.
-A bundled preset is never overwritten unless ``overwrite`` is set.
+Bundled presets live in ``configs/gaits`` and are read-only here: saving under a bundled
+name is refused whatever ``overwrite`` says, and a user file with a bundled name is
+ignored (the bundled one wins). The panel saves into ``presets_dir``: by default the
+user's ``$XDG_CONFIG_HOME/biped/gaits`` (``~/.config/biped/gaits``), never the repository.
 """
 
 from __future__ import annotations
 
 import logging
+import os
 import re
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from robot.config import GAITS_DIR, Gait, gait_names, gait_to_toml, load_gait, parse_gait
@@ -22,52 +25,69 @@ NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,47}$")
 
 
 class PresetExistsError(ConfigError):
-    """Saving would overwrite an existing preset and ``overwrite`` was not set."""
+    """Saving would overwrite a bundled preset, or a user preset without ``overwrite``."""
+
+
+def user_presets_dir() -> Path:
+    """``$XDG_CONFIG_HOME/biped/gaits``; ``~/.config/biped/gaits`` when it is unset or
+    relative (the XDG base directory rule)."""
+    xdg = os.environ.get("XDG_CONFIG_HOME", "")
+    root = Path(xdg) if os.path.isabs(xdg) else Path.home() / ".config"
+    return root / "biped" / "gaits"
 
 
 @dataclass(frozen=True)
 class PresetStore:
     """Where presets are read and written.
 
-    presets_dir: directory written by "save as preset" (default: the bundled gait dir),
-    searched before the bundled presets.
+    presets_dir: directory written by "save as preset" (default ``user_presets_dir()``);
+    it may not be the bundled directory.
     """
 
-    presets_dir: Path = GAITS_DIR
+    presets_dir: Path = field(default_factory=user_presets_dir)
+
+    def __post_init__(self) -> None:
+        if self.presets_dir.resolve() == GAITS_DIR.resolve():
+            raise ConfigError(f"presets directory {self.presets_dir}: that is where the "
+                              "bundled presets live; save elsewhere (default "
+                              f"{user_presets_dir()})")
 
     def names(self) -> list[str]:
         own = {p.stem for p in self.presets_dir.glob("*.toml")} if self.presets_dir.is_dir() \
             else set()
-        return sorted(own | set(gait_names()))
+        return sorted({n for n in own if NAME_RE.match(n)} | set(gait_names()))
 
     def path(self, name: object) -> Path:
         name = check_name(name)
-        own = self.presets_dir / f"{name}.toml"
-        if own.exists():
-            return own
-        bundled = GAITS_DIR / f"{name}.toml"
-        if bundled.exists():
-            return bundled
+        for path in (GAITS_DIR / f"{name}.toml", self.presets_dir / f"{name}.toml"):
+            if path.is_file():
+                return path
         raise ConfigError(f"preset {name!r} not found; valid: {', '.join(self.names())}")
 
     def load(self, name: object) -> Gait:
         return load_gait(self.path(name))
 
     def save(self, name: object, params: GaitParams, *, overwrite: bool = False) -> Path:
-        """Write ``params`` as preset ``name``; returns the file written."""
+        """Write ``params`` as user preset ``name``; returns the file written. A bundled
+        name is refused even with ``overwrite``."""
         name = check_name(name)
         target = self.presets_dir / f"{name}.toml"
-        bundled = name in gait_names()
-        if not overwrite and (target.exists() or bundled):
-            what = "bundled preset" if bundled else f"preset file {target}"
-            raise PresetExistsError(f"preset {name!r}: would overwrite the {what}; "
-                               "choose another name or set overwrite")
+        if name.lower() in {n.lower() for n in gait_names()}:
+            raise PresetExistsError(f"preset {name!r} is bundled with biped and cannot be "
+                                    "replaced from the panel; save under another name")
+        if not overwrite and target.exists():
+            raise PresetExistsError(f"preset {name!r}: would overwrite {target}; choose "
+                                    "another name or set overwrite")
         text = gait_to_toml(Gait(name=name, params=params))
         parse_gait(tomllib.loads(text), source=str(target))  # validate what we write
-        self.presets_dir.mkdir(parents=True, exist_ok=True)
         tmp = target.with_suffix(".toml.tmp")
-        tmp.write_text(text)
-        tmp.replace(target)
+        try:
+            self.presets_dir.mkdir(parents=True, exist_ok=True)
+            tmp.write_text(text)
+            tmp.replace(target)
+        except OSError as e:
+            raise ConfigError(f"preset {name!r}: cannot write {target}: {e.strerror or e}") \
+                from e
         log.info("saved preset %s to %s", name, target)
         return target
 

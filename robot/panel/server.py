@@ -1,17 +1,21 @@
 """The panel's HTTP server: a static page and JSON endpoints over a PanelController.
 
-Endpoints (JSON in and out; errors are ``{"error": "..."}``):
+Endpoints (JSON in and out; errors are ``{"error": "..."}``, never an empty reply):
   GET  /api/state    loop state, timing, servos, sim metrics, stick figure
   GET  /api/params   current parameters with ranges, grouped
   GET  /api/presets  preset names
   POST /api/params   {name: value, ...} → 200 {"params": {...}} or 400 (nothing changes)
   POST /api/preset   {"name": ...} → load a preset (validated set_params of all its values)
-  POST /api/save     {"name": ..., "overwrite": false} → write the current params as TOML
+  POST /api/save     {"name": ..., "overwrite": false} → write the current params as a user
+                     preset (a bundled preset is never replaced: 409)
   POST /api/start | /api/stop | /api/estop    run, safe ramp-out, torque off at once
   POST /api/reset    simulation only, while stopped: robot back on its feet
 
-With a token, every request needs ``Authorization: Bearer <token>`` or ``?token=<token>``
-(401 otherwise). Serving beyond loopback requires a token.
+Every request passes ``robot.panel.guard`` first (Host, Origin, JSON content type, body
+length). With a token, every /api request needs ``Authorization: Bearer <token>`` or
+``?token=<token>`` (401 otherwise); the page and its assets are public (they hold no
+secret) and the page sends the token from its own URL with each API call. Serving beyond
+loopback requires a token.
 """
 
 from __future__ import annotations
@@ -20,6 +24,7 @@ import hmac
 import json
 import logging
 import socket
+import sys
 import threading
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
@@ -29,22 +34,25 @@ from urllib.parse import parse_qs, urlsplit
 
 from robot.errors import BipedError, ConfigError
 from robot.panel.controller import PanelController, PanelStateError
+from robot.panel.guard import WILDCARD, Guard, Refused, is_loopback, lan_address
 from robot.panel.presets import PresetExistsError
 
 log = logging.getLogger(__name__)
 
-LOOPBACK = ("127.0.0.1", "localhost", "::1")
 STATIC = {"/": ("index.html", "text/html; charset=utf-8"),
           "/index.html": ("index.html", "text/html; charset=utf-8"),
           "/panel.js": ("panel.js", "text/javascript; charset=utf-8"),
           "/panel.css": ("panel.css", "text/css; charset=utf-8")}
 ACTIONS = {"/api/start": "start", "/api/stop": "stop", "/api/estop": "emergency_stop",
            "/api/reset": "reset_sim"}
-MAX_BODY = 64 * 1024  # [bytes]
+READ_TIMEOUT_S = 10.0  # a client that stalls mid-request is dropped after this
+HEADERS = {"Cache-Control": "no-store", "X-Content-Type-Options": "nosniff",
+           "Referrer-Policy": "no-referrer", "X-Frame-Options": "DENY",
+           "Content-Security-Policy": "default-src 'self'; img-src 'self' data:; "
+           "style-src 'self' 'unsafe-inline'; frame-ancestors 'none'; base-uri 'none'; "
+           "form-action 'none'"}
 
-
-def is_loopback(host: str) -> bool:
-    return host in LOOPBACK
+__all__ = ["build_server", "is_loopback", "panel_url", "serve_in_thread"]
 
 
 def static_file(name: str) -> bytes:
@@ -52,14 +60,19 @@ def static_file(name: str) -> bytes:
 
 
 def build_server(controller: PanelController, *, host: str = "127.0.0.1", port: int = 0,
-                 token: str | None = None) -> ThreadingHTTPServer:
+                 token: str | None = None, read_timeout_s: float = READ_TIMEOUT_S
+                 ) -> ThreadingHTTPServer:
     """A ThreadingHTTPServer bound to (host, port) (port 0: ephemeral) serving the panel for
-    ``controller``. Call ``serve_forever()`` (e.g. in a thread) and ``shutdown()``."""
+    ``controller``. Call ``serve_forever()`` (e.g. in a thread) and ``shutdown()``.
+    read_timeout_s: a client silent this long mid-request is answered 408 or dropped."""
     if not is_loopback(host) and not token:
         raise ConfigError(f"--host {host}: serving beyond loopback needs a token (--token)")
+    guard = Guard.for_bind(host)
 
     class Handler(BaseHTTPRequestHandler):
         server_version = "biped-panel/1"
+        default_request_version = "HTTP/1.0"  # errors always get a status line and headers
+        timeout = read_timeout_s
 
         def log_message(self, format: str, *args: Any) -> None:  # noqa: A002
             log.debug("%s " + format, self.address_string(), *args)
@@ -77,39 +90,71 @@ def build_server(controller: PanelController, *, host: str = "127.0.0.1", port: 
             self.send_response(status)
             self.send_header("Content-Type", ctype)
             self.send_header("Content-Length", str(len(body)))
-            self.send_header("Cache-Control", "no-store")
+            for k, v in HEADERS.items():
+                self.send_header(k, v)
+            if self.close_connection:
+                self.send_header("Connection", "close")
             self.end_headers()
-            self.wfile.write(body)
+            if self.command != "HEAD":
+                self.wfile.write(body)
 
         def _json(self, status: int, obj: Any) -> None:
             self._send(status, json.dumps(obj).encode(), "application/json")
 
+        def send_error(self, code: int, message: str | None = None,
+                       explain: str | None = None) -> None:
+            """The base class's errors (bad request line, unknown method...) as JSON."""
+            self.close_connection = True
+            self._json(code, {"error": message or HTTPStatus(code).phrase})
+
+        def _check(self, method: str, url: Any) -> None:
+            """Host, Origin and token for every request; content type for POST."""
+            host = self.headers.get("Host")
+            guard.check_host(host, str(self.connection.getsockname()[0]))
+            guard.check_origin(self.headers.get("Origin"), host or "")
+            if url.path.startswith("/api/") and not self._authorised(parse_qs(url.query)):
+                raise Refused(HTTPStatus.UNAUTHORIZED, "missing or wrong token; use "
+                              "Authorization: Bearer <token> or ?token=<token>")
+            if method == "POST":
+                guard.check_content_type(self.headers.get("Content-Type"))
+
         def _route(self, method: str) -> None:
-            url = urlsplit(self.path)
-            if not self._authorised(parse_qs(url.query)):
-                self._json(HTTPStatus.UNAUTHORIZED, {"error": "missing or wrong token; use "
-                           "Authorization: Bearer <token> or ?token=<token>"})
-                return
             try:
+                url = urlsplit(self.path)
+                self._check(method, url)
                 if method == "GET":
                     self._get(url.path)
                 else:
                     self._post(url.path, self._body())
-            except PresetExistsError as e:
-                self._json(HTTPStatus.CONFLICT, {"error": str(e)})
-            except PanelStateError as e:
+            except Refused as e:
+                self.close_connection = True  # an unread body must not be parsed as a request
+                self._json(e.status, {"error": str(e)})
+            except (PresetExistsError, PanelStateError) as e:
                 self._json(HTTPStatus.CONFLICT, {"error": str(e)})
             except BipedError as e:
                 self._json(HTTPStatus.BAD_REQUEST, {"error": str(e)})
+            except TimeoutError:
+                self.close_connection = True
+                self._json(HTTPStatus.REQUEST_TIMEOUT,
+                           {"error": f"request body not received within {read_timeout_s:g} s"})
+            except Exception as e:  # a bug: answer, and keep serving
+                log.error("panel: %s %s failed: %s: %s", method, self.path, type(e).__name__, e,
+                          exc_info=log.isEnabledFor(logging.DEBUG))
+                self.close_connection = True
+                self._json(HTTPStatus.INTERNAL_SERVER_ERROR,
+                           {"error": f"internal error: {type(e).__name__}: {e}"})
 
         def _body(self) -> dict[str, Any]:
-            n = int(self.headers.get("Content-Length") or 0)
-            if n > MAX_BODY:
-                raise ConfigError(f"request body too large ({n} bytes; max {MAX_BODY})")
-            raw = self.rfile.read(n) if n else b"{}"
+            cl = self.headers.get_all("Content-Length")
+            n = guard.body_length(", ".join(cl) if cl else None,
+                                  self.headers.get("Transfer-Encoding"))
+            raw = self.rfile.read(n) if n else b""
+            if len(raw) < n:
+                raise Refused(HTTPStatus.BAD_REQUEST,
+                              f"request body ended after {len(raw)} of {n} bytes")
             try:
                 body = json.loads(raw or b"{}")
-            except (json.JSONDecodeError, UnicodeDecodeError) as e:
+            except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as e:
                 raise ConfigError(f"request body is not JSON: {e}") from None
             if not isinstance(body, dict):
                 raise ConfigError("request body must be a JSON object")
@@ -158,18 +203,42 @@ def build_server(controller: PanelController, *, host: str = "127.0.0.1", port: 
 
 
 def serve_in_thread(server: ThreadingHTTPServer) -> tuple[threading.Thread, str]:
-    """Run ``server.serve_forever`` in a daemon thread; returns it and the base URL."""
+    """Run ``server.serve_forever`` in a daemon thread; returns it and a base URL for this
+    machine (loopback when serving on every address)."""
     host, port = str(server.server_address[0]), int(server.server_address[1])
-    if host in ("0.0.0.0", "::"):
+    if host in WILDCARD:
         host = "127.0.0.1" if host == "0.0.0.0" else "::1"
-    shown = f"[{host}]" if ":" in host else host
     thread = threading.Thread(target=server.serve_forever, name="panel-http", daemon=True)
     thread.start()
-    return thread, f"http://{shown}:{port}/"
+    return thread, base_url(host, port)
+
+
+def base_url(host: str, port: int) -> str:
+    return f"http://[{host}]:{port}/" if ":" in host else f"http://{host}:{port}/"
+
+
+def panel_url(host: str, port: int) -> str:
+    """The URL another device (a phone) opens: on every address (0.0.0.0, ::), this
+    machine's LAN address (loopback if it has none); else ``host`` itself."""
+    if host in WILDCARD:
+        family = socket.AF_INET6 if ":" in host else socket.AF_INET
+        found = lan_address(family)
+        if found is None:
+            log.warning("no LAN address found; the panel URL uses loopback")
+        host = found or ("::1" if family == socket.AF_INET6 else "127.0.0.1")
+    return base_url(host, port)
 
 
 class _Server(ThreadingHTTPServer):
     daemon_threads = True
+
+    def handle_error(self, request: Any, client_address: Any) -> None:
+        """A failed connection is one log line, never a traceback on stderr."""
+        exc = sys.exc_info()[1]
+        level = logging.DEBUG if isinstance(exc, (ConnectionError, TimeoutError)) \
+            else logging.WARNING
+        log.log(level, "panel: connection from %s failed: %s: %s", client_address[0],
+                type(exc).__name__, exc)
 
 
 class _Server6(_Server):

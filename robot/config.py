@@ -6,15 +6,16 @@ Every error is one line: ``<file>: <field path>: <what is expected>, got <value>
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Mapping
-from dataclasses import MISSING, dataclass, field, fields
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from robot.bus.tables import BUS_FAMILIES, MODELS, ServoModel
+from robot.bus.tables import MODELS, ServoModel
+from robot.config_checks import check_bus, check_ticks
 from robot.errors import ConfigError
 from robot.params import SPECS, GaitParams, canonical_name, check_value
+from robot.toml_io import Range, build, number, read_toml, show, spec, table
 
 CONFIG_DIR = Path(__file__).resolve().parent.parent / "configs"
 ROBOTS_DIR = CONFIG_DIR / "robots"
@@ -29,6 +30,23 @@ LEG_NAMES = tuple(f"{s}_{j}" for s in SIDES for j in LEG_JOINTS)
 ARM_NAMES = tuple(f"{s}_{j}" for s in SIDES for j in ARM_JOINTS)
 JOINT_NAMES = LEG_NAMES + ARM_NAMES
 
+# Valid ranges of the numeric fields (checked at load; see robot/toml_io.py).
+#: bus.retries: extra attempts per transaction; more than 10 only hides a broken bus.
+RETRIES = Range(0, 10)
+#: bus.timeout_ms: reply timeout; under 1 ms nothing answers, over 1 s the loop is dead.
+TIMEOUT_MS = Range(1.0, 1000.0, "ms")
+#: Geometry: 1 mm (no servo link is smaller; 0 divides by zero in IK) to 2 m.
+LENGTH = Range(0.001, 2.0, "m")
+#: Link masses: 1 g to 100 kg.
+MASS = Range(0.001, 100.0, "kg")
+#: Joint limits: one turn, centred on zero.
+ANGLE = Range(-math.pi, math.pi, "rad", label="[-pi, pi]")
+#: Slew limit: 0.05 rad/s (3 deg/s: a 2 pi ramp still ends within 4 min) to 20 rad/s (above
+#: the no-load speed of every hobby servo in tables.MODELS).
+SPEED = Range(0.05, 20.0, "rad/s")
+#: Servo ids: 0..252 (253..255 are broadcast / reserved in both protocols).
+SERVO_ID = Range(0, 252)
+
 
 @dataclass(frozen=True)
 class BusConfig:
@@ -38,8 +56,8 @@ class BusConfig:
     model: str
     port: str = "/dev/ttyUSB0"
     baud: int = 1_000_000
-    retries: int = 2
-    timeout_ms: float = 20.0
+    retries: int = field(default=2, metadata=spec(RETRIES))
+    timeout_ms: float = field(default=20.0, metadata=spec(TIMEOUT_MS))
 
     @property
     def servo(self) -> ServoModel:
@@ -58,18 +76,18 @@ class Geometry:
     ``forearm`` below the elbow.
     """
 
-    hip_width: float
-    thigh: float
-    shin: float
-    ankle_height: float
-    foot_length: float
-    foot_width: float
-    foot_forward: float
-    torso_height: float
-    torso_depth: float
-    shoulder_width: float
-    upper_arm: float
-    forearm: float
+    hip_width: float = field(metadata=spec(LENGTH))
+    thigh: float = field(metadata=spec(LENGTH))
+    shin: float = field(metadata=spec(LENGTH))
+    ankle_height: float = field(metadata=spec(LENGTH))
+    foot_length: float = field(metadata=spec(LENGTH))
+    foot_width: float = field(metadata=spec(LENGTH))
+    foot_forward: float = field(metadata=spec(LENGTH))
+    torso_height: float = field(metadata=spec(LENGTH))
+    torso_depth: float = field(metadata=spec(LENGTH))
+    shoulder_width: float = field(metadata=spec(LENGTH))
+    upper_arm: float = field(metadata=spec(LENGTH))
+    forearm: float = field(metadata=spec(LENGTH))
 
     @property
     def leg_length(self) -> float:
@@ -81,16 +99,16 @@ class Geometry:
 class Masses:
     """Link masses including the servos they carry [kg]."""
 
-    torso: float
-    hip_yaw_link: float
-    hip_roll_link: float
-    thigh: float
-    shin: float
-    ankle_link: float
-    foot: float
-    upper_arm: float
-    forearm: float
-    shoulder_link: float = 0.03
+    torso: float = field(metadata=spec(MASS))
+    hip_yaw_link: float = field(metadata=spec(MASS))
+    hip_roll_link: float = field(metadata=spec(MASS))
+    thigh: float = field(metadata=spec(MASS))
+    shin: float = field(metadata=spec(MASS))
+    ankle_link: float = field(metadata=spec(MASS))
+    foot: float = field(metadata=spec(MASS))
+    upper_arm: float = field(metadata=spec(MASS))
+    forearm: float = field(metadata=spec(MASS))
+    shoulder_link: float = field(default=0.03, metadata=spec(MASS))
 
     @property
     def total(self) -> float:
@@ -109,12 +127,12 @@ class JointConfig:
     """
 
     name: str
-    servo_id: int
+    servo_id: int = field(metadata=spec(SERVO_ID))
     sign: int
     zero_ticks: int
-    min_rad: float
-    max_rad: float
-    max_speed_rad_s: float
+    min_rad: float = field(metadata=spec(ANGLE))
+    max_rad: float = field(metadata=spec(ANGLE))
+    max_speed_rad_s: float = field(metadata=spec(SPEED))
 
 
 @dataclass(frozen=True)
@@ -162,76 +180,13 @@ class Gait:
     source: str = "<memory>"
 
 
-# ---------------------------------------------------------------------------- helpers
-
-
-def _read_toml(path: Path) -> dict[str, Any]:
-    try:
-        with path.open("rb") as f:
-            return tomllib.load(f)
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: file not found") from None
-    except tomllib.TOMLDecodeError as e:
-        raise ConfigError(f"{path}: not valid TOML: {e}") from e
-
-
-def _number(src: str, path: str, value: Any, *, lo: float = -math.inf, hi: float = math.inf,
-            integer: bool = False, positive: bool = False) -> Any:
-    kind = "an integer" if integer else "a number"
-    ok_type = isinstance(value, int) if integer else isinstance(value, (int, float))
-    if isinstance(value, bool) or not ok_type:
-        raise ConfigError(f"{src}: {path}: expected {kind}, got {value!r}")
-    if not math.isfinite(float(value)):
-        raise ConfigError(f"{src}: {path}: expected a finite number, got {value!r}")
-    if positive and value <= 0:
-        raise ConfigError(f"{src}: {path}: expected a positive number, got {value!r}")
-    if not lo <= value <= hi:
-        raise ConfigError(f"{src}: {path}: expected {kind} in [{lo:g}, {hi:g}], got {value!r}")
-    return value if integer else float(value)
-
-
-def _table(src: str, path: str, value: Any) -> dict[str, Any]:
-    if not isinstance(value, dict):
-        raise ConfigError(f"{src}: {path}: expected a table, got {value!r}")
-    return value
-
-
-def _build(cls: Any, src: str, path: str, data: Any, *, overrides: Mapping[str, Any] = {},
-           positive: bool = False) -> Any:
-    """Build a flat dataclass of numbers/strings from a TOML table, checking every field."""
-    data = _table(src, path, data)
-    names = [f.name for f in fields(cls) if f.name not in overrides]
-    unknown = sorted(set(data) - set(names))
-    if unknown:
-        raise ConfigError(f"{src}: {path}.{unknown[0]}: unknown key; valid: {', '.join(names)}")
-    kwargs: dict[str, Any] = dict(overrides)
-    for f in fields(cls):
-        if f.name in overrides:
-            continue
-        fpath = f"{path}.{f.name}"
-        if f.name not in data:
-            if f.default is not MISSING:
-                continue
-            raise ConfigError(f"{src}: {fpath}: missing (expected {f.type})")
-        v = data[f.name]
-        if f.type in ("str", str):
-            if not isinstance(v, str) or not v:
-                raise ConfigError(f"{src}: {fpath}: expected a non-empty string, got {v!r}")
-            kwargs[f.name] = v
-        elif f.type in ("int", int):
-            kwargs[f.name] = _number(src, fpath, v, integer=True)
-        else:
-            kwargs[f.name] = _number(src, fpath, v, positive=positive)
-    return cls(**kwargs)
-
-
 # ---------------------------------------------------------------------------- robots
 
 
 def load_robot(path: str | Path | None = None) -> RobotConfig:
     """Load and validate a robot TOML file (default: the Dynamixel biped)."""
     p = Path(path) if path is not None else DEFAULT_ROBOT
-    return parse_robot(_read_toml(p), source=str(p))
+    return parse_robot(read_toml(p), source=str(p))
 
 
 def parse_robot(data: Mapping[str, Any], *, source: str = "<memory>") -> RobotConfig:
@@ -245,24 +200,14 @@ def parse_robot(data: Mapping[str, Any], *, source: str = "<memory>") -> RobotCo
             raise ConfigError(f"{src}: {key}: missing")
     name = data["name"]
     if not isinstance(name, str) or not name:
-        raise ConfigError(f"{src}: name: expected a non-empty string, got {name!r}")
+        raise ConfigError(f"{src}: name: expected a non-empty string, got {show(name)}")
 
-    bus = _build(BusConfig, src, "bus", data["bus"])
-    if bus.kind not in BUS_FAMILIES:
-        raise ConfigError(f"{src}: bus.kind: expected one of {', '.join(BUS_FAMILIES)}, "
-                          f"got {bus.kind!r}")
-    if bus.model not in MODELS:
-        raise ConfigError(f"{src}: bus.model: unknown servo model {bus.model!r}; valid: "
-                          f"{', '.join(MODELS)}")
-    if MODELS[bus.model].family != BUS_FAMILIES[bus.kind]:
-        raise ConfigError(f"{src}: bus.model: {bus.model} is not a {bus.kind} servo")
-    if bus.baud <= 0:
-        raise ConfigError(f"{src}: bus.baud: expected a positive integer, got {bus.baud}")
+    bus = build(BusConfig, src, "bus", data["bus"])
+    check_bus(src, bus)
+    geometry = build(Geometry, src, "geometry", data["geometry"])
+    mass = build(Masses, src, "mass", data["mass"])
 
-    geometry = _build(Geometry, src, "geometry", data["geometry"], positive=True)
-    mass = _build(Masses, src, "mass", data["mass"], positive=True)
-
-    jtab = _table(src, "joints", data["joints"])
+    jtab = table(src, "joints", data["joints"])
     unknown = sorted(set(jtab) - set(JOINT_NAMES))
     if unknown:
         raise ConfigError(f"{src}: joints.{unknown[0]}: unknown joint; valid: "
@@ -282,42 +227,34 @@ def parse_robot(data: Mapping[str, Any], *, source: str = "<memory>") -> RobotCo
         if jn not in jtab:
             continue
         jp = f"joints.{jn}"
-        j = _build(JointConfig, src, jp, jtab[jn], overrides={"name": jn})
-        if not 0 <= j.servo_id <= 252:
-            raise ConfigError(f"{src}: {jp}.servo_id: expected an id in [0, 252], got {j.servo_id}")
+        j = build(JointConfig, src, jp, jtab[jn], overrides={"name": jn})
         if j.servo_id in seen:
             raise ConfigError(f"{src}: {jp}.servo_id: duplicate servo id {j.servo_id} "
                               f"(also joints.{seen[j.servo_id]})")
         seen[j.servo_id] = jn
         if j.sign not in (1, -1):
-            raise ConfigError(f"{src}: {jp}.sign: expected +1 or -1, got {j.sign}")
-        if not 0 <= j.zero_ticks < resolution:
-            raise ConfigError(f"{src}: {jp}.zero_ticks: expected an integer in "
-                              f"[0, {resolution - 1}], got {j.zero_ticks}")
+            raise ConfigError(f"{src}: {jp}.sign: expected +1 or -1, got {show(j.sign)}")
+        number(src, f"{jp}.zero_ticks", j.zero_ticks, Range(0, resolution - 1), integer=True)
         if not j.min_rad < j.max_rad:
             raise ConfigError(f"{src}: {jp}: limits reversed or empty: min_rad {j.min_rad} "
                               f"must be < max_rad {j.max_rad}")
-        if not (-math.pi <= j.min_rad and j.max_rad <= math.pi):
-            raise ConfigError(f"{src}: {jp}: limits must lie within [-pi, pi], got "
-                              f"[{j.min_rad}, {j.max_rad}]")
-        if j.max_speed_rad_s <= 0:
-            raise ConfigError(f"{src}: {jp}.max_speed_rad_s: expected a positive number, "
-                              f"got {j.max_speed_rad_s}")
         joints.append(j)
 
-    rest_raw = _table(src, "rest", data.get("rest", {}))
+    rest_raw = table(src, "rest", data.get("rest", {}))
     rest: dict[str, float] = {}
     names = {j.name: j for j in joints}
     for jn, v in rest_raw.items():
         if jn not in names:
             raise ConfigError(f"{src}: rest.{jn}: unknown joint; valid: {', '.join(names)}")
-        q = _number(src, f"rest.{jn}", v)
+        q = number(src, f"rest.{jn}", v, ANGLE)
         if not names[jn].min_rad <= q <= names[jn].max_rad:
             raise ConfigError(f"{src}: rest.{jn}: {q} is outside the joint limits "
                               f"[{names[jn].min_rad}, {names[jn].max_rad}]")
         rest[jn] = q
-    return RobotConfig(name=name, bus=bus, geometry=geometry, mass=mass, joints=tuple(joints),
-                       rest=rest, source=src)
+    robot = RobotConfig(name=name, bus=bus, geometry=geometry, mass=mass, joints=tuple(joints),
+                        rest=rest, source=src)
+    check_ticks(robot)
+    return robot
 
 
 # ---------------------------------------------------------------------------- gaits
@@ -343,7 +280,7 @@ def resolve_gait_path(name_or_path: str | Path) -> Path:
 def load_gait(name_or_path: str | Path | None = None) -> Gait:
     """Load and validate a gait preset by name or path (default: ``walk``)."""
     p = resolve_gait_path(name_or_path if name_or_path is not None else DEFAULT_GAIT)
-    return parse_gait(_read_toml(p), source=str(p))
+    return parse_gait(read_toml(p), source=str(p))
 
 
 def parse_gait(data: Mapping[str, Any], *, source: str = "<memory>") -> Gait:
@@ -354,13 +291,13 @@ def parse_gait(data: Mapping[str, Any], *, source: str = "<memory>") -> Gait:
         raise ConfigError(f"{src}: {unknown[0]}: unknown key; valid: {', '.join(sorted(allowed))}")
     name = data.get("name", Path(src).stem)
     if not isinstance(name, str) or not name:
-        raise ConfigError(f"{src}: name: expected a non-empty string, got {name!r}")
+        raise ConfigError(f"{src}: name: expected a non-empty string, got {show(name)}")
     values: dict[str, float] = {}
     if "fps" in data:
         values["fps"] = check_value("fps", data["fps"], where=f"{src}: fps")
     for section, paper in (("params", True), ("mapping", False)):
-        table = _table(src, section, data.get(section, {}))
-        for key, v in table.items():
+        entries = table(src, section, data.get(section, {}))
+        for key, v in entries.items():
             where = f"{src}: {section}.{key}"
             canon = canonical_name(key, where=where)
             if canon == "fps":

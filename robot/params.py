@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from robot.errors import ConfigError
+from robot.toml_io import show
 
 
 class ParamSpec(NamedTuple):
@@ -194,12 +195,12 @@ def check_value(name: str, value: Any, *, where: str = "parameter") -> float:
     spec = SPECS[name]
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ConfigError(f"{where}: {name} must be a number in [{spec.lo:g}, {spec.hi:g}] "
-                          f"{spec.unit}, got {value!r}")
-    v = float(value)
-    if not math.isfinite(v) or not spec.lo <= v <= spec.hi:
-        raise ConfigError(f"{where}: {name} = {value!r} is outside [{spec.lo:g}, {spec.hi:g}] "
-                          f"{spec.unit} ({spec.doc})")
-    return v
+                          f"{spec.unit}, got {show(value)}")
+    # Range first: float() of a 400-digit integer raises OverflowError.
+    if not (spec.lo <= value <= spec.hi):  # also false for nan
+        raise ConfigError(f"{where}: {name} = {show(value)} is outside [{spec.lo:g}, "
+                          f"{spec.hi:g}] {spec.unit} ({spec.doc})")
+    return float(value)
 
 
 # Sanity: SPECS and GaitParams must name the same parameters in the same order.

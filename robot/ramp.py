@@ -16,6 +16,12 @@ FloatArray = npt.NDArray[np.float64]
 
 #: Peak speed of the minimum-jerk profile relative to its mean speed (15/8).
 MIN_JERK_PEAK = 1.875
+#: Longest ramp [s]: a full turn (2 pi) at the slowest configurable joint speed (0.05 rad/s,
+#: robot.config) takes 236 s; anything longer is a unit error, not a motion.
+MAX_RAMP_S = 300.0
+#: Most waypoints of one ramp: MAX_RAMP_S at 2000 Hz (the highest --rate), 18 joints
+#: x 8 bytes x 600001 rows = 86 MB.
+MAX_RAMP_STEPS = 600_000
 
 
 def _speeds(max_speed: npt.ArrayLike, n: int) -> FloatArray:
@@ -60,7 +66,12 @@ def ramp_duration(q_from: npt.ArrayLike, q_to: npt.ArrayLike, max_speed: npt.Arr
         raise ConfigError("ramp: q_from and q_to must be finite angles [rad]")
     v = _speeds(max_speed, a.size)
     need = float(np.max(MIN_JERK_PEAK * np.abs(b - a) / v)) if a.size else 0.0
-    return max(float(min_duration), need)
+    duration = max(float(min_duration), need)
+    if not duration <= MAX_RAMP_S:
+        raise ConfigError(f"ramp: would last {duration:.3g} s (joint speeds down to "
+                          f"{float(np.min(v)) if v.size else 0:.3g} rad/s); expected at most "
+                          f"{MAX_RAMP_S:g} s: raise the speed or check its unit")
+    return duration
 
 
 def ramp(q_from: npt.ArrayLike, q_to: npt.ArrayLike, max_speed: npt.ArrayLike,
@@ -80,6 +91,9 @@ def ramp(q_from: npt.ArrayLike, q_to: npt.ArrayLike, max_speed: npt.ArrayLike,
     duration = ramp_duration(a, b, max_speed, min_duration=min_duration)
     # Whole steps; rounding up only lowers the peak speed.
     n = max(1, math.ceil(duration * rate_hz - 1e-9))
+    if n > MAX_RAMP_STEPS:
+        raise ConfigError(f"ramp: {duration:.3g} s at {rate_hz:g} Hz is {n} steps; expected "
+                          f"at most {MAX_RAMP_STEPS}: lower the rate")
     s = min_jerk(np.arange(n + 1) / n)
     path = a + np.outer(s, b - a)
     path[0] = a

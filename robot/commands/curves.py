@@ -7,11 +7,23 @@ import logging
 
 import numpy as np
 
-from robot.commands.common import add_robot_args, gait_from, positive_float, robot_from
+from robot.commands.common import (
+    add_robot_args,
+    gait_from,
+    one_line_errors,
+    output_file,
+    rate_hz,
+    robot_from,
+    seconds,
+)
 from robot.curves_io import plot_curves, write_csv
 from robot.engine import GaitEngine
+from robot.errors import ConfigError
 
 log = logging.getLogger(__name__)
+
+#: Most CSV rows (--seconds x --rate + 1): 1e6 rows of ~60 columns is ~1 GB of text.
+MAX_ROWS = 1_000_000
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
@@ -19,17 +31,21 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                        description="Evaluate the gait at constant parameters and write the "
                                    "paper's channels and the joint angles.")
     add_robot_args(p)
-    p.add_argument("--seconds", type=positive_float, default=4.0, help="duration [s]")
-    p.add_argument("--rate", type=positive_float, default=100.0, help="samples per second")
-    p.add_argument("--out", required=True, metavar="FILE.csv", help="CSV to write")
-    p.add_argument("--plot", metavar="FILE.png", help="also write a plot")
-    return p
+    p.add_argument("--seconds", type=seconds, default=4.0, help="duration [s]")
+    p.add_argument("--rate", type=rate_hz, default=100.0, help="samples per second [Hz]")
+    p.add_argument("--out", required=True, type=output_file, metavar="FILE.csv",
+                   help="CSV to write")
+    p.add_argument("--plot", type=output_file, metavar="FILE.png", help="also write a plot")
+    return one_line_errors(p)
 
 
 def run(args: argparse.Namespace) -> int:
+    n = int(round(args.seconds * args.rate)) + 1
+    if n > MAX_ROWS:
+        raise ConfigError(f"--seconds {args.seconds:g} x --rate {args.rate:g}: {n} rows; "
+                          f"expected at most {MAX_ROWS}")
     robot = robot_from(args)
     gait = gait_from(args)
-    n = int(round(args.seconds * args.rate)) + 1
     times = np.arange(n) / args.rate
     engine = GaitEngine(robot, gait.params)
     channels, q = engine.curves(times)

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import argparse
 
+from robot.commands.common import checked, input_file, one_line_errors, output_file
+
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
     p = sub.add_parser("plot", help="plot a run record or a curves file to a PNG",
@@ -13,12 +15,15 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                                    "channels and joint angles of a curves CSV.")
     p.add_argument("file", metavar="FILE", help="run record (.csv/.jsonl) or curves CSV")
     p.add_argument("--out", required=True, metavar="FILE.png", help="PNG to write")
-    return p
+    return one_line_errors(p)
 
 
 def run(args: argparse.Namespace) -> int:
     from robot.plotting import plot_file
 
+    # Checked here rather than as argparse types so that main() returns 2 like for a bad file.
+    checked("FILE", input_file, args.file)
+    checked("--out", output_file, args.out)
     kind = plot_file(args.file, args.out)
     print(f"wrote {args.out} ({kind} plot of {args.file})")
     return 0

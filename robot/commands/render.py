@@ -9,13 +9,24 @@ import logging
 from robot.commands.common import (
     add_robot_args,
     add_set_arg,
+    bounded_float,
+    bounded_int,
+    one_line_errors,
+    output_file,
     params_from,
-    positive_float,
-    positive_int,
+    rate_hz,
     robot_from,
 )
+from robot.errors import ConfigError
 
 log = logging.getLogger(__name__)
+
+#: A previs clip lasts at most an hour.
+clip_seconds = bounded_float(0.0, 3600.0, "s", what="a clip length", lo_open=True)
+#: Frame sizes parse up to this; sim.render.check_output enforces the real limits.
+frame_px = bounded_int(1, 100_000, "px", what="a frame size")
+#: A GIF is assembled in memory: at most this many bytes of RGB frames.
+MAX_GIF_BYTES = 1 << 30
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
@@ -23,16 +34,19 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                        description="Walk the gait on the MuJoCo bus and film it with the "
                                    "tracking camera (offscreen, MUJOCO_GL=egl).")
     add_robot_args(p)
-    p.add_argument("--seconds", type=positive_float, default=5.0, help="clip length [s]")
-    p.add_argument("--out", required=True, metavar="FILE.mp4|FILE.gif", help="clip to write")
-    p.add_argument("--width", type=positive_int, default=640, help="frame width [px]")
-    p.add_argument("--height", type=positive_int, default=360, help="frame height [px]")
-    p.add_argument("--fps", type=positive_float, default=30.0, help="video frames per second")
-    p.add_argument("--rate", type=positive_float, default=200.0, help="control rate [Hz]")
+    p.add_argument("--seconds", type=clip_seconds, default=5.0, help="clip length [s]")
+    p.add_argument("--out", required=True, type=output_file, metavar="FILE.mp4|FILE.gif",
+                   help="clip to write")
+    # The offscreen buffer's limits (16..1920 x 16..1080) are checked by check_output.
+    p.add_argument("--width", type=frame_px, default=640, help="frame width [px]")
+    p.add_argument("--height", type=frame_px, default=360, help="frame height [px]")
+    p.add_argument("--fps", type=bounded_float(1.0, 120.0, "frames/s", what="a frame rate"),
+                   default=30.0, help="video frames per second")
+    p.add_argument("--rate", type=rate_hz, default=200.0, help="control rate [Hz]")
     p.add_argument("--camera", default="track", help="MuJoCo camera (default: %(default)s)")
     add_set_arg(p)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
-    return p
+    return one_line_errors(p)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -40,7 +54,13 @@ def run(args: argparse.Namespace) -> int:
 
     spec = ClipSpec(seconds=args.seconds, width=args.width, height=args.height, fps=args.fps,
                     rate_hz=args.rate, camera=args.camera)
-    check_output(args.out, spec)
+    path = check_output(args.out, spec)
+    size = spec.frames * spec.width * spec.height * 3
+    if path.suffix.lower() == ".gif" and size > MAX_GIF_BYTES:
+        raise ConfigError(f"--seconds/--fps/--width/--height: a GIF of {spec.frames} frames "
+                          f"of {spec.width}x{spec.height} needs {size / 2**30:.1f} GiB in "
+                          f"memory; expected at most {MAX_GIF_BYTES / 2**30:g} GiB (shorter, "
+                          "smaller, or .mp4)")
     robot = robot_from(args)
     gait, params = params_from(args)
     result = render_walk(robot, params, args.out, spec=spec, progress=not args.quiet)

@@ -8,9 +8,8 @@ import logging
 
 from robot.bus import health
 from robot.bus.base import ServoInfo
-from robot.bus.factory import make_bus
 from robot.bus.sdk_bus import SdkBus
-from robot.commands.common import add_bus_args, parse_ids
+from robot.commands.common import add_bus_args, bus_from, id_list, one_line_errors
 from robot.config import DEFAULT_ROBOT, ROBOTS_DIR, RobotConfig, load_robot
 from robot.errors import BusError
 
@@ -21,14 +20,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p = subparsers.add_parser("scan", help="list the servos on a Dynamixel or Feetech bus",
                               description=__doc__)
     add_bus_args(p, choices=("dynamixel", "feetech"))
-    p.add_argument("--ids", default=None, metavar="RANGE",
+    p.add_argument("--ids", type=id_list, default=None, metavar="RANGE",
                    help="ids to ping, e.g. 1-20 or 1,3,5-7 (default: 1-20 and the robot's ids)")
     p.add_argument("--robot", default=None, metavar="PATH",
                    help="robot TOML whose joints to match (default: the bundled robot for --bus)")
     p.add_argument("--json", action="store_true", help="print one JSON list and nothing else")
     p.add_argument("--fix-return-delay", action="store_true",
                    help="set return_delay_time = 0 on every servo found (torque off)")
-    return p
+    return one_line_errors(p)
 
 
 def _robot(args: argparse.Namespace) -> RobotConfig:
@@ -50,9 +49,8 @@ def _row(info: ServoInfo, robot: RobotConfig) -> dict[str, object]:
 
 def run(args: argparse.Namespace) -> int:
     robot = _robot(args)
-    ids = (parse_ids(args.ids) if args.ids else
-           sorted(set(range(1, 21)) | set(robot.ids)))
-    bus = make_bus(args.bus, robot=robot, port=args.port, baud=args.baud, check_health=False)
+    ids = args.ids or sorted(set(range(1, 21)) | set(robot.ids))
+    bus = bus_from(args, robot, check_health=False)
     bus.open()
     try:
         found = bus.scan(ids)

@@ -1,16 +1,24 @@
-"""`biped torque on|off`: enable torque holding the present position, or release it."""
+"""`biped torque on|off`: enable torque holding the present position, or release it.
+
+`on` runs the streamer's start (``Streamer.move_to`` the present pose): it refuses, with
+torque untouched, if a joint is outside its limits, sets goal := present, then torque on.
+"""
 
 from __future__ import annotations
 
 import argparse
 
-from robot.bus.factory import make_bus
-from robot.commands.common import add_bus_args, add_robot_args, robot_from
+from robot.commands.common import (
+    add_bus_args,
+    add_robot_args,
+    bus_from,
+    one_line_errors,
+    robot_from,
+)
+from robot.engine import GaitEngine
+from robot.params import GaitParams
 from robot.servo_map import ServoMap
-from robot.streamer import check_inside_limits
-
-#: How far outside its limits [rad] a joint may be and still be held where it is (clamped).
-HOLD_TOLERANCE_RAD = 0.02
+from robot.streamer import Streamer
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -19,24 +27,25 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p.add_argument("state", choices=("on", "off"))
     add_robot_args(p, gait=False)
     add_bus_args(p)
-    return p
+    return one_line_errors(p)
 
 
 def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
-    bus = make_bus(args.bus, robot=robot, port=args.port, baud=args.baud)
+    bus = bus_from(args, robot)
     bus.open()
     try:
-        if args.state == "on":
-            sm = ServoMap(robot)
-            q = sm.from_positions(bus.read_positions(sm.ids))
-            q = check_inside_limits(sm, q, tolerance=HOLD_TOLERANCE_RAD, source=robot.source)
-            bus.write_goals(sm.goals(q.tolist()))   # goal := present: no snap at torque-on
-            bus.set_torque(sm.ids, enabled=True)
-            print(f"torque ON on {len(robot.ids)} servos, holding their present position")
-        else:
+        if args.state == "off":
             bus.set_torque(robot.ids, enabled=False)
             print(f"torque OFF on {len(robot.ids)} servos: the robot is limp, support it")
+            return 0
+        sm = ServoMap(robot)
+        streamer = Streamer(sm, bus, GaitEngine(robot, GaitParams()), hold_at_end=True)
+        stats = streamer.move_to(sm.from_positions(bus.read_positions(sm.ids)))
+        if stats.fault or not stats.holding:
+            print(f"stopped: {stats.stop_reason}; torque OFF")
+            return 1
+        print(f"torque ON on {len(robot.ids)} servos, holding their present position")
+        return 0
     finally:
         bus.close(torque_off=False)
-    return 0

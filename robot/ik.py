@@ -25,6 +25,8 @@ from robot.config import Geometry
 from robot.xmath import Num, Rot, Vec
 
 SIDE_SIGN = {"r": -1.0, "l": 1.0}  # y sign of the right / left hip and shoulder
+#: A target within this distance [m] of the arm's workspace counts as reachable.
+REACH_TOL = 1e-12
 
 
 class LegIK(NamedTuple):
@@ -50,6 +52,17 @@ def shoulder_centre(g: Geometry, side: str) -> Vec:
     return (0.0, SIDE_SIGN[side] * g.shoulder_width / 2, g.torso_height)
 
 
+def bend(a: float, b: float, c: Num) -> Num:
+    """Bend [rad] of the joint between links ``a`` and ``b`` [m] whose far ends are ``c`` [m]
+    apart: 0 straight, pi folded, clamped to those outside |a - b| <= c <= a + b.
+
+    The half-angle form of the law of cosines (no acos of a rounded cosine): full precision
+    at both ends, where acos loses half the digits (~1e-9 m at a fully folded knee).
+    """
+    return 2.0 * xm.atan2(xm.sqrt(xm.maximum((a + b - c) * (a + b + c), 0.0)),
+                          xm.sqrt(xm.maximum((c - a + b) * (c + a - b), 0.0)))
+
+
 def leg_fk_full(g: Geometry, side: str, q: tuple[Num, ...]) -> tuple[Vec, Rot]:
     """Sole point [m] and foot rotation in the pelvis frame for leg angles ``q`` (6)."""
     hx, hy, hz = hip_centre(g, side)
@@ -70,8 +83,13 @@ def leg_fk(g: Geometry, side: str, q: np.ndarray) -> np.ndarray:
 
 
 def leg_ik(g: Geometry, side: str, sole: Vec, foot_rot: Rot = xm.IDENTITY) -> LegIK:
-    """Leg angles that put the sole point at ``sole`` [m] with foot rotation ``foot_rot``
-    (both in the pelvis frame)."""
+    """Leg angles [rad] that put the sole point at ``sole`` [m] with foot rotation
+    ``foot_rot`` (both in the pelvis frame).
+
+    Degenerate targets divide by nothing: an ankle point at the hip centre folds the knee
+    (pi) and, with thigh == shin, is reached; one nearer than |thigh - shin| or farther
+    than thigh + shin is clamped along the ankle → hip line (``reachable`` False).
+    """
     a, b = g.thigh, g.shin
     hx, hy, hz = hip_centre(g, side)
     # Ankle point: the sole plus the foot's own up vector times the ankle height.
@@ -79,10 +97,9 @@ def leg_ik(g: Geometry, side: str, sole: Vec, foot_rot: Rot = xm.IDENTITY) -> Le
     ay = sole[1] + foot_rot[5] * g.ankle_height
     az = sole[2] + foot_rot[8] * g.ankle_height
     rx, ry, rz = xm.apply_t(foot_rot, (hx - ax, hy - ay, hz - az))  # ankle → hip, foot frame
-    c = xm.maximum(xm.sqrt(rx * rx + ry * ry + rz * rz), 1e-9)
-    c_knee = (c * c - a * a - b * b) / (2.0 * a * b)
-    reachable = (c_knee <= 1.0) & (c_knee >= -1.0)
-    knee = xm.acos(c_knee)
+    c = xm.sqrt(rx * rx + ry * ry + rz * rz)
+    reachable = (c >= abs(a - b) - REACH_TOL) & (c <= a + b + REACH_TOL)
+    knee = bend(a, b, c)
     # Angle at the ankle between the shin and the ankle → hip line. atan2, not the
     # law-of-sines asin: that one picks the acute branch, wrong when thigh > shin.
     ankle_a = xm.atan2(a * xm.sin(knee), b + a * xm.cos(knee))
@@ -114,24 +131,43 @@ def arm_fk(g: Geometry, side: str, q: np.ndarray) -> np.ndarray:
 
 
 def arm_ik(g: Geometry, hand: Vec) -> ArmIK:
-    """Arm angles putting the hand point at ``hand`` [m] relative to the shoulder centre.
+    """Arm angles [rad] putting the hand point at ``hand`` [m] relative to the shoulder centre.
 
-    The elbow bends forward (negative angle); the shoulder roll stays within ±90°.
+    The elbow (bent forward, <= 0) sets the distance d; in the elbow's plane the hand is
+    then at (vx, vz) = (-f sin(elbow), -u - f cos(elbow)) [m], and the roll about x sends it
+    to y = -sin(roll) vz. So the workspace is not the whole annulus |f - u| <= d <= u + f:
+    at distance d the hand reaches only |y| <= |vz| = |d^2 + u^2 - f^2| / (2u). With
+    forearm f > upper arm u, vz = 0 at d0 = sqrt(f^2 - u^2) (forearm square to the upper
+    arm, hand on the roll axis): there only y = 0 is reachable (the singular circle), and a
+    hand held |y| = 1 cm out of the shoulder plane cannot come nearer than
+    sqrt(f^2 - u^2 + 2u|y|) (5.7 cm on the shipped robots).
+
+    Clamping (``reachable`` False; never NaN, no division by ~0):
+    - outside the annulus: radially onto it, which is the nearest reachable point;
+    - inside it but out of lateral reach (|y| > |vz|): the hand keeps d and its direction
+      about the pitch axis, and sin(roll) = -vz / y, the reciprocal of the exact -y / vz.
+      The roll is +-90 deg at the edge of reach and passes through 0 at the singular
+      sphere, so it is continuous there. (The nearest point is not: it jumps between the
+      two lobes of the workspace and the roll flips by pi.) The hand lands at
+      |y| = vz^2 / |y_target|.
+    Where an angle does not matter, it takes its neutral value: roll 0 on the singular
+    circle (vz = y = 0), shoulder pitch 0 for a target or hand on the pitch axis (y).
+    The shoulder roll stays within +-90 deg; the pitch is in (-pi, pi].
     """
     u, f = g.upper_arm, g.forearm
     px, py, pz = hand
-    d = xm.maximum(xm.sqrt(px * px + py * py + pz * pz), 1e-12)
-    c_elbow = (d * d - u * u - f * f) / (2.0 * u * f)
-    reachable = (c_elbow <= 1.0) & (c_elbow >= -1.0)
-    # Unreachable: aim at the nearest reachable point along the shoulder → hand line.
-    k = xm.clip(d, abs(u - f), u + f) / d
-    px, py, pz = px * k, py * k, pz * k
-    elbow = -xm.acos(c_elbow)
-    vx = -f * xm.sin(elbow)
-    vz = -u - f * xm.cos(elbow)  # < 0 for every elbow angle when f < u + f
-    s2 = xm.clip(-py / vz, -1.0, 1.0)
-    roll = xm.asin(s2)
+    d = xm.sqrt(px * px + py * py + pz * pz)
+    lo, hi = abs(u - f), u + f
+    dc = xm.clip(d, lo, hi)
+    y = py * (dc / xm.maximum(d, 1e-300))  # radial clamp onto the annulus
+    elbow = -bend(u, f, dc)
+    vx = -f * xm.sin(elbow)  # >= 0
+    vz = -u - f * xm.cos(elbow)
+    # sin(roll) = -y vz / max(y^2, vz^2): -y/vz within reach, -vz/y beyond it.
+    yy, zz = y * y, vz * vz
+    roll = xm.asin(-y * vz / xm.maximum(xm.maximum(yy - zz, 0.0) + zz, 1e-300))
     w = xm.cos(roll) * vz
-    pitch = xm.atan2(px, pz) - xm.atan2(vx, w)
-    pitch = xm.atan2(xm.sin(pitch), xm.cos(pitch))  # wrap to (-pi, pi]
+    # pitch = atan2(px, pz) - atan2(vx, w), as one atan2: 0 when either vector is zero.
+    pitch = xm.atan2(px * w - pz * vx, pz * w + px * vx + 0.0)
+    reachable = (d >= lo - REACH_TOL) & (d <= hi + REACH_TOL) & (abs(y) <= abs(vz) + REACH_TOL)
     return ArmIK((pitch, roll, elbow), reachable)

@@ -3,6 +3,7 @@ expected; GaitParams.replace validates; gait_to_toml round-trips."""
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import re
@@ -14,6 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from robot.bus.limits import TickLimits
 from robot.config import (
     ARM_NAMES,
     ROBOTS_DIR,
@@ -23,11 +25,14 @@ from robot.config import (
     load_gait,
     load_robot,
     parse_gait,
+    parse_robot,
 )
-from robot.errors import BipedError, ConfigError
+from robot.errors import BipedError, BusError, ConfigError
 from robot.params import ALIASES, SPECS, GaitParams
+from robot.servo_map import ServoMap
 
 BASE_ROBOT = (ROBOTS_DIR / "biped18-dynamixel.toml").read_text()
+BASE = load_robot(ROBOTS_DIR / "biped18-dynamixel.toml")
 
 
 def load_error(loader: Callable[[Path], object], path: Path, text: str) -> str:
@@ -101,7 +106,8 @@ def test_bundled_robots_load() -> None:
      "joints.r_knee.max_rad: expected a number in [-pi, pi] rad, got 4.0"),
     (joint_field("l_knee", "servo_id", "4"),
      "joints.l_knee.servo_id: duplicate servo id 4 (also joints.r_knee)"),
-    (joint_field("l_knee", "servo_id", "300"), "joints.l_knee.servo_id: expected an integer in [0, 252], got 300"),
+    (joint_field("l_knee", "servo_id", "300"),
+     "joints.l_knee.servo_id: expected an integer in [0, 252], got 300"),
     (joint_field("l_hip_yaw", "sign", "2"), "joints.l_hip_yaw.sign: expected +1 or -1, got 2"),
     (joint_field("r_knee", "zero_ticks", "4096"),
      "joints.r_knee.zero_ticks: expected an integer in [0, 4095]"),
@@ -275,3 +281,92 @@ def test_replace_accepts_ints_and_bounds() -> None:
     p = GaitParams().replace({"vM": 1, "Slgt_R": SPECS["Slgt_R"].hi, "turn": SPECS["turn"].lo})
     assert p.vM == 1.0 and isinstance(p.vM, float)
     assert p.Slgt_R == SPECS["Slgt_R"].hi and p.turn == SPECS["turn"].lo
+
+
+# ----------------------------------------------------------------------------- ticks
+# ServoMap: ticks = zero_ticks + sign * q * 4096 / (2 pi); the bus accepts 0..4095.
+# By hand: 2047 ticks above 2048 is 2047 * 2 pi / 4096 = 3.14006 rad; 100 ticks below
+# is -0.15340 rad (-0.1533 rounded inward); 195 ticks above 3900 with sign -1 is -0.29913 rad.
+
+
+@pytest.mark.parametrize("edits, expect", [
+    ([("r_knee", "max_rad", "3.141592653589793")],
+     "joints.r_knee.max_rad: 3.14159 rad is tick 4096, outside the servo's 0..4095 "
+     "(zero_ticks 2048, sign +1); expected min_rad and max_rad within [-3.1415, 3.1400] rad"),
+    ([("r_hip_yaw", "zero_ticks", "100")],
+     "joints.r_hip_yaw.min_rad: -0.6 rad is tick -291, outside the servo's 0..4095 "
+     "(zero_ticks 100, sign +1); expected min_rad and max_rad within [-0.1533, 3.1415] rad"),
+    ([("l_hip_yaw", "zero_ticks", "3900")],
+     "joints.l_hip_yaw.min_rad: -0.6 rad is tick 4291, outside the servo's 0..4095 "
+     "(zero_ticks 3900, sign -1); expected min_rad and max_rad within [-0.2991, 3.1415] rad"),
+    ([("r_hip_yaw", "min_rad", "0.0001"), ("r_hip_yaw", "max_rad", "0.0002")],
+     "joints.r_hip_yaw.min_rad/max_rad: [0.0001, 0.0002] rad holds no whole servo tick; "
+     "expected limits at least one tick (0.00153 rad) apart"),
+])
+def test_limits_the_bus_would_refuse_are_refused_at_load(
+        tmp_path: Path, edits: list[tuple[str, str, str]], expect: str) -> None:
+    def edit(text: str) -> str:
+        for joint, field, value in edits:
+            text = joint_field(joint, field, value)(text)
+        return text
+    msg = robot_error(tmp_path, edit)
+    assert expect in msg, msg
+
+
+@pytest.mark.parametrize("joint, zero, lo, hi", [
+    ("r_knee", "2048", "-3.1415", "3.1400"),
+    ("r_hip_yaw", "100", "-0.1533", "3.1415"),
+    ("l_hip_yaw", "3900", "-0.2991", "3.1415"),
+])
+def test_the_range_a_message_names_loads(tmp_path: Path, joint: str, zero: str, lo: str,
+                                         hi: str) -> None:
+    text = BASE_ROBOT
+    for field, value in (("zero_ticks", zero), ("min_rad", lo), ("max_rad", hi)):
+        text = joint_field(joint, field, value)(text)
+    path = tmp_path / "fits.toml"
+    path.write_text(text.split("[rest]")[0])
+    j = load_robot(path).joint(joint)
+    assert (j.min_rad, j.max_rad) == (float(lo), float(hi))
+
+
+BASE_DATA = tomllib.loads(BASE_ROBOT)
+JOINT = "r_hip_yaw"  # no [rest] entry, so any limits are consistent with the rest pose
+ANGLES = [-math.inf, -1e300, -math.pi, -1.0, 0.0, 1.0, math.pi, 1e300, math.inf]
+
+
+@settings(max_examples=300, deadline=None)
+@given(zero=st.integers(0, 4095), sign=st.sampled_from([1, -1]),
+       ends=st.lists(st.floats(-math.pi, math.pi), min_size=2, max_size=2, unique=True),
+       extra=st.lists(st.floats(allow_nan=False), max_size=5))
+def test_a_config_loads_iff_the_bus_accepts_every_goal(zero: int, sign: int,
+                                                       ends: list[float],
+                                                       extra: list[float]) -> None:
+    lo, hi = sorted(ends)
+    data = copy.deepcopy(BASE_DATA)
+    data["joints"][JOINT].update(zero_ticks=zero, sign=sign, min_rad=lo, max_rad=hi)
+    i = [j.name for j in BASE.joints].index(JOINT)
+    probe = [*ANGLES, lo, hi, *extra]
+    try:
+        robot = parse_robot(data, source="prop.toml")
+    except ConfigError as e:
+        assert re.match(rf"prop.toml: joints.{JOINT}.(min_rad|max_rad)", str(e)), e
+        # The same joint, unchecked: some angle's goal is refused by the bus.
+        joints = list(BASE.joints)
+        joints[i] = dataclasses.replace(joints[i], zero_ticks=zero, sign=sign, min_rad=lo,
+                                        max_rad=hi)
+        raw = dataclasses.replace(BASE, joints=tuple(joints))
+        sm, limits, refused = ServoMap(raw), TickLimits(raw), 0
+        for q in probe:
+            sid, t = list(sm.goals([*[0.0] * i, q, *[0.0] * (len(joints) - i - 1)]).items())[i]
+            try:
+                limits.check(sid, t)
+            except BusError:
+                refused += 1
+        assert refused > 0
+        return
+    sm, limits = ServoMap(robot), TickLimits(robot)
+    for q in probe:
+        for sid, t in sm.goals([q] * len(robot.joints)).items():
+            assert limits.check(sid, t) == t
+        assert (0 <= sm.to_ticks([q] * len(robot.joints))).all()
+        assert (sm.to_ticks([q] * len(robot.joints)) <= 4095).all()

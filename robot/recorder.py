@@ -31,6 +31,7 @@ class Recorder:
         self._csv: Any = None
         self._last_tick = -1
         self._t0: float | None = None
+        self.error: str | None = None  # the first failed write, one line (e.g. disk full)
 
     def header(self) -> list[str]:
         cols = ["t", "state", "tick", "period_error_ms", "overruns", "amplitude"]
@@ -60,12 +61,19 @@ class Recorder:
         try:
             self.close()
         except OSError as e:
-            return f"{self.path}: {e.strerror or e}"
-        return None
+            self.error = self.error or f"{self.path}: {e.strerror or e}"
+        return self.error
 
     def __call__(self, tel: Telemetry) -> None:
         if self._file is None or tel.tick == self._last_tick:
             return
+        try:
+            self._write(tel)
+        except OSError as e:
+            self.error = self.error or f"{self.path}: {e.strerror or e}"
+            raise
+
+    def _write(self, tel: Telemetry) -> None:
         self._last_tick = tel.tick
         if self._t0 is None:
             self._t0 = tel.t

@@ -277,3 +277,17 @@ def test_no_trip_while_torque_is_off(bus: SdkBus, emu: Emulator, robot: RobotCon
     assert emu.registers(KNEE)["torque_enable"] == 1
     assert bus.arm_failsafe([KNEE], timeout_s=TIMEOUT_S) == pytest.approx(TIMEOUT_S)
     assert emu.registers(KNEE)["bus_watchdog"] == 5   # re-arming clears the trip first
+
+
+@pytest.mark.parametrize("protocol", ["dynamixel"])
+def test_register_range_and_reboot_as_the_manual_says(bus: SdkBus, emu: Emulator) -> None:
+    with pytest.raises(BusError, match=rf"id {KNEE} \(r_knee\): write bus_watchdog=128 "
+                                       rf"failed: .*{DXL_DATA_RANGE_ERROR}"):
+        bus.write_register(KNEE, "bus_watchdog", DXL.max_steps + 1)
+    bus.set_torque([KNEE], enabled=True)
+    bus.arm_failsafe([KNEE], timeout_s=0.02)
+    time.sleep(0.1)
+    assert emu.registers(KNEE)["bus_watchdog"] == DXL.tripped
+    bus.packet_handler.reboot(bus.port_handler, KNEE)   # RAM back to its initial value 0
+    regs = emu.registers(KNEE)
+    assert regs["bus_watchdog"] == 0 and regs["torque_enable"] == 0

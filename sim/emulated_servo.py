@@ -41,7 +41,8 @@ READ_ONLY: frozenset[str] = frozenset({
 })
 #: Dynamixel registers holding two's-complement signed values.
 DXL_SIGNED: frozenset[str] = frozenset({
-    "bus_watchdog", "homing_offset", "goal_position", "present_load", "present_velocity", "present_position",
+    "bus_watchdog", "homing_offset", "goal_position", "present_load", "present_velocity",
+    "present_position",
 })
 #: Allowed raw values of a few registers [inclusive range]; others accept any value.
 VALID_RANGE: dict[str, tuple[int, int]] = {

@@ -1,18 +1,22 @@
 """End to end in real headless Chromium (Debian's, driven by Playwright): the panel on the
-MuJoCo bus; drag a slider and see it reach the running loop; stop, start, emergency stop."""
+MuJoCo bus; drag a slider and see it reach the running loop; stop, start, emergency stop;
+token mode served on every address, opened at the LAN URL a phone would use.
+
+Waits use Playwright's ``expect`` (no string evaluation: the page's CSP forbids eval)."""
 
 from __future__ import annotations
 
+import re
 import time
 from collections.abc import Callable, Iterator
 
 import numpy as np
 import pytest
-from playwright.sync_api import Page, sync_playwright
+from playwright.sync_api import Browser, Page, expect, sync_playwright
 
 from robot.config import DEFAULT_ROBOT, load_gait, load_robot
 from robot.panel.controller import LoopOptions, PanelController, make_controller
-from robot.panel.server import build_server, serve_in_thread
+from robot.panel.server import build_server, panel_url, serve_in_thread
 from sim.mujoco_bus import MujocoBus
 
 CHROMIUM = "/usr/bin/chromium"
@@ -47,17 +51,24 @@ def running() -> Iterator[tuple[PanelController, str]]:
 
 
 @pytest.fixture(scope="module")
-def page(running: tuple[PanelController, str]) -> Iterator[Page]:
+def browser() -> Iterator[Browser]:
     with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        pg = browser.new_page(viewport={"width": 1400, "height": 950})
-        errors: list[str] = []
-        pg.on("pageerror", lambda e: errors.append(str(e)))
-        pg.goto(running[1])
-        pg.wait_for_selector("#range-Slgt_R")
-        yield pg
-        browser.close()
-        assert not errors, errors
+        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        yield b
+        b.close()
+
+
+@pytest.fixture(scope="module")
+def page(running: tuple[PanelController, str], browser: Browser) -> Iterator[Page]:
+    pg = browser.new_page(viewport={"width": 1400, "height": 950})
+    errors: list[str] = []
+    pg.on("pageerror", lambda e: errors.append(str(e)))
+    pg.on("console", lambda m: "Content Security Policy" in m.text and errors.append(m.text))
+    pg.goto(running[1])
+    pg.wait_for_selector("#range-Slgt_R")
+    yield pg
+    pg.close()
+    assert not errors, errors
 
 
 def hip_pitch_swing(controller: PanelController, seconds: float) -> float:
@@ -113,7 +124,7 @@ def test_number_box_refuses_out_of_range(running: tuple[PanelController, str],
     page.wait_for_selector("#message.error")
     assert "vM = 7 is outside [0, 2]" in page.inner_text("#message")
     assert controller.params == before
-    page.wait_for_function(f"document.getElementById('num-vM').value == '{before.vM:g}'")
+    expect(page.locator("#num-vM")).to_have_value(f"{before.vM:g}")
 
 
 def test_stop_start_estop_buttons(running: tuple[PanelController, str], page: Page) -> None:
@@ -122,14 +133,52 @@ def test_stop_start_estop_buttons(running: tuple[PanelController, str], page: Pa
     page.click("#stop")
     assert wait_for(lambda: seen.add(controller.state()["state"]) or not controller.running)
     assert seen & {"ramp_out", "rest"} and controller.state()["state"] == "stopped"
-    page.wait_for_function("document.getElementById('state').textContent.startsWith('stopped')")
+    expect(page.locator("#state")).to_have_text(re.compile("^stopped"))
     page.click("#start")
     assert wait_for(lambda: controller.state()["state"] == "walking")
-    page.wait_for_function("document.getElementById('state').textContent == 'walking'")
+    expect(page.locator("#state")).to_have_text("walking")
     bus = controller.bus
     assert isinstance(bus, MujocoBus) and (bus.model.actuator_gainprm[:, 0] > 0).all()
     page.click("#estop")
     assert controller.wait(1.0)
     assert controller.state()["state"] == "estop"
     assert (bus.model.actuator_gainprm[:, 0] == 0).all()
-    page.wait_for_function("document.getElementById('state').textContent.startsWith('estop')")
+    expect(page.locator("#state")).to_have_text(re.compile("^estop"))
+
+
+def test_token_mode_from_a_phone(browser: Browser) -> None:
+    """Served on 0.0.0.0 with a token: the printed LAN URL shows the sliders and drives
+    the loop; without the token the page loads but the API refuses it."""
+    robot = load_robot(DEFAULT_ROBOT)
+    controller = make_controller(robot, MujocoBus(robot, realtime=True),
+                                 load_gait("walk").params,
+                                 options=LoopOptions(rate_hz=100.0, read_every=5))
+    server = build_server(controller, host="0.0.0.0", port=0, token="phone-t0ken")
+    serve_in_thread(server)
+    url = panel_url("0.0.0.0", int(server.server_address[1]))
+    assert "0.0.0.0" not in url
+    pg = browser.new_page(viewport={"width": 412, "height": 915})  # a phone's
+    errors: list[str] = []
+    pg.on("pageerror", lambda e: errors.append(str(e)))
+    statuses: dict[str, int] = {}
+    pg.on("response", lambda r: statuses.setdefault(r.url.split("?")[0], r.status))
+    try:
+        pg.goto(url)  # no token: the page and its assets load, every API call is refused
+        expect(pg.locator("#message")).to_contain_text("token")
+        assert pg.locator("#range-Slgt_R").count() == 0
+        assert statuses[url] == statuses[url + "panel.js"] == statuses[url + "panel.css"] == 200
+        assert statuses[url + "api/params"] == 401
+        pg.goto(url + "?token=phone-t0ken")
+        pg.wait_for_selector("#range-Slgt_R")
+        expect(pg.locator("#state")).to_have_text(re.compile("^idle"))
+        pg.click("#start")
+        assert wait_for(lambda: controller.state()["state"] == "walking")
+        expect(pg.locator("#state")).to_have_text("walking")
+        pg.click("#estop")
+        assert controller.wait(1.0) and controller.state()["state"] == "estop"
+        assert not errors, errors
+    finally:
+        pg.close()
+        server.shutdown()
+        server.server_close()
+        controller.shutdown(timeout=2.0)

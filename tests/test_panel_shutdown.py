@@ -1,0 +1,123 @@
+"""`biped panel` ends safely whatever the signals: a subprocess on the pty emulator (both
+protocols), end state read back from the emulated servos' registers."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+import urllib.request
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+import robot.cli as cli
+from robot.config import ROBOTS_DIR, RobotConfig
+from robot.servo_map import ServoMap
+from sim.emulator import Emulator
+
+pytest_plugins = ("bus_harness",)
+
+REPO = Path(__file__).resolve().parent.parent
+Launch = Callable[..., "subprocess.Popen[str]"]
+ONLY_PANEL = ("import sys, robot.cli as c; c.COMMANDS = ('panel',); "
+              "sys.exit(c.main(sys.argv[1:]))")
+
+
+@pytest.fixture
+def panel_robot(tmp_path: Path, protocol: str) -> Path:
+    """The bundled robot with a reply timeout for a busy test machine."""
+    text = (ROBOTS_DIR / f"biped18-{protocol}.toml").read_text()
+    path = tmp_path / "robot.toml"
+    path.write_text(text.replace("timeout_ms = 20.0", "timeout_ms = 50.0"))
+    return path
+
+
+def state(url: str) -> str:
+    with urllib.request.urlopen(url + "api/state", timeout=5) as r:
+        return str(json.load(r)["state"])
+
+
+@pytest.fixture
+def launch(emu: Emulator, panel_robot: Path, tmp_path: Path) -> Iterator[Launch]:
+    """``launch(*extra_args)`` → a walking `biped panel` process on the emulator."""
+    procs: list[subprocess.Popen[str]] = []
+
+    def start(*extra: str) -> subprocess.Popen[str]:
+        cmd = [sys.executable, "-c", ONLY_PANEL, "panel", "--bus", emu.protocol, "--port",
+               emu.port, "--robot", str(panel_robot), "--http-port", "0", "--rate", "50",
+               "--presets-dir", str(tmp_path / "presets"), *extra]
+        proc = subprocess.Popen(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True, env={**os.environ, "MUJOCO_GL": "egl"})
+        procs.append(proc)
+        assert proc.stdout is not None
+        line = proc.stdout.readline()
+        assert " open http://" in line, line + proc.stderr.read() if proc.stderr else ""
+        url = line.split(" open ")[1].split()[0]
+        deadline = time.monotonic() + 10
+        while state(url) != "walking":
+            assert time.monotonic() < deadline, "the panel never reached 'walking'"
+            time.sleep(0.05)
+        return proc
+
+    yield start
+    for p in procs:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+
+
+def finish(proc: subprocess.Popen[str]) -> tuple[int, str, str]:
+    out, err = proc.communicate(timeout=20)
+    return proc.returncode, out, err
+
+
+def torque(emu: Emulator, robot: RobotConfig) -> set[int]:
+    return {emu.registers(i)["torque_enable"] for i in robot.ids}
+
+
+@pytest.mark.parametrize("second", [signal.SIGINT, signal.SIGTERM])
+def test_second_signal_stops_at_once_torque_off(emu: Emulator, robot: RobotConfig,
+                                                launch: Launch, second: int) -> None:
+    proc = launch("--hold")
+    proc.send_signal(signal.SIGINT)
+    time.sleep(0.3)  # well inside the default 3-cycle ramp-out (about 2.6 s)
+    proc.send_signal(second)
+    t0 = time.monotonic()
+    code, out, err = finish(proc)
+    assert code == 130, err
+    assert time.monotonic() - t0 < 2.0  # did not wait for the ramp-out
+    assert "stopping" in out and "torque off" in out.splitlines()[-1], out
+    assert "Traceback" not in err
+    assert torque(emu, robot) == {0}
+
+
+@pytest.mark.parametrize("hold", [True, False])
+def test_one_signal_ramps_to_rest_then_holds_or_releases(emu: Emulator, robot: RobotConfig,
+                                                         launch: Launch, hold: bool) -> None:
+    extra = ["--set", "ramp_cycles=0.5"] + (["--hold"] if hold else [])
+    proc = launch(*extra)
+    proc.send_signal(signal.SIGINT if hold else signal.SIGTERM)
+    code, out, err = finish(proc)
+    assert code == (130 if hold else 143), err
+    assert torque(emu, robot) == ({1} if hold else {0}), out + err
+    sm = ServoMap(robot)
+    rest = sm.goals(sm.clamp(sm.vector(robot.rest)).tolist())
+    assert {i: emu.registers(i)["goal_position"] for i in robot.ids} == rest  # reached rest
+    assert ("left ON" in out) == hold
+
+
+def test_http_port_out_of_range_is_one_line_exit_2(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr(cli, "COMMANDS", ("panel",))
+    for bad in ("99999", "-1", "http"):
+        with pytest.raises(SystemExit) as e:
+            cli.main(["panel", "--http-port", bad])
+        assert e.value.code == 2
+        err = capsys.readouterr().err.strip().splitlines()[-1]
+        assert err.endswith(f"argument --http-port: expected a port number in [0, 65535], "
+                            f"got {bad!r}"), err

@@ -1,0 +1,126 @@
+"""Start and end paths of the one streaming loop, read at the wire on the pty emulator:
+a joint outside its limits refuses the start (nothing written), a failing gait engine
+ramps straight to rest, pose shares the loop and its watchdog, statistics stay bounded."""
+
+from __future__ import annotations
+
+import math
+import random
+from pathlib import Path
+
+import numpy as np
+import pytest
+from bus_harness import open_bus
+
+import robot.cli as cli
+from robot.config import ROBOTS_DIR, RobotConfig, load_gait
+from robot.engine import GaitEngine
+from robot.latency import SampleStats
+from robot.servo_map import ServoMap
+from robot.streamer import Streamer
+from sim.emulator import Emulator
+
+pytest_plugins = ("bus_harness",)
+
+RESOLUTION = 4096
+WRITES = ("write", "sync_write", "reg_write", "bulk_write", "action")
+
+
+@pytest.fixture
+def robot_toml(tmp_path: Path, protocol: str) -> Path:
+    text = (ROBOTS_DIR / f"biped18-{protocol}.toml").read_text()
+    path = tmp_path / f"robot-{protocol}.toml"
+    path.write_text(text.replace("timeout_ms = 20.0", "timeout_ms = 50.0"))
+    return path
+
+
+def ticks_of(robot: RobotConfig, name: str, q: float) -> int:
+    j = robot.joint(name)
+    return round(j.zero_ticks + j.sign * q * RESOLUTION / (2 * math.pi))
+
+
+@pytest.mark.parametrize("command", [["walk", "--seconds", "1"], ["pose", "rest"]])
+def test_joint_outside_limits_refuses_before_torque_on(
+        emu: Emulator, robot: RobotConfig, robot_toml: Path, command: list[str],
+        capsys: pytest.CaptureFixture[str]) -> None:
+    knee = robot.joint("r_knee")
+    beyond = knee.max_rad + 0.3                               # 0.3 rad past its max
+    emu.set_register(knee.servo_id, "present_position", ticks_of(robot, "r_knee", beyond))
+    emu.log(clear=True)
+    code = cli.main([*command, "--bus", emu.protocol, "--port", emu.port,
+                     "--robot", str(robot_toml)])
+    err = capsys.readouterr().err.strip()
+    assert code == 1
+    assert len(err.splitlines()) == 1
+    assert "refusing to start: r_knee" in err and "0.300 rad" in err and "max_rad" in err
+    assert [p for p in emu.log() if p.instruction in WRITES] == []     # nothing written
+    assert {emu.registers(i)["torque_enable"] for i in robot.ids} == {0}
+
+
+def test_joint_just_outside_is_taken_in_without_a_jump(emu: Emulator, robot: RobotConfig,
+                                                       robot_toml: Path) -> None:
+    knee = robot.joint("r_knee")
+    step = knee.max_speed_rad_s / 50.0                        # one slew step at 50 Hz
+    start = ticks_of(robot, "r_knee", knee.max_rad + 0.5 * step)
+    emu.set_register(knee.servo_id, "present_position", start)
+    emu.log(clear=True)
+    assert cli.main(["pose", "zero", "--bus", emu.protocol, "--port", emu.port,
+                     "--robot", str(robot_toml), "--rate", "50", "--speed", "2"]) == 0
+    goals = [p.values[knee.servo_id] for p in emu.log()
+             if p.instruction == "sync_write" and knee.servo_id in p.values
+             and p.address in (116, 42)]
+    assert abs(goals[0] - start) <= step * RESOLUTION / (2 * math.pi) + 1
+    assert goals[-1] == knee.zero_ticks                       # then on to the zero pose
+
+
+class BrokenEngine(GaitEngine):
+    """A gait engine with a bug that shows after ``fail_at`` ticks."""
+
+    fail_at = 120
+
+    def tick(self, dt: float) -> list[float]:
+        self.fail_at -= 1
+        if self.fail_at <= 0:
+            raise ZeroDivisionError("a bug in the gait")
+        return super().tick(dt)
+
+
+@pytest.mark.parametrize("hold", [False, True])
+def test_gait_engine_exception_ramps_to_rest_then_torque_off(
+        emu: Emulator, robot: RobotConfig, hold: bool) -> None:
+    bus = open_bus(emu, robot)
+    engine = BrokenEngine(robot, load_gait("walk").params)
+    try:
+        stats = Streamer(ServoMap(robot), bus, engine, rate_hz=200.0,
+                         hold_at_end=hold).run(seconds=10)
+    finally:
+        bus.close(torque_off=False)
+    assert stats.fault and not stats.holding
+    assert stats.stop_reason == ("exception in the gait engine: ZeroDivisionError: "
+                                 "a bug in the gait")
+    rest = {j.servo_id: ticks_of(robot, j.name, min(max(robot.rest.get(j.name, 0.0),
+                                                         j.min_rad), j.max_rad))
+            for j in robot.joints}
+    assert {i: emu.registers(i)["goal_position"] for i in robot.ids} == rest
+    assert {emu.registers(i)["torque_enable"] for i in robot.ids} == {0}
+
+
+def test_sample_stats_exact_while_small_bounded_when_large() -> None:
+    rng = random.Random(3)
+    small = [rng.gauss(0.0, 1.0) for _ in range(5000)]
+    s = SampleStats(capacity=8192)
+    for x in small:
+        s.add(x)
+    for p in (1, 50, 99):
+        assert s.percentile(p) == pytest.approx(float(np.percentile(small, p)), abs=1e-12)
+    assert s.max == max(small)
+    big = SampleStats(capacity=4096, seed=1)
+    top = 0.0
+    for k in range(400_000):                                   # 33 min at 200 Hz
+        x = rng.random()
+        top = max(top, x)
+        big.add(x)
+    assert big.stored == 4096 and big.count == 400_000         # memory does not grow
+    assert big.max == top
+    assert big.percentile(50) == pytest.approx(0.5, abs=0.03)  # uniform: p50 = 0.5
+    assert big.percentile(99) == pytest.approx(0.99, abs=0.01)

@@ -116,7 +116,7 @@ def test_sample_stats_exact_while_small_bounded_when_large() -> None:
     assert s.max == max(small)
     big = SampleStats(capacity=4096, seed=1)
     top = 0.0
-    for k in range(400_000):                                   # 33 min at 200 Hz
+    for _ in range(400_000):                                   # 33 min at 200 Hz
         x = rng.random()
         top = max(top, x)
         big.add(x)

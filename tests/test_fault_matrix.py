@@ -29,7 +29,7 @@ import numpy as np
 import pytest
 
 import robot.cli as cli
-from robot.config import ROBOTS_DIR, RobotConfig, load_robot
+from robot.config import ROBOTS_DIR, RobotConfig
 from sim.emulator import Emulator, Packet
 
 pytest_plugins = ("bus_harness",)

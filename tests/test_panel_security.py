@@ -149,7 +149,8 @@ def test_missing_or_malformed_host_refused(served: tuple[PanelController, int]) 
     _, port = served
     assert request(port, "GET /api/state HTTP/1.0\n").status == 400
     assert get(port, "/api/state", host="a b").status == 400
-    assert get(port, "/api/state", host=f"LOCALHOST:{port}").status == 200
+    for ok in (f"LOCALHOST:{port}", f"[::1]:{port}", f"localhost.:{port}", "127.0.0.1"):
+        assert get(port, "/api/state", host=ok).status == 200, ok
 
 
 def test_cross_origin_save_cannot_touch_bundled_preset(served: tuple[PanelController, int]

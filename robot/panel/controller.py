@@ -75,6 +75,7 @@ class PanelController:
         self.runs = 0
         self.last_stats: LoopStats | None = None  # of the last run that returned
         self._holding = False  # torque left on by the last run (hold, no fault or estop)
+        self._estop_requested = False  # during the current run
         self._closing = False
 
     # -- parameters --------------------------------------------------------------------
@@ -133,7 +134,7 @@ class PanelController:
                                       observer=observe)
             self._tel = {"state": "starting"}
             self.runs += 1
-            self._holding = False
+            self._holding = self._estop_requested = False
             self._thread = threading.Thread(target=self._run, args=(self._streamer,),
                                             name=f"gait-run-{self.runs}", daemon=False)
             self._thread.start()
@@ -144,7 +145,9 @@ class PanelController:
             log.info("run ended: %s", stats.stop_reason)
             with self._lock:
                 self.last_stats = stats
-                self._holding = bool(getattr(stats, "holding", False))
+                self._holding = stats.holding and not self._estop_requested
+            if stats.holding and not self._holding:  # an E-stop as the run ended holding
+                self.bus.set_torque(list(self._map.ids), enabled=False)
         except BipedError as e:
             log.error("run failed: %s", e)
         except Exception:
@@ -163,6 +166,7 @@ class PanelController:
         """Torque off at once: ends a run within one tick; with no run, torque off now."""
         with self._lock:
             if self.running and self._streamer is not None:
+                self._estop_requested = True
                 self._streamer.emergency_stop()
                 return
             self._holding = False

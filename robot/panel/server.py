@@ -137,6 +137,8 @@ def build_server(controller: PanelController, *, host: str = "127.0.0.1", port: 
                 self.close_connection = True
                 self._json(HTTPStatus.REQUEST_TIMEOUT,
                            {"error": f"request body not received within {read_timeout_s:g} s"})
+            except ConnectionError:
+                raise  # the client went away: nothing to answer (handle_error logs it)
             except Exception as e:  # a bug: answer, and keep serving
                 log.error("panel: %s %s failed: %s: %s", method, self.path, type(e).__name__, e,
                           exc_info=log.isEnabledFor(logging.DEBUG))

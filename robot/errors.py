@@ -28,3 +28,8 @@ class SafetyStop(BipedError):
 
 class StartRefused(SafetyStop):
     """A run refused to start before torque-on (nothing moved, torque untouched)."""
+
+
+class BusDead(SafetyStop):
+    """The watchdog gave up on the bus (a streak of failed transactions): nothing can be
+    ramped, and every further transaction would only cost its timeout."""

@@ -74,6 +74,7 @@ class Recorder:
             raise
 
     def _write(self, tel: Telemetry) -> None:
+        assert self._file is not None
         self._last_tick = tel.tick
         if self._t0 is None:
             self._t0 = tel.t

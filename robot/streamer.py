@@ -33,38 +33,18 @@ import numpy as np
 from robot.bus.base import Bus
 from robot.clock import Clock, MonotonicClock
 from robot.engine import GaitEngine
-from robot.errors import BusError, SafetyStop, StartRefused
+from robot.errors import BusDead, BusError, SafetyStop
 from robot.latency import SampleStats
 from robot.params import GaitParams
 from robot.ramp import ramp
 from robot.servo_map import ServoMap
+from robot.start_check import check_inside_limits
 from robot.telemetry import LoopStats, Telemetry, TickObserver
 from robot.watchdog import Watchdog, WatchdogConfig
 
-__all__ = ["LoopStats", "Streamer", "Telemetry", "TickObserver"]
+__all__ = ["LoopStats", "Streamer", "Telemetry", "TickObserver", "check_inside_limits"]
 
 log = logging.getLogger(__name__)
-
-
-def check_inside_limits(smap: ServoMap, present: np.ndarray, *, tolerance: Any,
-                        source: str) -> np.ndarray:
-    """``present`` [rad] clamped to the joint limits; StartRefused (naming the joint, how far
-    out it is and the fix) if a joint is further outside than ``tolerance`` [rad] (scalar or
-    per joint): its first goal would jump it."""
-    inside = smap.clamp(present)
-    beyond = np.abs(present - inside) - tolerance
-    if (beyond > 0).any():
-        i = int(np.argmax(beyond))
-        name, q, lim = smap.names[i], float(present[i]), float(inside[i])
-        side = "max_rad" if q > lim else "min_rad"
-        others = int((beyond > 0).sum()) - 1
-        more = f" (and {others} more joint{'s' * (others > 1)})" if others else ""
-        raise StartRefused(
-            f"refusing to start: {name} (servo id {smap.ids[i]}) is at {q:.3f} rad, "
-            f"{abs(q - lim):.3f} rad ({np.degrees(abs(q - lim)):.1f} deg) beyond its "
-            f"{side} {lim:.3f}{more}; move it inside its limits by hand with torque off "
-            f"(`biped torque off`), or check its zero_ticks, sign and limits in {source}")
-    return inside
 
 
 class Streamer:
@@ -92,6 +72,7 @@ class Streamer:
         self._stop = threading.Event()
         self._estop = threading.Event()
         self._fault: str | None = None
+        self._bus_dead = False
         self._q_last: np.ndarray = np.zeros(len(robot_map.ids))
         self._lateness = SampleStats()
         self._overruns = 0
@@ -154,6 +135,7 @@ class Streamer:
             self._arm_failsafe()
             motion()
         except SafetyStop as e:                  # the watchdog: unsafe or impossible to drive
+            self._bus_dead = isinstance(e, BusDead)
             self._set_fault(f"watchdog: {e}")
         except Exception as e:
             log.exception("the control loop failed")
@@ -204,26 +186,32 @@ class Streamer:
 
     def _arm_failsafe(self) -> None:
         timeout = self.watchdog_config.failsafe_s
-        arm = getattr(self.bus, "arm_failsafe", None)
-        if timeout and arm is not None:
-            armed = arm(self.map.ids, timeout_s=timeout)
+        if timeout:
+            armed = self.bus.arm_failsafe(self.map.ids, timeout_s=timeout)
             if armed is not None:
                 log.info("servo bus watchdog armed: %.2f s", armed)
 
     def _finish(self, *, torque_off: bool) -> None:
+        """Torque off (one packet first, then confirmed servo by servo) or hold; disarm the
+        servos' watchdog. On a dead bus only the one packet is tried."""
         self.telemetry.state = "estop" if self._estop.is_set() else "stopped"
-        disarm = getattr(self.bus, "disarm_failsafe", None)
-        try:
-            if disarm is not None and self.watchdog_config.failsafe_s:
-                disarm(self.map.ids)
-        except BusError as e:
-            log.error("could not disarm the servo bus watchdog: %s", e)
+        ids = list(self.map.ids)
+        steps: list[tuple[str, Callable[[], None]]] = []
         if torque_off:
+            steps.append(("disable torque", lambda: self.bus.release(ids)))
+        if not self._bus_dead:
+            if self.watchdog_config.failsafe_s:
+                steps.append(("disarm the servos' bus watchdog",
+                              lambda: self.bus.disarm_failsafe(ids)))
+            if torque_off:
+                steps.append(("confirm torque off",
+                              lambda: self.bus.set_torque(ids, enabled=False)))
+        for what, step in steps:
             try:
-                self.bus.set_torque(list(self.map.ids), enabled=False)
+                step()
             except BusError as e:
-                log.error("could not disable torque: %s", e)
-        else:
+                log.error("could not %s: %s", what, e)
+        if not torque_off:
             log.info("holding the last pose with torque on (hold_at_end)")
         self._notify()
 

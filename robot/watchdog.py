@@ -9,7 +9,7 @@ import numpy as np
 
 from robot.bus.base import ServoState
 from robot.config import RobotConfig
-from robot.errors import BusError, SafetyStop
+from robot.errors import BusDead, BusError, SafetyStop
 from robot.servo_map import ServoMap
 
 FAULTS = frozenset({"overheating", "overload", "voltage", "electrical_shock", "encoder",
@@ -33,7 +33,7 @@ class WatchdogConfig:
     max_temperature_c: float = 70.0
     follow_error_rad: float = 0.6
     follow_reads: int = 5
-    failsafe_s: float | None = 0.5
+    failsafe_s: float | None = 0.1
 
 
 class Watchdog:
@@ -60,7 +60,7 @@ class Watchdog:
         self._bus_streak[kind] += 1
         n = self._bus_streak[kind]
         if n >= self.cfg.bus_error_streak:
-            raise SafetyStop(f"{n} bus errors in a row ({kind}); last: {error}") from error
+            raise BusDead(f"{n} bus errors in a row ({kind}); last: {error}") from error
 
     def on_time(self) -> None:
         self._overrun_streak = 0

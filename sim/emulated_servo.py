@@ -109,6 +109,7 @@ class EmulatedServo:
         for i, (_, reg) in enumerate(self._regs):
             self._owner[reg.address:reg.address + reg.size] = bytes([i + 1]) * reg.size
         self.conditions: set[str] = set()   # injected hardware faults (names of ERROR_BITS)
+        self.stuck = False                  # injected jam: the horn does not move
         self.speed_tps = self.model.no_load_speed * self.model.resolution / (2 * math.pi)
         codes = {b: c for c, b in BAUD_CODES[self.family].items()}
         if spec.baud not in codes:
@@ -204,7 +205,7 @@ class EmulatedServo:
         dt = max(0.0, now - self._t)
         self._t = now
         goal = self.get("goal_position")
-        if self.get("torque_enable"):
+        if self.get("torque_enable") and not self.stuck:
             step = self.speed_tps * dt
             self._pos = min(goal, self._pos + step) if goal > self._pos else max(
                 goal, self._pos - step)

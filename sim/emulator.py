@@ -220,6 +220,7 @@ class Emulator:
                    missing_ids: Iterable[int] | None = None,
                    vanish: Mapping[int, float] | None = None,
                    hw_error: Mapping[int, str | None] | None = None,
+                   stuck_ids: Iterable[int] | None = None,
                    close_port: bool = False) -> None:
         """Change faults while serving; unspecified ones keep their setting.
 
@@ -227,6 +228,8 @@ class Emulator:
         missing_ids: ids that never answer (replaces the set); vanish: id → seconds from now
         after which it stops answering; hw_error: id → "overheating" | "overload" |
         "voltage" | ... (names in tables.ERROR_BITS) or None to end the condition;
+        stuck_ids: ids whose horn is jammed from now on (they answer, take goals and
+        report no error, but do not move; replaces the set);
         close_port: close the pty (the SDK then gets an error; the log stays readable).
         """
         for name, rate in (("drop_rate", drop_rate), ("corrupt_rate", corrupt_rate)):
@@ -243,6 +246,7 @@ class Emulator:
             "missing_ids": None if missing_ids is None else list(missing_ids),
             "vanish_at": {sid: now + t for sid, t in (vanish or {}).items()},
             "hw_error": dict(hw_error or {}), "close_port": close_port,
+            "stuck_ids": None if stuck_ids is None else list(stuck_ids),
         })
 
     def clear_faults(self) -> None:

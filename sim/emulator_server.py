@@ -169,6 +169,7 @@ class _ChainServer:
             self.vanish.clear()
             for s in self.servos:
                 s.conditions.clear()
+                s.stuck = False
             return None
         if cmd == "log":
             out = list(self.log)
@@ -196,6 +197,11 @@ class _ChainServer:
         if f.get("missing_ids") is not None:
             self.missing = set(f["missing_ids"])
         self.vanish.update(f.get("vanish_at") or {})
+        if f.get("stuck_ids") is not None:
+            now = time.monotonic()
+            for s in self.servos:
+                s.update(now)
+                s.stuck = s.servo_id in f["stuck_ids"]
         for sid, kind in (f.get("hw_error") or {}).items():
             s = self.by_id(sid)
             s.conditions = {kind} if kind else set()

@@ -109,14 +109,15 @@ def walk_args(emu: Emulator, robot_toml: Path, *, hold: bool, seconds: float = 2
 
 
 @contextmanager
-def inject_when_streaming(emu: Emulator, action: Callable[[], None] | None) -> Iterator[dict]:
-    """Run ``action`` once INJECT_AFTER_GOALS goal packets have reached the servos."""
+def inject_when_streaming(emu: Emulator, action: Callable[[], None] | None, *,
+                          after: int = INJECT_AFTER_GOALS) -> Iterator[dict]:
+    """Run ``action`` once ``after`` goal packets have reached the servos."""
     info: dict[str, Any] = {"at": None}
     stop = threading.Event()
 
     def worker() -> None:
         while not stop.is_set():
-            if emu.counters().get("sync_write", 0) >= INJECT_AFTER_GOALS:
+            if emu.counters().get("sync_write", 0) >= after:
                 assert action is not None
                 action()
                 info["at"] = time.monotonic()
@@ -148,12 +149,14 @@ class Fault:
     """name; inject(emu, robot) or None; the end it must reach: "ok" (exit 0, rest, torque
     as --hold says), "ramp" (exit 1, ramped to rest, torque off), "off" (exit 1, torque off
     at once: goals stop soon after the fault), "either" (ok or off: a noisy bus that may or
-    may not reach the error streak); cause: text the one-line stop reason must contain."""
+    may not reach the error streak); cause: text the one-line stop reason must contain;
+    after: goal packets before the fault is injected."""
 
     name: str
     inject: Callable[[Emulator, RobotConfig], None] | None
     end: str
     cause: str = ""
+    after: int = INJECT_AFTER_GOALS
 
 
 VICTIM = "l_knee"
@@ -171,6 +174,9 @@ FAULTS = [
     Fault("corrupt30", lambda e, r: e.set_faults(corrupt_rate=0.3), "either"),
     Fault("corrupt100", lambda e, r: e.set_faults(corrupt_rate=1.0), "off", "bus errors"),
     Fault("vanish", lambda e, r: e.set_faults(vanish={_vid(r): 0.0}), "off", "bus errors"),
+    # Jammed from the first goal: the ramp-in bends the knee ~1 rad; it stays straight.
+    Fault("stuck", lambda e, r: e.set_faults(stuck_ids=[_vid(r)]), "off",
+          f"servo {{}} ({VICTIM}) stopped following", after=1),
 ]
 
 
@@ -184,10 +190,11 @@ def test_bus_faults(emu: Emulator, robot: RobotConfig, robot_toml: Path, fault: 
                     hold: bool, capsys: pytest.CaptureFixture[str]) -> None:
     action = (lambda: fault.inject(emu, robot)) if fault.inject else None
     t0 = time.monotonic()
-    with inject_when_streaming(emu, action) as info:
+    with inject_when_streaming(emu, action, after=fault.after) as info:
         code, result, err = run_walk(walk_args(emu, robot_toml, hold=hold), capsys)
     emu.clear_faults()
     reason = result["stop_reason"]
+    cause = fault.cause.format(_vid(robot))
     assert "\n" not in reason
     goals = goal_writes(emu)
     assert_stream_safe(robot, goals)
@@ -205,7 +212,7 @@ def test_bus_faults(emu: Emulator, robot: RobotConfig, robot_toml: Path, fault: 
     else:
         assert code == 1, err
         assert result["fault"] and not result["holding"]
-        assert fault.cause in reason and reason.startswith("watchdog")
+        assert cause in reason and reason.startswith("watchdog")
         assert torque(emu, reachable) == {0}                 # hold or not
         assert info["at"] is not None
         stopped = max(p.t for p in goals) - info["at"]
@@ -243,6 +250,31 @@ def test_full_disk_under_record_ramps_out(emu: Emulator, robot: RobotConfig, rob
     assert_stream_safe(robot, goal_writes(emu))
     assert last_goals(emu, robot) == rest_ticks(robot)        # ramped out to rest
     assert torque(emu, robot.ids) == {0}                       # a fault: off, hold or not
+
+
+@pytest.mark.parametrize("hold", [False, True], ids=["nohold", "hold"])
+def test_port_closed_mid_walk(emu: Emulator, robot: RobotConfig, robot_toml: Path, hold: bool,
+                              capsys: pytest.CaptureFixture[str]) -> None:
+    """The adapter vanishes: nothing can reach the servos. They keep torque; Dynamixel X's
+    Bus Watchdog (armed while streaming) stops them where they are."""
+    with inject_when_streaming(emu, lambda: emu.set_faults(close_port=True)) as info:
+        code, result, err = run_walk(walk_args(emu, robot_toml, hold=hold), capsys)
+    assert code == 1, err
+    reason = result["stop_reason"]
+    assert reason.startswith("watchdog: 5 bus errors in a row") and "port error" in reason
+    assert "\n" not in reason and not result["holding"]
+    goals = goal_writes(emu)
+    assert_stream_safe(robot, goals)
+    assert max(p.t for p in goals) <= info["at"] + 0.05       # nothing heard after it
+    time.sleep(0.3)                                           # past the 0.1 s failsafe
+    regs = [emu.registers(i) for i in robot.ids]
+    assert {r["torque_enable"] for r in regs} == {1}          # unreachable: still torqued
+    if emu.protocol == "dynamixel":
+        assert {r["bus_watchdog"] for r in regs} == {-1}      # tripped: stopped, holding
+        assert all(r["goal_position"] == r["present_position"] for r in regs)
+        time.sleep(0.1)
+        assert [emu.registers(i)["present_position"] for i in robot.ids] == [
+            r["present_position"] for r in regs]
 
 
 # ------------------------------------------------------------------------------ signals

@@ -97,6 +97,12 @@ class Bus(ABC):
         when there is none. This default is for buses without one: it does nothing."""
         return None
 
+    def release(self, ids: Iterable[int]) -> None:
+        """Torque off on ``ids`` at once, in one packet that needs no reply where the bus
+        allows (an emergency, or a bus that stopped answering); confirm with
+        ``set_torque(ids, enabled=False)`` while the bus answers. Default: ``set_torque``."""
+        self.set_torque(ids, enabled=False)
+
     def read_positions(self, ids: Iterable[int]) -> dict[int, int]:
         """Present positions [ticks] of ``ids``."""
         return {i: s.position for i, s in self.read_state(ids).items()}

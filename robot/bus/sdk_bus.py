@@ -300,6 +300,22 @@ class SdkBus(Bus):
         if wd is not None:
             failsafe.disarm(self, wd, ids)
 
+    def release(self, ids: Iterable[int]) -> None:
+        """Torque off on ``ids`` in one sync write (no status reply to wait for)."""
+        ids = sorted(set(ids))
+        if not ids:
+            return
+        reg = self.table["torque_enable"]
+
+        def send() -> tuple[None, int, int]:
+            group = self.sdk.GroupSyncWrite(self._port, self._ph, reg.address, reg.size)
+            for sid in ids:
+                group.addParam(sid, [0])
+            return None, group.txPacket(), 0
+
+        self._transact("sync write torque_enable=0", None, send)
+        self._torqued.difference_update(ids)
+
     def write_goals(self, goals: Mapping[int, int]) -> None:
         if not goals:
             return

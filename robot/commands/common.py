@@ -44,7 +44,7 @@ def one_line_errors(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
 
 def checked(option: str, parse: Callable[[str], T], text: str) -> T:
     """Apply the argparse type ``parse`` to ``text`` at run time: ConfigError
-    ``<option> <text>: expected ...`` instead of argparse's exit (main() returns 2)."""
+    ``<option>: <why>; expected ...`` instead of argparse's exit, so main() returns 2."""
     try:
         return parse(text)
     except argparse.ArgumentTypeError as e:

@@ -12,6 +12,7 @@ import logging
 import os
 import sys
 
+from robot.commands.common import one_line_errors
 from robot.errors import BipedError, SafetyStop
 
 # Order is the order of `biped --help`.
@@ -38,7 +39,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name in COMMANDS:
         module = importlib.import_module(f"robot.commands.{name}")
-        p = module.add_parser(sub)
+        p = one_line_errors(module.add_parser(sub))
         p.set_defaults(_run=module.run)
     return parser
 
@@ -46,7 +47,10 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     os.environ.setdefault("MUJOCO_GL", "egl")
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as e:   # --help (0) or a refused option (2, one line on stderr)
+        return e.code if isinstance(e.code, int) else 2
     logging.basicConfig(level=getattr(logging, args.log_level), stream=sys.stderr,
                         format="%(levelname)s %(name)s: %(message)s")
     try:

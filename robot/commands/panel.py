@@ -15,8 +15,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from robot.bus.factory import make_bus
-from robot.commands.common import add_set_arg, params_from, robot_from
+from robot.commands.common import add_set_arg, bus_from, params_from, robot_from
 from robot.commands.signals import SignalLatch, stop_on_signals
 from robot.commands.walk import add_walk_args
 from robot.errors import ConfigError
@@ -82,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
         token = secrets.token_urlsafe(18)
     presets = PresetStore(Path(args.presets_dir)) if args.presets_dir else PresetStore()
     options: dict[str, Any] = {"realtime": True, "view": args.view} if kind == "sim" else {}
-    bus = make_bus(kind, robot=robot, port=args.port, baud=args.baud, **options)
+    bus = bus_from(args, robot, kind=kind, **options)
     controller = make_controller(
         robot, bus, params,
         options=LoopOptions(rate_hz=args.rate, read_every=args.read_every, hold=args.hold),

@@ -15,8 +15,14 @@ import logging
 import numpy as np
 import numpy.typing as npt
 
-from robot.bus.factory import make_bus
-from robot.commands.common import add_bus_args, add_robot_args, positive_float, robot_from
+from robot.commands.common import (
+    add_bus_args,
+    add_robot_args,
+    bus_from,
+    joint_speed,
+    rate_hz,
+    robot_from,
+)
 from robot.commands.signals import SignalLatch, stop_on_signals
 from robot.config import RobotConfig
 from robot.engine import GaitEngine
@@ -35,8 +41,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p.add_argument("pose", choices=POSES, help="rest: the robot config's [rest]; zero: all 0")
     add_robot_args(p, gait=False)
     add_bus_args(p)
-    p.add_argument("--rate", type=positive_float, default=50.0, help="goal rate [Hz]")
-    p.add_argument("--speed", type=positive_float, default=1.0,
+    p.add_argument("--rate", type=rate_hz, default=50.0, help="goal rate [Hz]")
+    p.add_argument("--speed", type=joint_speed, default=1.0,
                    help="peak joint speed [rad/s], capped by each joint's max_speed_rad_s")
     return p
 
@@ -50,7 +56,7 @@ def pose_target(robot: RobotConfig, name: str, servo_map: ServoMap) -> npt.NDArr
 def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
     sm = ServoMap(robot)
-    bus = make_bus(args.bus, robot=robot, port=args.port, baud=args.baud)
+    bus = bus_from(args, robot)
     streamer = Streamer(sm, bus, GaitEngine(robot, GaitParams()), rate_hz=args.rate,
                         hold_at_end=True)
     latch = SignalLatch()

@@ -10,15 +10,17 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from robot.bus.factory import make_bus
 from robot.commands.common import (
     add_bus_args,
     add_robot_args,
     add_set_arg,
+    bus_from,
+    output_file,
     params_from,
-    positive_float,
     positive_int,
+    rate_hz,
     robot_from,
+    seconds,
 )
 from robot.commands.signals import SignalLatch, stop_on_signals
 from robot.engine import GaitEngine
@@ -34,7 +36,7 @@ def add_walk_args(p: argparse.ArgumentParser) -> None:
     """Options shared by `walk` and `panel`."""
     add_robot_args(p)
     add_bus_args(p, default="sim")
-    p.add_argument("--rate", type=positive_float, default=200.0, help="control rate [Hz]")
+    p.add_argument("--rate", type=rate_hz, default=200.0, help="control rate [Hz]")
     p.add_argument("--read-every", type=positive_int, default=10, metavar="N",
                    help="read servos back every N ticks (default: %(default)s)")
     p.add_argument("--hold", action="store_true",
@@ -46,8 +48,9 @@ def add_walk_args(p: argparse.ArgumentParser) -> None:
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
     p = sub.add_parser("walk", help="walk the robot (MuJoCo by default, or a real bus)")
     add_walk_args(p)
-    p.add_argument("--seconds", type=positive_float, default=10.0, help="gait duration [s]")
-    p.add_argument("--record", metavar="PATH", help="per-tick record (.csv or .jsonl)")
+    p.add_argument("--seconds", type=seconds, default=10.0, help="gait duration [s]")
+    p.add_argument("--record", type=output_file, metavar="PATH",
+                   help="per-tick record (.csv or .jsonl)")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     add_set_arg(p)
     return p
@@ -61,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("--view and --realtime apply to --bus sim only")
     options: dict[str, Any] = (
         {"realtime": args.realtime, "view": args.view} if kind == "sim" else {})
-    bus = make_bus(kind, robot=robot, port=args.port, baud=args.baud, **options)
+    bus = bus_from(args, robot, kind=kind, **options)
     recorder = Recorder(args.record, robot.joint_names, robot.ids) if args.record else None
     engine = GaitEngine(robot, params)
     smap = ServoMap(robot)

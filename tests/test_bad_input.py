@@ -484,3 +484,27 @@ def test_scan_ids_out_of_range(chain: Emulator, ids: str, shown: str,
     assert_refused(code, err, "argument --ids: expected ids or ranges in [0, 252] like 1-20 "
                               f"or 1,3,5-7, got {shown}")
     assert received(chain) == before
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["walk", "--record", "/nonexistent-dir/run.csv"],
+     "argument --record: directory /nonexistent-dir does not exist; expected a writable"),
+    (["walk", "--record", "."], "argument --record: "),
+    (["walk", "--rate", "1e9"], "argument --rate: "),
+    (["walk", "--rate", "0"], "argument --rate: "),
+    (["walk", "--seconds", "1e300"], "argument --seconds: "),
+    (["walk", "--baud", "12345"], "argument --baud: expected a standard servo baud rate"),
+    (["pose", "rest", "--speed", "1e-9"], "argument --speed: "),
+    (["pose", "rest", "--rate", "-5"], "argument --rate: "),
+])
+def test_walk_and_pose_options_refused_before_the_port_is_used(
+        chain: Emulator, argv: list[str], needle: str, tmp_path: Path,
+        capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    robot = tmp_path / "r.toml"
+    robot.write_text(base_robot(chain.protocol))
+    before = received(chain)
+    code, out, err = run_cli([*argv, "--bus", chain.protocol, "--port", chain.port,
+                              "--robot", str(robot)], capsys, monkeypatch)
+    assert_refused(code, err, needle)
+    assert out == ""
+    assert received(chain) == before, "bytes reached the servos"

@@ -52,15 +52,17 @@ def shoulder_centre(g: Geometry, side: str) -> Vec:
     return (0.0, SIDE_SIGN[side] * g.shoulder_width / 2, g.torso_height)
 
 
-def bend(a: float, b: float, c: Num) -> Num:
-    """Bend [rad] of the joint between links ``a`` and ``b`` [m] whose far ends are ``c`` [m]
-    apart: 0 straight, pi folded, clamped to those outside |a - b| <= c <= a + b.
+def bend(a: float, b: float, s: Num, t: Num = 0.0) -> Num:
+    """Bend [rad] of the joint between links ``a`` and ``b`` [m] whose far ends are
+    sqrt(s^2 + t^2) [m] apart: 0 straight, pi folded, and clamped to those beyond.
 
-    The half-angle form of the law of cosines (no acos of a rounded cosine): full precision
-    at both ends, where acos loses half the digits (~1e-9 m at a fully folded knee).
+    Half-angle law of cosines with c^2 - L^2 = (|s| - L)(|s| + L) + t^2 for L = a + b and
+    |a - b|: no acos of a rounded cosine (which loses half the digits when nearly straight
+    or folded), and exact to the last bit when the pair points along s (t ~ 0).
     """
-    return 2.0 * xm.atan2(xm.sqrt(xm.maximum((a + b - c) * (a + b + c), 0.0)),
-                          xm.sqrt(xm.maximum((c - a + b) * (c + a - b), 0.0)))
+    far, near, s, t2 = a + b, abs(a - b), abs(s), t * t
+    return 2.0 * xm.atan2(xm.sqrt(xm.maximum((far - s) * (far + s) - t2, 0.0)),
+                          xm.sqrt(xm.maximum((s - near) * (s + near) + t2, 0.0)))
 
 
 def leg_fk_full(g: Geometry, side: str, q: tuple[Num, ...]) -> tuple[Vec, Rot]:
@@ -156,18 +158,25 @@ def arm_ik(g: Geometry, hand: Vec) -> ArmIK:
     """
     u, f = g.upper_arm, g.forearm
     px, py, pz = hand
-    d = xm.sqrt(px * px + py * py + pz * pz)
+    rho2 = px * px + pz * pz  # squared distance from the pitch axis
+    d = xm.sqrt(rho2 + py * py)
     lo, hi = abs(u - f), u + f
     dc = xm.clip(d, lo, hi)
-    y = py * (dc / xm.maximum(d, 1e-300))  # radial clamp onto the annulus
-    elbow = -bend(u, f, dc)
+    k = dc / xm.maximum(d, 1e-300)  # radially onto the annulus
+    y = xm.clip(py * k, -dc, dc)
+    elbow = -bend(u, f, py, xm.sqrt(rho2))  # clamps by itself
     vx = -f * xm.sin(elbow)  # >= 0
     vz = -u - f * xm.cos(elbow)
-    # sin(roll) = -y vz / max(y^2, vz^2): -y/vz within reach, -vz/y beyond it.
-    yy, zz = y * y, vz * vz
-    roll = xm.asin(-y * vz / xm.maximum(xm.maximum(yy - zz, 0.0) + zz, 1e-300))
+    # sin(roll) = -y/vz within reach, -vz/y beyond it: atan2(-+min(|y|, |vz|),
+    # sqrt(|vz^2 - y^2|)), no asin of a rounded sine, 0 where both are 0. vz^2 - y^2 =
+    # rho^2 - vx^2 (= d^2 - vx^2 - y^2); each form is exact to ~eps * its larger operand,
+    # so they are weighed towards the smaller (rho on the pitch axis, vz near d0).
+    ay, az, rr, zz = abs(y), abs(vz), rho2 * k * k, vz * vz
+    lat2 = (zz * (rr - vx * vx) + rr * (az - ay) * (az + ay)) / xm.maximum(rr + zz, 1e-300)
+    roll = xm.atan2(-xm.sign(y) * xm.sign(vz) * 0.5 * (ay + az - abs(ay - az)),
+                    xm.sqrt(abs(lat2)))
     w = xm.cos(roll) * vz
     # pitch = atan2(px, pz) - atan2(vx, w), as one atan2: 0 when either vector is zero.
     pitch = xm.atan2(px * w - pz * vx, pz * w + px * vx + 0.0)
-    reachable = (d >= lo - REACH_TOL) & (d <= hi + REACH_TOL) & (abs(y) <= abs(vz) + REACH_TOL)
+    reachable = (d >= lo - REACH_TOL) & (d <= hi + REACH_TOL) & (ay <= az + REACH_TOL)
     return ArmIK((pitch, roll, elbow), reachable)

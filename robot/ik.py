@@ -10,8 +10,9 @@ Arm chain: shoulder pitch (y), roll (x) at (0, -/+ shoulder_width/2, torso_heigh
 (y) ``upper_arm`` below; the hand point ``forearm`` below the elbow.
 
 Every function works on floats (one tick) and on numpy arrays (vectorised). An
-unreachable target is clamped to the nearest reachable pose: never NaN, never an
-exception; ``reachable`` tells which inputs were clamped.
+unreachable target is clamped to a reachable pose (the nearest one, except in the arm's
+lateral caps: see arm_ik): never NaN, never an exception, no division by ~0;
+``reachable`` tells which inputs were clamped.
 """
 
 from __future__ import annotations
@@ -154,7 +155,10 @@ def arm_ik(g: Geometry, hand: Vec) -> ArmIK:
       |y| = vz^2 / |y_target|.
     Where an angle does not matter, it takes its neutral value: roll 0 on the singular
     circle (vz = y = 0), shoulder pitch 0 for a target or hand on the pitch axis (y).
-    The shoulder roll stays within +-90 deg; the pitch is in (-pi, pi].
+    Jumps remain only where no stateless IK avoids them: across the pitch axis, and right
+    at the singular circle (reachable targets beside it need every roll in +-90 deg, at
+    joint rates ~ 1 / their distance from it). The roll stays within +-90 deg; the pitch
+    is in (-pi, pi].
     """
     u, f = g.upper_arm, g.forearm
     px, py, pz = hand

@@ -1,4 +1,5 @@
-"""Leg and arm IK: FK(IK(x)) == x on the reachable set, nearest reachable pose outside it.
+"""Leg and arm IK: FK(IK(x)) == x on the reachable set, nearest reachable pose outside it
+(the arm's singularity and lateral caps: test_arm_ik_singularity.py).
 
 Poses are generated the only way that is sure to be reachable: sample joint angles inside
 the limits (away from the straight-knee / straight-elbow singularity), FK them, IK, FK again.
@@ -8,6 +9,8 @@ Geometries are random too, so thigh != shin and upper_arm != forearm are covered
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Iterable
+from typing import cast
 
 import numpy as np
 from hypothesis import given, settings
@@ -16,6 +19,7 @@ from hypothesis import strategies as st
 from robot import xmath as xm
 from robot.config import Geometry, load_robot
 from robot.ik import arm_fk, arm_fk_local, arm_ik, hip_centre, leg_fk, leg_fk_full, leg_ik
+from robot.xmath import Rot, Vec
 
 BASE = load_robot().geometry
 LEG_LO = np.array([-0.6, -0.5, -1.7, 0.15, -1.2, -0.5])   # knee > 0: away from straight
@@ -39,7 +43,16 @@ def lerp(lo: np.ndarray, hi: np.ndarray, u: np.ndarray) -> np.ndarray:
     return lo + (hi - lo) * u
 
 
-def pose_err(a: tuple, b: tuple) -> float:
+def vec3(v: Iterable[object]) -> Vec:
+    """Three coordinates as the Vec tuple the kinematics take (floats or arrays)."""
+    return cast(Vec, tuple(v))
+
+
+def rot9(v: Iterable[object]) -> Rot:
+    return cast(Rot, tuple(v))
+
+
+def pose_err(a: object, b: object) -> float:
     return float(np.max(np.abs(np.asarray(a, dtype=float) - np.asarray(b, dtype=float))))
 
 
@@ -83,8 +96,8 @@ def test_leg_ik_vectorised_equals_scalar(g: Geometry, side: str, seed: int) -> N
     assert pose_err(np.array(sole)[:, reach], np.array(sole2)[:, reach]) < POS_TOL
     assert pose_err(np.array(rot), np.array(rot2)) < ROT_TOL
     for i in range(40):
-        one = leg_ik(g, side, tuple(float(c[i]) for c in sole),
-                     tuple(float(r[i]) for r in rot))
+        one = leg_ik(g, side, vec3(float(c[i]) for c in sole),
+                     rot9(float(r[i]) for r in rot))
         assert bool(one.reachable) == bool(vec.reachable[i])
         assert pose_err(one.q, [v[i] for v in vec.q]) < 1e-12
 
@@ -98,7 +111,7 @@ def test_leg_too_far_gives_a_straight_leg_pointing_at_the_target(
     rot = xm.rz_ry(yaw, pitch)
     hip = np.array(hip_centre(g, side))
     sole = hip + d * f * reach - np.array(rot).reshape(3, 3)[:, 2] * g.ankle_height
-    sol = leg_ik(g, side, tuple(float(v) for v in sole), rot)
+    sol = leg_ik(g, side, vec3(float(v) for v in sole), rot)
     assert not sol.reachable
     assert np.all(np.isfinite(sol.q))
     assert abs(sol.q[3]) < 1e-6                              # knee straight
@@ -117,7 +130,7 @@ def test_leg_too_close_folds_the_knee_towards_the_target(
         gap = 0.03
     hip = np.array(hip_centre(g, side))
     sole = hip + d * f * gap - np.array([0.0, 0.0, g.ankle_height])
-    sol = leg_ik(g, side, tuple(float(v) for v in sole))
+    sol = leg_ik(g, side, vec3(float(v) for v in sole))
     assert not sol.reachable
     assert np.all(np.isfinite(sol.q))
     sole2, rot2 = leg_fk_full(g, side, sol.q)
@@ -133,6 +146,47 @@ def test_leg_ik_never_nan_on_degenerate_targets() -> None:
         assert np.all(np.isfinite(sol.q)), sole
     arr = leg_ik(g, "l", (np.zeros(3), np.full(3, 0.045), np.array([0.0, -1.0, 1e9])))
     assert np.all(np.isfinite(np.array(arr.q)))
+
+
+equal_legs = st.floats(0.04, 0.3).map(lambda a: dataclasses.replace(BASE, thigh=a, shin=a))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.one_of(geometry_st, equal_legs), sides, unit_vectors,
+       st.sampled_from(["hip", "folded", "folded_in", "folded_out", "straight", "along_x"]),
+       st.floats(-0.5, 0.5), st.floats(-0.5, 0.5))
+def test_leg_degenerate_targets_divide_by_nothing(g: Geometry, side: str, e: np.ndarray,
+                                                  case: str, yaw: float, pitch: float) -> None:
+    """The ankle point at the hip centre, at exactly |thigh - shin| (knee fully bent), just
+    inside and outside that, at full reach, and straight along the foot's x axis (ankle
+    roll undefined): finite, no numpy warning, and FK exact (1e-12 m) where reachable,
+    else the ankle at the clamped distance."""
+    a, b = g.thigh, g.shin
+    rot = xm.rz_ry(yaw, pitch)
+    if case == "along_x":
+        e = np.array(rot).reshape(3, 3)[:, 0]
+    dist = {"hip": 0.0, "folded": abs(a - b), "folded_in": abs(a - b) - 1e-7,
+            "folded_out": abs(a - b) + 1e-7, "straight": a + b, "along_x": 0.5 * (a + b)}[case]
+    dist = max(dist, 0.0)
+    hip = np.array(hip_centre(g, side))
+    ankle = hip + e * dist
+    sole = ankle - np.array(rot).reshape(3, 3)[:, 2] * g.ankle_height
+    with np.errstate(divide="raise", invalid="raise", over="raise"):
+        vec = leg_ik(g, side, vec3(np.array([v, v]) for v in sole),
+                     rot9(np.array([v, v]) for v in rot))
+    sol = leg_ik(g, side, vec3(float(v) for v in sole), rot)
+    assert all(isinstance(v, float) and np.isfinite(v) for v in sol.q)
+    assert pose_err(sol.q, [v[0] for v in vec.q]) < 1e-12
+    sole2, rot2 = leg_fk_full(g, side, sol.q)
+    reach = abs(a - b) <= dist <= a + b
+    assert bool(sol.reachable) == reach
+    if reach:
+        assert pose_err(ankle_of(g, sole2, rot2), ankle) < 1e-12
+        assert pose_err(rot, rot2) < 1e-12
+    else:
+        assert abs(np.linalg.norm(ankle_of(g, sole2, rot2) - hip) - abs(a - b)) < 1e-12
+    if case in ("folded", "hip") and reach:
+        assert abs(sol.q[3] - np.pi) < 1e-7                    # knee fully bent
 
 
 def test_leg_fk_helper_matches_full_fk() -> None:
@@ -171,7 +225,7 @@ def test_arm_ik_vectorised_equals_scalar(g: Geometry, seed: int) -> None:
     assert pose_err(np.array(hand)[:, reach], np.array(arm_fk_local(g, vec.q))[:, reach]) \
         < POS_TOL
     for i in range(40):
-        one = arm_ik(g, tuple(float(c[i]) for c in hand))
+        one = arm_ik(g, vec3(float(c[i]) for c in hand))
         assert bool(one.reachable) == bool(vec.reachable[i])
         assert pose_err(one.q, [v[i] for v in vec.q]) < 1e-12
 
@@ -186,7 +240,7 @@ def test_arm_unreachable_goes_to_the_nearest_point_on_the_line(
         fa = u + 0.03
     lo, hi = abs(u - fa), u + fa
     dist = f * hi if f > 1 else f * lo
-    sol = arm_ik(g, tuple(float(v) for v in d * dist))
+    sol = arm_ik(g, vec3(float(v) for v in d * dist))
     assert not sol.reachable
     assert np.all(np.isfinite(sol.q))
     want = d * (hi if f > 1 else lo)

@@ -40,7 +40,7 @@ from robot.ramp import ramp
 from robot.servo_map import ServoMap
 from robot.start_check import check_inside_limits
 from robot.telemetry import LoopStats, Telemetry, TickObserver
-from robot.watchdog import Watchdog, WatchdogConfig
+from robot.watchdog import FAILSAFE_MARGIN, Watchdog, WatchdogConfig
 
 __all__ = ["LoopStats", "Streamer", "Telemetry", "TickObserver", "check_inside_limits"]
 
@@ -187,6 +187,7 @@ class Streamer:
     def _arm_failsafe(self) -> None:
         timeout = self.watchdog_config.failsafe_s
         if timeout:
+            timeout = max(timeout, FAILSAFE_MARGIN * self.bus.retry_span_s + 2 * self.dt)
             armed = self.bus.arm_failsafe(self.map.ids, timeout_s=timeout)
             if armed is not None:
                 log.info("servo bus watchdog armed: %.2f s", armed)

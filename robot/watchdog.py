@@ -12,6 +12,9 @@ from robot.config import RobotConfig
 from robot.errors import BusDead, BusError, SafetyStop
 from robot.servo_map import ServoMap
 
+#: How many times the longest retried transaction the servos' bus watchdog must allow.
+FAILSAFE_MARGIN = 1.5
+
 FAULTS = frozenset({"overheating", "overload", "voltage", "electrical_shock", "encoder",
                     "overcurrent"})
 
@@ -25,7 +28,9 @@ class WatchdogConfig:
     max_temperature_c: [°C]; follow_error_rad: commanded - present beyond which a servo
     is "not following" [rad]; follow_reads: consecutive read-backs it must persist;
     failsafe_s: the servos' own bus watchdog, armed while streaming: with no packet for
-    this long [s] they stop by themselves (None: leave it off).
+    this long [s] they stop by themselves (None: leave it off). It is armed at least
+    ``FAILSAFE_MARGIN`` times the bus's ``retry_span_s`` plus two ticks, so a transaction
+    that is retried to its end never trips it.
     """
 
     bus_error_streak: int = 5

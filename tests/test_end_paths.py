@@ -124,3 +124,20 @@ def test_sample_stats_exact_while_small_bounded_when_large() -> None:
     assert big.max == top
     assert big.percentile(50) == pytest.approx(0.5, abs=0.03)  # uniform: p50 = 0.5
     assert big.percentile(99) == pytest.approx(0.99, abs=0.01)
+
+
+@pytest.mark.parametrize("protocol", ["dynamixel"])
+def test_bus_watchdog_armed_past_the_longest_retried_transaction(
+        emu: Emulator, robot: RobotConfig, robot_toml: Path) -> None:
+    """Bus Watchdog (X-series address 98, 20 ms units) is armed while streaming, for longer
+    than a transaction retried to its end (50 ms x 3 attempts here), and disarmed after."""
+    emu.log(clear=True)
+    assert cli.main(["walk", "--bus", "dynamixel", "--port", emu.port, "--robot",
+                     str(robot_toml), "--seconds", "0.3", "--set", "ramp_cycles=0.5"]) == 0
+    writes = [p for p in emu.log() if p.instruction == "write" and p.address == 98]
+    values = {i: [p.values[i] for p in writes if i in p.values] for i in robot.ids}
+    span = 0.050 * 3
+    steps = math.ceil((1.5 * span + 2 / 200.0) / 0.020 - 1e-9)   # 12: 0.24 s
+    assert steps == 12
+    assert all(v == [0, steps, 0] for v in values.values()), values   # clear, arm, disarm
+    assert {emu.registers(i)["bus_watchdog"] for i in robot.ids} == {0}

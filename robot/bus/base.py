@@ -63,6 +63,13 @@ class Bus(ABC):
     @abstractmethod
     def is_open(self) -> bool: ...
 
+    @property
+    def retry_span_s(self) -> float:
+        """The longest one transaction with all its retries can keep a servo from hearing
+        any packet [s] (a partial sync-read retry addresses only the silent servos). The
+        servos' own bus watchdog must be armed longer than this. 0 for buses without one."""
+        return 0.0
+
     @abstractmethod
     def ping(self, servo_id: int) -> int | None:
         """Model number of ``servo_id``, or None if it does not answer."""

@@ -106,6 +106,10 @@ class SdkBus(Bus):
     def is_open(self) -> bool:
         return self._port is not None and bool(self._port.is_open)
 
+    @property
+    def retry_span_s(self) -> float:
+        return self.timeout_ms * 1e-3 * (self.retries + 1)
+
     def open(self) -> None:
         if self.is_open:
             return

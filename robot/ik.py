@@ -53,17 +53,25 @@ def shoulder_centre(g: Geometry, side: str) -> Vec:
     return (0.0, SIDE_SIGN[side] * g.shoulder_width / 2, g.torso_height)
 
 
+def spans(a: float, b: float, s: Num, t: Num = 0.0) -> tuple[Num, Num]:
+    """(a + b)^2 - c^2 and c^2 - (a - b)^2 [m^2] for links ``a``, ``b`` [m] whose far ends
+    are c = sqrt(s^2 + t^2) [m] apart, c clamped to [|a - b|, a + b] (the two sum to 4ab).
+    Written as (|s| -+ L)(|s| +- L) -+ t^2: exact to the last bit when the pair points
+    along s (t ~ 0)."""
+    far, near, s, t2, span = a + b, abs(a - b), abs(s), t * t, 4.0 * a * b
+    return (xm.clip((far - s) * (far + s) - t2, 0.0, span),
+            xm.clip((s - near) * (s + near) + t2, 0.0, span))
+
+
 def bend(a: float, b: float, s: Num, t: Num = 0.0) -> Num:
     """Bend [rad] of the joint between links ``a`` and ``b`` [m] whose far ends are
     sqrt(s^2 + t^2) [m] apart: 0 straight, pi folded, and clamped to those beyond.
 
-    Half-angle law of cosines with c^2 - L^2 = (|s| - L)(|s| + L) + t^2 for L = a + b and
-    |a - b|: no acos of a rounded cosine (which loses half the digits when nearly straight
-    or folded), and exact to the last bit when the pair points along s (t ~ 0).
+    Half-angle law of cosines, tan(bend/2) = sqrt(spans): no acos of a rounded cosine
+    (which loses half the digits when nearly straight or folded).
     """
-    far, near, s, t2 = a + b, abs(a - b), abs(s), t * t
-    return 2.0 * xm.atan2(xm.sqrt(xm.maximum((far - s) * (far + s) - t2, 0.0)),
-                          xm.sqrt(xm.maximum((s - near) * (s + near) + t2, 0.0)))
+    out, inn = spans(a, b, s, t)
+    return 2.0 * xm.atan2(xm.sqrt(out), xm.sqrt(inn))
 
 
 def leg_fk_full(g: Geometry, side: str, q: tuple[Num, ...]) -> tuple[Vec, Rot]:
@@ -109,6 +117,7 @@ def leg_ik(g: Geometry, side: str, sole: Vec, foot_rot: Rot = xm.IDENTITY) -> Le
     sz_ = xm.sign(rz)
     ankle_roll = xm.atan2(ry * sz_, rz * sz_)  # in (-pi/2, pi/2]
     ankle_pitch = -xm.atan2(rx, sz_ * xm.sqrt(ry * ry + rz * rz)) - ankle_a
+    ankle_pitch = xm.atan2(xm.sin(ankle_pitch), xm.cos(ankle_pitch))  # into (-pi, pi]
     # Hip: R = foot_rot @ Rx(-roll) @ Ry(-(pitch + knee)) = Rz(yaw) Rx(roll) Ry(pitch).
     r = xm.post_ry(xm.post_rx(foot_rot, -ankle_roll), -(ankle_pitch + knee))
     hip_yaw = xm.atan2(-r[1], r[4])
@@ -168,9 +177,11 @@ def arm_ik(g: Geometry, hand: Vec) -> ArmIK:
     dc = xm.clip(d, lo, hi)
     k = dc / xm.maximum(d, 1e-300)  # radially onto the annulus
     y = xm.clip(py * k, -dc, dc)
-    elbow = -bend(u, f, py, xm.sqrt(rho2))  # clamps by itself
-    vx = -f * xm.sin(elbow)  # >= 0
-    vz = -u - f * xm.cos(elbow)
+    out, inn = spans(u, f, py, xm.sqrt(rho2))  # clamp by themselves
+    elbow = -2.0 * xm.atan2(xm.sqrt(out), xm.sqrt(inn))
+    # The hand in the elbow's plane, by algebra (the same bits on floats and arrays):
+    vx = xm.sqrt(out * inn) / (2.0 * u)  # -f sin(elbow) >= 0
+    vz = (f - u) - inn / (2.0 * u)  # -u - f cos(elbow)
     # sin(roll) = -y/vz within reach, -vz/y beyond it: atan2(-+min(|y|, |vz|),
     # sqrt(|vz^2 - y^2|)), no asin of a rounded sine, 0 where both are 0. vz^2 - y^2 =
     # rho^2 - vx^2 (= d^2 - vx^2 - y^2); each form is exact to ~eps * its larger operand,

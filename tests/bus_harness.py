@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import signal
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from types import FrameType
 
 import pytest
@@ -84,3 +85,12 @@ def bus(emu: Emulator, robot: RobotConfig) -> Iterator[SdkBus]:
     b = open_bus(emu, robot)
     yield b
     b.close()
+
+
+@pytest.fixture
+def robot_toml(tmp_path: Path, protocol: str) -> Path:
+    """The bundled robot with a reply timeout that tolerates a busy test machine."""
+    text = (ROBOTS_DIR / f"biped18-{protocol}.toml").read_text()
+    path = tmp_path / f"robot-{protocol}.toml"
+    path.write_text(text.replace("timeout_ms = 20.0", f"timeout_ms = {TEST_TIMEOUT_MS}"))
+    return path

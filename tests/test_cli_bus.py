@@ -14,22 +14,13 @@ import numpy as np
 import pytest
 
 import robot.cli as cli
-from robot.config import ROBOTS_DIR, RobotConfig, load_robot
+from robot.config import RobotConfig, load_robot
 from robot.servo_map import ServoMap
 from sim.emulator import Emulator
 
 pytest_plugins = ("bus_harness",)
 
 REPO = Path(__file__).resolve().parent.parent
-
-
-@pytest.fixture
-def robot_toml(tmp_path: Path, protocol: str) -> Path:
-    """The bundled robot with a reply timeout that tolerates a busy test machine."""
-    text = (ROBOTS_DIR / f"biped18-{protocol}.toml").read_text()
-    path = tmp_path / f"robot-{protocol}.toml"
-    path.write_text(text.replace("timeout_ms = 20.0", "timeout_ms = 50.0"))
-    return path
 
 
 @pytest.fixture(autouse=True)

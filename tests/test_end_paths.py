@@ -13,7 +13,7 @@ import pytest
 from bus_harness import open_bus
 
 import robot.cli as cli
-from robot.config import ROBOTS_DIR, RobotConfig, load_gait
+from robot.config import RobotConfig, load_gait
 from robot.engine import GaitEngine
 from robot.latency import SampleStats
 from robot.servo_map import ServoMap
@@ -24,14 +24,6 @@ pytest_plugins = ("bus_harness",)
 
 RESOLUTION = 4096
 WRITES = ("write", "sync_write", "reg_write", "bulk_write", "action")
-
-
-@pytest.fixture
-def robot_toml(tmp_path: Path, protocol: str) -> Path:
-    text = (ROBOTS_DIR / f"biped18-{protocol}.toml").read_text()
-    path = tmp_path / f"robot-{protocol}.toml"
-    path.write_text(text.replace("timeout_ms = 20.0", "timeout_ms = 50.0"))
-    return path
 
 
 def ticks_of(robot: RobotConfig, name: str, q: float) -> int:

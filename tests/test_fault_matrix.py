@@ -29,7 +29,7 @@ import numpy as np
 import pytest
 
 import robot.cli as cli
-from robot.config import ROBOTS_DIR, RobotConfig
+from robot.config import RobotConfig
 from sim.emulator import Emulator, Packet
 
 pytest_plugins = ("bus_harness",)
@@ -92,15 +92,6 @@ def last_goals(emu: Emulator, robot: RobotConfig) -> dict[int, int]:
 
 
 # ------------------------------------------------------------------------------ running
-@pytest.fixture
-def robot_toml(tmp_path: Path, protocol: str) -> Path:
-    """The bundled robot with a reply timeout that tolerates a busy test machine."""
-    text = (ROBOTS_DIR / f"biped18-{protocol}.toml").read_text()
-    path = tmp_path / f"robot-{protocol}.toml"
-    path.write_text(text.replace("timeout_ms = 20.0", "timeout_ms = 50.0"))
-    return path
-
-
 def walk_args(emu: Emulator, robot_toml: Path, *, hold: bool, seconds: float = 2.0) -> list[str]:
     args = ["walk", "--bus", emu.protocol, "--port", emu.port, "--robot", str(robot_toml),
             "--seconds", str(seconds), "--rate", str(RATE), "--json", "--set",

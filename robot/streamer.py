@@ -102,11 +102,6 @@ class Streamer:
         self._estop.set()
         self._stop.set()
 
-    @property
-    def stopping(self) -> bool:
-        """A stop (safe or emergency) has been requested or a fault occurred."""
-        return self._stop.is_set()
-
     # -- runs ----------------------------------------------------------------------------
     def run(self, *, seconds: float | None = None) -> LoopStats:
         """Walk until ``seconds`` of gait have passed or a stop is requested."""

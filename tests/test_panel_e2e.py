@@ -108,9 +108,12 @@ def test_slider_reaches_the_running_loop(running: tuple[PanelController, str],
     page.mouse.up()
     assert wait_for(lambda: abs(streamer.engine.params.Slgt_R - s1) < 0.1, 3.0), \
         streamer.engine.params.Slgt_R
-    shown = float(page.input_value("#num-Slgt_R"))
-    assert wait_for(lambda: streamer.engine.params.Slgt_R == controller.params.Slgt_R)
-    assert shown == pytest.approx(streamer.engine.params.Slgt_R, abs=0.01)
+    # The drag's last input events may still be in flight: wait until page, controller and
+    # loop agree on the final value.
+    assert wait_for(lambda: streamer.engine.params.Slgt_R == controller.params.Slgt_R
+                    and abs(float(page.input_value("#num-Slgt_R"))
+                            - streamer.engine.params.Slgt_R) < 0.01, 3.0), \
+        (page.input_value("#num-Slgt_R"), streamer.engine.params.Slgt_R)
     after = hip_pitch_swing(controller, cycle)
     assert after > before * 1.3 + 0.02, (before, after)
 

@@ -11,17 +11,23 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from robot.bundled import (  # noqa: F401  (re-exported: where configs come from)
+    CONFIG_DIR,
+    DEFAULT_GAIT,
+    DEFAULT_ROBOT,
+    DEFAULT_ROBOT_NAME,
+    GAITS_DIR,
+    ROBOTS_DIR,
+    gait_names,
+    resolve_gait_path,
+    resolve_robot_path,
+    robot_names,
+)
 from robot.bus.tables import MODELS, ServoModel
 from robot.config_checks import check_bus, check_ticks
 from robot.errors import ConfigError
 from robot.params import SPECS, GaitParams, canonical_name, check_value
 from robot.toml_io import Range, build, number, read_toml, show, spec, table
-
-CONFIG_DIR = Path(__file__).resolve().parent.parent / "configs"
-ROBOTS_DIR = CONFIG_DIR / "robots"
-GAITS_DIR = CONFIG_DIR / "gaits"
-DEFAULT_ROBOT = ROBOTS_DIR / "biped18-dynamixel.toml"
-DEFAULT_GAIT = "walk"
 
 SIDES = ("r", "l")
 LEG_JOINTS = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
@@ -183,9 +189,10 @@ class Gait:
 # ---------------------------------------------------------------------------- robots
 
 
-def load_robot(path: str | Path | None = None) -> RobotConfig:
-    """Load and validate a robot TOML file (default: the Dynamixel biped)."""
-    p = Path(path) if path is not None else DEFAULT_ROBOT
+def load_robot(name_or_path: str | Path | None = None) -> RobotConfig:
+    """Load and validate a robot by bundled name or TOML path (default: the Dynamixel
+    biped)."""
+    p = resolve_robot_path(name_or_path) if name_or_path is not None else DEFAULT_ROBOT
     return parse_robot(read_toml(p), source=str(p))
 
 
@@ -258,23 +265,6 @@ def parse_robot(data: Mapping[str, Any], *, source: str = "<memory>") -> RobotCo
 
 
 # ---------------------------------------------------------------------------- gaits
-
-
-def gait_names() -> list[str]:
-    """Names of the bundled gait presets."""
-    return sorted(p.stem for p in GAITS_DIR.glob("*.toml"))
-
-
-def resolve_gait_path(name_or_path: str | Path) -> Path:
-    """A preset name (``walk``) or a path to a TOML file → a path."""
-    s = str(name_or_path)
-    if s.endswith(".toml") or "/" in s or Path(s).exists():
-        return Path(s)
-    p = GAITS_DIR / f"{s}.toml"
-    if not p.exists():
-        raise ConfigError(f"--gait: unknown preset {s!r}; valid: {', '.join(gait_names())} "
-                          f"(or a path to a .toml file)")
-    return p
 
 
 def load_gait(name_or_path: str | Path | None = None) -> Gait:

@@ -1,26 +1,65 @@
-"""One factory picks the bus backend (like pyserial's ``serial_for_url``)."""
+"""One factory picks the bus backend (like pyserial's ``serial_for_url``).
+
+The hardware buses (``dynamixel``, ``feetech``) are built in. Other kinds are plugins: a
+distribution declares an entry point in the group ``biped.buses`` (biped's own
+pyproject.toml declares ``sim = "sim:open_bus"``), naming a callable
+``(robot, *, port, baud, **options) -> Bus``; ``register_bus`` adds one at run time. So
+``robot/`` never imports ``sim/``.
+"""
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from importlib.metadata import entry_points
 
 from robot.bus.base import Bus
 from robot.config import RobotConfig
 from robot.errors import ConfigError
 
-KINDS = ("sim", "dynamixel", "feetech")
+#: Entry-point group where bus plugins are declared.
+ENTRY_POINT_GROUP = "biped.buses"
+HARDWARE = ("dynamixel", "feetech")
+
+BusFactory = Callable[..., Bus]   # (robot, *, port: str | None, baud: int | None, **options)
+
+_registered: dict[str, BusFactory] = {}
+
+
+def register_bus(kind: str, factory: BusFactory) -> None:
+    """Make ``make_bus(kind, ...)`` call ``factory(robot, port=..., baud=..., **options)``."""
+    if kind in HARDWARE:
+        raise ConfigError(f"register_bus: {kind!r} is a built-in bus kind; choose another name")
+    _registered[kind] = factory
+
+
+def bus_kinds() -> tuple[str, ...]:
+    """Every bus kind ``make_bus`` accepts: plugins (registered or declared), then hardware."""
+    plugins = set(_registered) | {ep.name for ep in entry_points(group=ENTRY_POINT_GROUP)}
+    return (*sorted(plugins - set(HARDWARE)), *HARDWARE)
+
+
+def _plugin(kind: str) -> BusFactory | None:
+    if kind not in _registered:
+        found = [ep for ep in entry_points(group=ENTRY_POINT_GROUP) if ep.name == kind]
+        if not found:
+            return None
+        try:
+            _registered[kind] = found[0].load()
+        except ImportError as e:
+            raise ConfigError(f"--bus {kind}: plugin {found[0].value} (entry point group "
+                              f"{ENTRY_POINT_GROUP}) cannot be imported: {e}") from e
+    return _registered[kind]
 
 
 def make_bus(kind: str | None, *, robot: RobotConfig, port: str | None = None,
              baud: int | None = None, **options: object) -> Bus:
     """A closed bus of ``kind`` (default: the robot config's) for ``robot``'s servos.
 
-    kind: "sim" | "dynamixel" | "feetech"; port/baud override the robot config's.
+    kind: one of ``bus_kinds()`` ("sim", "dynamixel", "feetech" when biped is installed);
+    port/baud override the robot config's.
     """
     kind = kind or robot.bus.kind
-    if kind == "sim":
-        from sim.mujoco_bus import MujocoBus
-
-        return MujocoBus(robot, **options)  # type: ignore[arg-type]
-    if kind in ("dynamixel", "feetech"):
+    if kind in HARDWARE:
         if kind != robot.bus.kind:
             raise ConfigError(f"--bus {kind}: robot {robot.name} ({robot.source}) has "
                               f"{robot.bus.kind} servos; use --bus {robot.bus.kind} or a "
@@ -34,4 +73,9 @@ def make_bus(kind: str | None, *, robot: RobotConfig, port: str | None = None,
         from robot.bus.feetech import FeetechBus
 
         return FeetechBus(port, baud=baud, robot=robot, **options)  # type: ignore[arg-type]
-    raise ConfigError(f"--bus: unknown bus {kind!r}; valid: {', '.join(KINDS)}")
+    factory = _plugin(kind)
+    if factory is None:
+        raise ConfigError(f"--bus: unknown bus {kind!r}; valid: {', '.join(bus_kinds())} "
+                          f"(plugins are entry points in group {ENTRY_POINT_GROUP}; "
+                          "reinstall biped if 'sim' is missing)")
+    return factory(robot, port=port, baud=baud, **options)

@@ -14,17 +14,20 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NoReturn, TypeVar
 
+from robot.bundled import user_gaits_dir
 from robot.bus.base import Bus
 from robot.bus.factory import make_bus
 from robot.config import (
     DEFAULT_GAIT,
-    DEFAULT_ROBOT,
+    DEFAULT_ROBOT_NAME,
     SERVO_ID,
     SPEED,
     Gait,
     RobotConfig,
+    gait_names,
     load_gait,
     load_robot,
+    robot_names,
 )
 from robot.config_checks import standard_bauds
 from robot.errors import ConfigError
@@ -206,11 +209,13 @@ def input_file(text: str) -> str:
 
 
 def add_robot_args(p: argparse.ArgumentParser, *, gait: bool = True) -> None:
-    p.add_argument("--robot", default=str(DEFAULT_ROBOT), metavar="PATH",
-                   help="robot TOML (default: %(default)s)")
+    p.add_argument("--robot", default=DEFAULT_ROBOT_NAME, metavar="NAME|PATH",
+                   help=f"bundled robot ({', '.join(robot_names())}) or a robot TOML path "
+                        "(default: %(default)s)")
     if gait:
         p.add_argument("--gait", default=DEFAULT_GAIT, metavar="NAME|PATH",
-                       help="gait preset name or TOML path (default: %(default)s)")
+                       help=f"gait preset: bundled ({', '.join(gait_names())}), one saved in "
+                            f"{user_gaits_dir()}, or a TOML path (default: %(default)s)")
 
 
 def add_bus_args(p: argparse.ArgumentParser, *, default: str | None = None,

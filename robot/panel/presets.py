@@ -1,20 +1,22 @@
 """Gait presets for the panel: list, load and save (validated TOML via gait_to_toml).
 
-Bundled presets live in ``configs/gaits`` and are read-only here: saving under a bundled
-name is refused whatever ``overwrite`` says, and a user file with a bundled name is
-ignored (the bundled one wins). The panel saves into ``presets_dir``: by default the
-user's ``$XDG_CONFIG_HOME/biped/gaits`` (``~/.config/biped/gaits``), never the repository.
+Bundled presets ship inside the package (``robot/configs/gaits``) and are read-only here:
+saving under a bundled name is refused whatever ``overwrite`` says, and a user file with a
+bundled name is ignored (the bundled one wins). The panel saves into ``presets_dir``: by
+default the user's config directory (``robot.bundled.user_gaits_dir``, platformdirs:
+``~/.config/biped/gaits`` on Linux), never the package or the repository; ``biped walk
+--gait NAME`` finds presets saved there too.
 """
 
 from __future__ import annotations
 
 import logging
-import os
 import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from robot.bundled import user_gaits_dir
 from robot.config import GAITS_DIR, Gait, gait_names, gait_to_toml, load_gait, parse_gait
 from robot.errors import ConfigError
 from robot.params import GaitParams
@@ -28,12 +30,8 @@ class PresetExistsError(ConfigError):
     """Saving would overwrite a bundled preset, or a user preset without ``overwrite``."""
 
 
-def user_presets_dir() -> Path:
-    """``$XDG_CONFIG_HOME/biped/gaits``; ``~/.config/biped/gaits`` when it is unset or
-    relative (the XDG base directory rule)."""
-    xdg = os.environ.get("XDG_CONFIG_HOME", "")
-    root = Path(xdg) if os.path.isabs(xdg) else Path.home() / ".config"
-    return root / "biped" / "gaits"
+#: Where "save as preset" writes by default (the user's config directory, via platformdirs).
+user_presets_dir = user_gaits_dir
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,7 @@ import importlib
 import logging
 import os
 import sys
+from importlib.metadata import PackageNotFoundError, version
 
 from robot.commands.common import one_line_errors
 from robot.errors import BipedError, SafetyStop
@@ -28,12 +29,23 @@ COMMANDS: tuple[str, ...] = (
     "panel",
     "render",
     "plot",
+    "find_port",
+    "monitor",
 )
+
+
+def installed_version() -> str:
+    """The installed distribution's version (importlib.metadata)."""
+    try:
+        return version("biped")
+    except PackageNotFoundError:
+        return "unknown (not installed; pip install .)"
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="biped", description="Trigonometric-gait driver for hobby servo bipeds.")
+    parser.add_argument("--version", action="version", version=f"biped {installed_version()}")
     parser.add_argument("--log-level", default="WARNING",
                         choices=["DEBUG", "INFO", "WARNING", "ERROR"], help="stderr log level")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")

@@ -18,12 +18,14 @@ from typing import Any
 
 import pytest
 
-from robot.config import DEFAULT_ROBOT, GAITS_DIR, load_gait, load_robot
+from robot.bus.factory import make_bus
+from robot.config import DEFAULT_ROBOT, GAITS_DIR, ROBOTS_DIR, load_gait, load_robot
 from robot.errors import ConfigError
 from robot.panel.controller import LoopOptions, PanelController, make_controller
 from robot.panel.presets import PresetStore
 from robot.panel.server import build_server, serve_in_thread
 from robot.params import GROUPS, SPECS
+from sim.emulator import Emulator
 from sim.mujoco_bus import MujocoBus
 
 Call = Callable[..., tuple[int, Any]]
@@ -274,3 +276,48 @@ def test_biped_panel_command_prints_token_and_stops_on_sigterm(tmp_path: Path) -
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+#: Every instruction that writes a register (the emulator's packet names).
+WRITES = {"write", "sync_write", "reg_write", "bulk_write", "action"}
+
+
+@pytest.mark.parametrize("protocol", ["dynamixel", "feetech"])
+def test_idle_figure_shows_the_read_back_pose_without_writing(protocol: str,
+                                                              tmp_path: Path) -> None:
+    """No run: /api/state reads the present pose (<= 5 reads/s however often it is asked)
+    and the stick figure follows a joint moved by hand; nothing is written to the servos."""
+    robot = load_robot(ROBOTS_DIR / f"biped18-{protocol}.toml")
+    with Emulator(protocol, robot, seed=1) as emu:
+        emu.set_register(4, "present_position", 2048 + 600)  # r_knee, sign +1, zero 2048
+        bus = make_bus(protocol, robot=robot, port=emu.port, timeout_ms=50.0)
+        controller = make_controller(robot, bus, load_gait("walk").params,
+                                     presets=PresetStore(tmp_path))
+        server = build_server(controller, port=0)
+        _, base = serve_in_thread(server)
+        try:
+            s = http(base, "GET", "/api/state")[1]
+            assert s["figure"]["present"] is None and emu.log() == []  # bus closed: no read
+            bus.open()
+            emu.log(clear=True)
+            t0 = time.monotonic()
+            states = [http(base, "GET", "/api/state")[1] for _ in range(30)]
+            knee = robot.joint_names.index("r_knee")
+            s = states[-1]
+            assert not s["running"] and s["state"] == "idle"
+            assert s["q_present"][knee] == pytest.approx(600 * 2 * 3.141592653589793 / 4096)
+            assert s["figure"]["cmd"] is None
+            assert set(s["figure"]["present"]["side"]) >= {"r_leg", "l_leg", "torso"}
+            assert all(v["temperature"] is not None for v in s["servos"])
+            emu.set_register(4, "present_position", 2048)  # moved back by hand
+            assert wait_for(lambda: http(base, "GET", "/api/state")[1]["q_present"][knee]
+                            == 0.0)
+            elapsed = time.monotonic() - t0
+            log = emu.log()
+            assert [p for p in log if p.instruction in WRITES] == []
+            reads = [p for p in log if "read" in p.instruction]
+            assert 2 <= len(reads) <= 5 * elapsed + 2
+        finally:
+            server.shutdown()
+            server.server_close()
+            controller.shutdown()

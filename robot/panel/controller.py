@@ -22,6 +22,7 @@ from robot.config import RobotConfig
 from robot.engine import GaitEngine
 from robot.errors import BipedError
 from robot.panel.figure import views
+from robot.panel.idle_pose import IdlePose
 from robot.panel.presets import PresetStore
 from robot.panel.sim_monitor import sim_monitor_factory
 from robot.params import GROUPS, SPECS, GaitParams
@@ -64,6 +65,7 @@ class PanelController:
         self.presets = presets or PresetStore()
         self._monitor_factory = monitor_factory
         self._map = ServoMap(robot)
+        self._idle = IdlePose(bus, self._map)  # the read-back pose while no run is active
         self._params = params
         self.preset = preset  # name of the last preset loaded (shown by the picker)
         self._lock = threading.RLock()
@@ -125,6 +127,7 @@ class PanelController:
             monitor = self._monitor_factory() if self._monitor_factory else None
             self._ticks.clear()
             self._sim = {}
+            self._idle.forget()
 
             def observe(tel: Telemetry) -> None:
                 self._observe(tel, monitor)
@@ -265,6 +268,10 @@ class PanelController:
         """A JSON-ready snapshot: loop state and timing, servos, sim metrics, stick figure."""
         with self._lock:
             tel, sim, running = dict(self._tel), dict(self._sim), self.running
+            if not running and not self._closing and self.bus.is_open:
+                idle = self._idle.poll()  # reads (never writes), at most 5 times a second
+                if idle is not None:
+                    tel["q_present"], tel["servo"] = idle
         names = self.robot.joint_names
         servos = [{"id": j.servo_id, "joint": j.name,
                    "temperature": s.temperature if s else None,

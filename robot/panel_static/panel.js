@@ -132,7 +132,7 @@ function drawView(canvas, cmd, present, horizontal) {
     }
     g.globalAlpha = 1; g.setLineDash([]);
   };
-  draw(present, true, 0.6);
+  draw(present, !!cmd, cmd ? 0.6 : 1);   // idle: the read-back pose alone, drawn solid
   draw(cmd, false, 1);
 }
 

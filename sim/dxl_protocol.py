@@ -197,8 +197,9 @@ def handle(servo_id: int, inst: int, params: bytes,
         targets_w = list(hearing.values()) if servo_id == BROADCAST_ID else (
             [servo] if servo else [])
         for s in targets_w:
+            sid = s.servo_id     # a new id takes effect after the reply (sent as the old id)
             err = WRITE_ERRORS[s.write(address, data)]
-            reply(s, status(s.servo_id, err | _alert(s)), LEVEL_ALL)
+            reply(s, status(sid, err | _alert(s)), LEVEL_ALL)
     elif inst == INST_REBOOT:
         if servo is not None:   # the status goes out first, then the servo restarts
             reply(servo, status(servo_id, _alert(servo)), LEVEL_ALL)

@@ -84,7 +84,8 @@ class ServoSpec:
     """What the emulator needs to build one servo.
 
     servo_id: bus id; model: key of ``tables.MODELS``; zero_ticks: initial present
-    position [ticks]; min_ticks/max_ticks: position limits [ticks]; baud: [bit/s].
+    position [ticks]; min_ticks/max_ticks: position limits [ticks]; baud: [bit/s];
+    return_delay: Return Delay Time register [raw steps] (0: a chain already set up).
     """
 
     servo_id: int
@@ -93,6 +94,7 @@ class ServoSpec:
     min_ticks: int
     max_ticks: int
     baud: int
+    return_delay: int = 0
 
 
 class EmulatedServo:
@@ -117,7 +119,7 @@ class EmulatedServo:
                              f"{self.family} rate; valid: {sorted(codes)}")
         values = dict(DEFAULTS[self.family])
         values.update(model_number=self.model.number, id=spec.servo_id,
-                      baud_rate=codes[spec.baud], return_delay_time=0,
+                      baud_rate=codes[spec.baud], return_delay_time=spec.return_delay,
                       present_position=spec.zero_ticks, goal_position=spec.zero_ticks)
         if self.family == "dynamixel_x":
             values.update(max_position_limit=spec.max_ticks, min_position_limit=spec.min_ticks)
@@ -129,6 +131,9 @@ class EmulatedServo:
         self._t = now
         self.watchdog = COMM_WATCHDOG[self.family]
         self.heard = now    # time of the last instruction packet addressed to this servo [s]
+        self.eeprom_end = self.table["torque_enable"].address   # EEPROM below, RAM from here
+        self._saved = bytes(self.mem[:self.eeprom_end])   # EEPROM as kept over power-off
+        self._ram_at_power_on = bytes(self.mem[self.eeprom_end:])
 
     # ------------------------------------------------------------------ raw access
     def get(self, name: str) -> int:
@@ -273,7 +278,29 @@ class EmulatedServo:
             if name == "torque_enable" and shutdown:
                 continue  # refused while in shutdown; the status carries the alert bit
             self.set(name, v)
+        if address < self.eeprom_end and self._keeps_eeprom():
+            self._saved = bytes(self.mem[:self.eeprom_end])
         return WriteError.NONE
+
+    def _keeps_eeprom(self) -> bool:
+        """Whether an EEPROM write survives power-off: always on Dynamixel X; on Feetech
+        STS only with the Lock flag (55) at 0 (1 = changes not saved, the factory value)."""
+        return self.family == "dynamixel_x" or self.get("lock") == 0
+
+    def power_off(self, now: float) -> None:
+        """Unplugged: the horn stops where it is and torque is gone."""
+        self.update(now)
+        self.set("torque_enable", 0)
+
+    def power_on(self, now: float) -> None:
+        """Plugged in again: EEPROM as saved, RAM at its power-on values, horn unmoved."""
+        self.update(now)
+        pos = round(self._pos)
+        self.mem[:self.eeprom_end] = self._saved
+        self.mem[self.eeprom_end:] = self._ram_at_power_on
+        self.set("present_position", pos)
+        self.set("goal_position", pos)
+        self._t = self.heard = now
 
     def _check(self, name: str, value: int) -> WriteError:
         lo_hi = VALID_RANGE.get(name)

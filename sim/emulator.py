@@ -45,6 +45,7 @@ import sys
 import threading
 import time
 from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import replace
 from multiprocessing.connection import Connection
 from pathlib import Path
 from types import TracebackType
@@ -63,6 +64,12 @@ ROOT = Path(__file__).resolve().parent.parent   # puts `sim` and `robot` on the 
 
 DEFAULT_MODEL = {"dynamixel": "XL430-W250", "feetech": "STS3215"}
 DEFAULT_BAUD = 1_000_000
+# As shipped: ROBOTIS e-Manual XL430-W250 (Baud Rate(8) initial 1 = 57600, Return Delay
+# Time(9) initial 250 = 500 us, ID(7) initial 1); Feetech STS memory table (ID(5) 1, Baud
+# Rate(6) 0 = 1 Mbps, Return Delay Time(7) 0).
+FACTORY_BAUD = {"dynamixel": 57_600, "feetech": 1_000_000}
+FACTORY_RETURN_DELAY = {"dynamixel": 250, "feetech": 0}
+FACTORY_ID = 1
 CENTER_TICKS = 2048
 REPLY_TIMEOUT_S = 5.0        # control-channel answer [s]
 START_TIMEOUT_S = 20.0       # child start-up [s]
@@ -119,6 +126,25 @@ class Emulator:
         self._conn: Connection | None = None
         self._port: str | None = None
         self._lock = threading.Lock()
+
+    @classmethod
+    def factory_new(cls, protocol: str, count: int, *, model: str | None = None) -> Emulator:
+        """``count`` servos as they come out of the box, none plugged in yet.
+
+        Each has id 1, the factory baud and return delay, torque off and its horn at
+        mid-range; connect them with :meth:`plug` (one at a time) or :meth:`plug_all`.
+        """
+        if protocol not in FACTORY_BAUD:
+            raise EmulatorError(f"protocol: expected one of {', '.join(FACTORY_BAUD)}, "
+                                f"got {protocol!r}")
+        if count < 1:
+            raise EmulatorError(f"count: expected at least 1 servo, got {count}")
+        emu = cls(protocol, ids=[FACTORY_ID] * count, model=model,
+                  baud=FACTORY_BAUD[protocol])
+        delay = FACTORY_RETURN_DELAY[protocol]
+        emu.spec = replace(emu.spec, plugged=(),
+                           servos=tuple(replace(s, return_delay=delay) for s in emu.spec.servos))
+        return emu
 
     # ------------------------------------------------------------------ lifecycle
     def start(self) -> str:
@@ -264,6 +290,30 @@ class Emulator:
     def registers(self, servo_id: int) -> dict[str, int]:
         """Snapshot of one servo's control table by register name (motion brought to now)."""
         return dict(self._call("registers", servo_id))
+
+    def registers_of(self, index: int) -> dict[str, int]:
+        """Snapshot of servo number ``index`` (0-based, plugged or not; ids may repeat)."""
+        self._check_index(index)
+        return dict(self._call("registers_of", index))
+
+    def plug(self, index: int | None) -> None:
+        """Connect servo number ``index`` (0-based) alone, unplugging the others; None: none.
+
+        A servo that was unplugged powers on: it keeps what was saved in its EEPROM (id,
+        baud rate, ...) and its RAM (torque, goals, ...) starts from the power-on values.
+        """
+        if index is not None:
+            self._check_index(index)
+        self._call("plug", [] if index is None else [index])
+
+    def plug_all(self) -> None:
+        """Connect every servo (a chain after setup)."""
+        self._call("plug", None)
+
+    def _check_index(self, index: int) -> None:
+        if not 0 <= index < len(self.ids):
+            raise EmulatorError(f"servo index {index} is out of range; the chain has "
+                                f"{len(self.ids)} servos (0..{len(self.ids) - 1})")
 
     def set_register(self, servo_id: int, name: str, value: int) -> None:
         """Store a register without the checks a host write gets (e.g. return_delay_time)."""

@@ -59,9 +59,12 @@ class Packet:
 
 @dataclass(frozen=True)
 class ChainSpec:
+    """The chain to serve; ``plugged``: indices into ``servos`` on the bus (None: all)."""
+
     protocol: str
     servos: tuple[ServoSpec, ...]
     seed: int = 0
+    plugged: tuple[int, ...] | None = None
 
 
 class _ChainServer:
@@ -73,6 +76,8 @@ class _ChainServer:
         self.parser = self.codec.Parser()
         now = time.monotonic()
         self.servos = [EmulatedServo(s, now) for s in spec.servos]
+        self.plugged: set[int] = set(range(len(self.servos)) if spec.plugged is None
+                                     else spec.plugged)
         self.rng = random.Random(spec.seed)
         self.log: collections.deque[Packet] = collections.deque(maxlen=LOG_MAX)
         self.counters: dict[str, int] = dict.fromkeys(
@@ -88,9 +93,11 @@ class _ChainServer:
         self.path = os.ttyname(slave)
 
     def by_id(self, servo_id: int) -> EmulatedServo:
-        for s in self.servos:
-            if s.servo_id == servo_id:
-                return s
+        """The servo with ``servo_id``, a plugged one first when several share it."""
+        order = sorted(range(len(self.servos)), key=lambda i: i not in self.plugged)
+        for i in order:
+            if self.servos[i].servo_id == servo_id:
+                return self.servos[i]
         raise EmulatorError(f"no emulated servo with id {servo_id}; ids: "
                             f"{sorted(s.servo_id for s in self.servos)}")
 
@@ -114,23 +121,36 @@ class _ChainServer:
         for servo_id, inst, params in frames:
             now = time.monotonic()
             speed = self.port_speed()
-            present = [s for s in self.servos if s.servo_id not in self.missing
+            present = [s for i, s in enumerate(self.servos) if i in self.plugged
+                       and s.servo_id not in self.missing
                        and self.vanish.get(s.servo_id, float("inf")) > now]
-            hearing = {s.servo_id: s for s in present if speed is None or s.baud == speed}
-            if present and not hearing:
+            listening = [s for s in present if speed is None or s.baud == speed]
+            if present and not listening:
                 self.counters["baud_mismatch"] += 1
                 continue
-            for s in hearing.values():
+            for s in listening:
                 s.update(now)
-            h = self.codec.handle(servo_id, inst, params, hearing)
-            addressed = hearing.values() if self.codec.BROADCAST_ID in h.ids else (
-                hearing[i] for i in h.ids if i in hearing)
-            for s in addressed:
-                s.hear(now)
+            # Servos sharing an id all execute the packet and all answer (on a real bus
+            # their replies collide); each layer holds at most one servo per id.
+            layers: list[dict[int, EmulatedServo]] = []
+            for s in listening:
+                layer = next((d for d in layers if s.servo_id not in d), None)
+                if layer is None:
+                    layer = {}
+                    layers.append(layer)
+                layer[s.servo_id] = s
+            handled = [self.codec.handle(servo_id, inst, params, d)
+                       for d in layers or [{}]]
+            h = handled[0]
+            for layer, hl in zip(layers, handled, strict=False):
+                addressed = layer.values() if self.codec.BROADCAST_ID in hl.ids else (
+                    layer[i] for i in hl.ids if i in layer)
+                for s in addressed:
+                    s.hear(now)
             self.counters["rx_packets"] += 1
             self.counters[h.instruction] = self.counters.get(h.instruction, 0) + 1
             self.log.append(Packet(now, h.instruction, h.ids, h.address, h.values, h.length))
-            for r in h.replies:
+            for r in (r for hl in handled for r in hl.replies):
                 self.send(r.data, r.delay_s)
 
     def send(self, data: bytes, delay_s: float) -> None:
@@ -182,12 +202,28 @@ class _ChainServer:
             s = self.by_id(args[0])
             s.update(time.monotonic())
             return s.snapshot()
+        if cmd == "plug":
+            return self.plug(args[0])
+        if cmd == "registers_of":
+            s = self.servos[args[0]]
+            s.update(time.monotonic())
+            return s.snapshot()
         if cmd == "set_register":
             s = self.by_id(args[0])
             s.update(time.monotonic())
             s.set(args[1], args[2])
             return None
         raise EmulatorError(f"unknown emulator request {cmd!r}")
+
+    def plug(self, indices: list[int] | None) -> None:
+        """Connect exactly ``indices`` (None: every servo); a newly connected servo powers on."""
+        wanted = set(range(len(self.servos))) if indices is None else set(indices)
+        now = time.monotonic()
+        for i in self.plugged - wanted:
+            self.servos[i].power_off(now)
+        for i in wanted - self.plugged:
+            self.servos[i].power_on(now)
+        self.plugged = wanted
 
     def set_faults(self, f: dict[str, Any]) -> None:
         if f.get("drop_rate") is not None:

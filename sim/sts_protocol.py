@@ -98,9 +98,10 @@ def handle(servo_id: int, inst: int, params: bytes,
         targets = list(hearing.values()) if servo_id == BROADCAST_ID else (
             [servo] if servo else [])
         for s in targets:
+            sid = s.servo_id     # a new id takes effect after the reply (sent as the old id)
             s.write(address, data)
             if servo_id != BROADCAST_ID and s.status_return_level >= LEVEL_ALL:
-                replies.append(Reply(s.servo_id, status(s.servo_id, s.error_bits),
+                replies.append(Reply(sid, status(sid, s.error_bits),
                                      s.return_delay_s))
     elif inst == INST_SYNC_READ and len(params) >= 2:
         address, length = params[0], params[1]

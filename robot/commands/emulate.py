@@ -2,6 +2,10 @@
 
 Prints the pty device path (one line, flushed) so a script or another shell can point a
 bus at it (``biped scan --bus dynamixel --port /dev/pts/N``); SIGINT / SIGTERM stop it.
+
+``--factory-new N`` serves N servos as shipped (id 1, factory baud and return delay), none
+plugged in: each line read on stdin plugs the next one in alone (the previous one is
+unplugged), as a user connects one new servo at a time; the line ``all`` plugs in all.
 """
 
 from __future__ import annotations
@@ -11,8 +15,12 @@ import signal
 import sys
 import threading
 from types import FrameType
+from typing import TYPE_CHECKING
 
 from robot.commands.common import add_robot_args, positive_int, robot_from
+
+if TYPE_CHECKING:
+    from sim.emulator import Emulator
 
 PROTOCOLS = ("dynamixel", "feetech")
 ALIVE_CHECK_S = 0.5          # how often the emulator process is checked [s]
@@ -30,12 +38,37 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p.add_argument("--baud", type=positive_int, default=None,
                    help="chain baud rate [bit/s]; other rates get no answer "
                         "(default: the robot config's)")
+    p.add_argument("--factory-new", type=positive_int, default=None, metavar="N",
+                   help="serve N servos as shipped (id 1, factory baud); each stdin line "
+                        "plugs in the next one alone, the line 'all' plugs in all")
     return p
+
+
+def _plug_from_stdin(emu: Emulator, count: int, stop: threading.Event) -> None:
+    """Plug the next factory-new servo per stdin line; 'all' plugs every one."""
+    plugged = 0
+    for line in sys.stdin:
+        if stop.is_set():
+            return
+        if line.strip().lower() == "all":
+            emu.plug_all()
+            print(f"plugged all {count} servos", flush=True)
+        elif plugged < count:
+            emu.plug(plugged)
+            plugged += 1
+            print(f"plugged new servo {plugged} of {count}", flush=True)
+        else:
+            print(f"biped emulate: all {count} new servos were plugged in already; "
+                  "send 'all' to connect the whole chain", file=sys.stderr, flush=True)
 
 
 def run(args: argparse.Namespace) -> int:
     from sim.emulator import Emulator
 
+    if args.factory_new and args.baud:
+        print("biped emulate: error: --baud: factory-new servos listen at their factory "
+              "baud; drop --baud or --factory-new", file=sys.stderr)
+        return 2
     robot = robot_from(args)
     protocol = args.protocol or robot.bus.kind
     stop = threading.Event()
@@ -45,8 +78,13 @@ def run(args: argparse.Namespace) -> int:
 
     old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
-        with Emulator(protocol, robot, baud=args.baud) as emu:
+        emu = (Emulator.factory_new(protocol, args.factory_new) if args.factory_new
+               else Emulator(protocol, robot, baud=args.baud))
+        with emu:
             print(emu.port, flush=True)
+            if args.factory_new:
+                threading.Thread(target=_plug_from_stdin, args=(emu, args.factory_new, stop),
+                                 daemon=True).start()
             while not stop.wait(ALIVE_CHECK_S):
                 if not emu.alive:
                     print("biped emulate: error: the emulator process exited",

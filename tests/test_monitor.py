@@ -160,3 +160,49 @@ def test_next_deadline_stays_on_the_grid() -> None:
     assert next_deadline(10.0, 0.5, 10.5) == 11.0
     assert next_deadline(10.0, 0.5, 11.74) == 12.0  # a slow read skips missed deadlines
     assert next_deadline(10.0, 0.5, 9.0) == 10.5
+
+
+def test_live_table_refreshes_in_place_on_a_terminal(emu: Emulator, robot: RobotConfig,
+                                                     robot_toml: Path) -> None:
+    """On a terminal each refresh moves the cursor up over the last table and redraws it."""
+    import pty
+    import threading
+
+    master, slave = pty.openpty()
+    chunks: list[bytes] = []
+
+    def drain() -> None:  # a terminal that is read, as a real one is
+        while True:
+            try:
+                data = os.read(master, 65536)
+            except OSError:
+                return
+            if not data:
+                return
+            chunks.append(data)
+
+    reader = threading.Thread(target=drain, daemon=True)
+    reader.start()
+    code = ("import sys, robot.cli as c; c.COMMANDS = ('monitor',); "
+            "sys.exit(c.main(sys.argv[1:]))")
+    proc = subprocess.Popen([sys.executable, "-c", code, *args(emu, robot_toml, "--rate",
+                                                                "20")],
+                            cwd=REPO, stdout=slave, stderr=subprocess.PIPE,
+                            env={**os.environ, "MUJOCO_GL": "egl"})
+    try:
+        end = time.monotonic() + 10
+        while time.monotonic() < end and b"".join(chunks).count(b"\x1b[J") < 3:
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(10) == 130
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        os.close(slave)
+    reader.join(5)  # the rest of the output, up to the terminal's hang-up
+    os.close(master)
+    out = b"".join(chunks).decode()
+    lines_per_table = 2 + len(robot.ids) + 1  # title, header, joints, summary
+    assert out.count(f"\x1b[{lines_per_table}F\x1b[J") >= 3
+    assert out.count("r_knee ") == out.count("\x1b[J") + 1
+    assert_limp_and_no_goal(emu, robot)

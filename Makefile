@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint typecheck unit bench clean browser
+.PHONY: demo test lint typecheck unit bench clean browser wheel-check
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -30,10 +30,31 @@ browser:
 unit: $(STAMP) browser
 	MUJOCO_GL=egl $(BIN)/python -m pytest
 
-test: lint typecheck unit
+# The wheel, installed (not editable) into a fresh venv and run from a directory outside
+# the checkout: proves the package ships everything it needs (configs, panel files, the
+# sim bus entry point). Dependencies come from pip's cache or the registry.
+wheel-check: $(STAMP)
+	@set -eu; tmp=$$(mktemp -d); trap 'rm -rf "$$tmp"' EXIT; start=$$(date +%s); \
+	rm -rf build; \
+	$(BIN)/python -m pip wheel -q --no-deps . -w "$$tmp/dist" > "$$tmp/build.log" 2>&1 \
+	  || { cat "$$tmp/build.log"; echo "wheel-check: building the wheel failed"; exit 1; }; \
+	$(PY) -m venv "$$tmp/venv"; \
+	"$$tmp/venv/bin/python" -m pip install -q "$$tmp"/dist/biped-*.whl > "$$tmp/install.log" 2>&1 \
+	  || { cat "$$tmp/install.log"; echo "wheel-check: installing the wheel failed"; exit 1; }; \
+	want="biped $$($(BIN)/python -c 'import tomllib; print(tomllib.load(open("pyproject.toml", "rb"))["project"]["version"])')"; \
+	mkdir "$$tmp/run"; cd "$$tmp/run"; \
+	got=$$("$$tmp/venv/bin/biped" --version); \
+	test "$$got" = "$$want" || { echo "wheel-check: biped --version printed '$$got', expected '$$want'"; exit 1; }; \
+	"$$tmp/venv/bin/biped" walk --seconds 0.5 --json > walk.json; \
+	"$$tmp/venv/bin/python" -c 'import json, sys; r = json.load(open("walk.json")); sys.exit(0 if r["seconds"] == 0.5 else "wheel-check: walk.json: seconds != 0.5")'; \
+	"$$tmp/venv/bin/biped" curves --seconds 1 --robot biped18-feetech --gait crouch --out x.csv; \
+	test "$$(wc -l < x.csv)" -gt 1 || { echo "wheel-check: x.csv has no rows"; exit 1; }; \
+	echo "wheel-check: $$got from the wheel ran walk and curves outside the checkout in $$(( $$(date +%s) - start )) s"
+
+test: lint typecheck unit wheel-check
 
 bench: $(STAMP)
 	MUJOCO_GL=egl $(BIN)/biped bench
 
 clean:
-	rm -rf $(VENV) build *.egg-info .pytest_cache .mypy_cache .ruff_cache
+	rm -rf $(VENV) build dist *.egg-info .pytest_cache .mypy_cache .ruff_cache

@@ -108,23 +108,23 @@ def run(args: argparse.Namespace) -> int:
     sm = ServoMap(robot)
     bus = bus_from(args, robot)
     port = args.port or robot.bus.port
-    bus.open()
     latch, stopper = SignalLatch(), _Stop()
-    try:
-        with stop_on_signals(stopper, latch):
+    with stop_on_signals(stopper, latch):  # a signal never lands inside a transaction
+        bus.open()
+        try:
             bus.set_torque(sm.ids, enabled=False)
             if args.once:
                 title = f"{robot.name} on {bus.kind} {port}: torque OFF"
                 for line in _frame(robot, sm, bus, t=0.0, title=title, as_json=args.json,
                                    strict=True):
                     print(line)
-                return 0
-            _loop(robot, sm, bus, args, port, stopper)
-    finally:
-        bus.close(torque_off=True)  # torque off once more (a write of torque_enable only)
-    if not args.json:
+            else:
+                _loop(robot, sm, bus, args, port, stopper)
+        finally:
+            bus.close(torque_off=True)  # torque off once more (writes torque_enable only)
+    if not (args.json or args.once):
         print(f"biped monitor: stopped; torque off on {len(sm.ids)} servos")
-    return latch.exit_code(None)
+    return latch.exit_code(None)  # 0, or 128 + the signal that ended it
 
 
 def _loop(robot: RobotConfig, sm: ServoMap, bus: Bus, args: argparse.Namespace, port: str,

@@ -22,28 +22,11 @@ import enum
 import math
 from dataclasses import dataclass
 
-from robot.bus.tables import (
-    BAUD_CODES,
-    COMM_WATCHDOG,
-    ERROR_BITS,
-    MODELS,
-    RETURN_DELAY_UNIT_S,
-    TABLES,
-    Register,
-)
+from robot.bus.tables import COMM_WATCHDOG, ERROR_BITS, MODELS, RETURN_DELAY_UNIT_S
+from sim.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, Entry, read_only
 
-#: Registers a host may not write (the servo answers with an access error).
-READ_ONLY: frozenset[str] = frozenset({
-    "model_number", "firmware_version", "firmware_major", "firmware_minor",
-    "hardware_error_status", "moving", "status", "present_load", "present_velocity",
-    "present_speed", "present_position", "present_input_voltage", "present_voltage",
-    "present_temperature", "present_current",
-})
-#: Dynamixel registers holding two's-complement signed values.
-DXL_SIGNED: frozenset[str] = frozenset({
-    "bus_watchdog", "homing_offset", "goal_position", "present_load", "present_velocity",
-    "present_position",
-})
+#: Registers a host may not write (the manual marks them "R"; an access error).
+READ_ONLY: dict[str, frozenset[str]] = {fam: read_only(fam) for fam in TABLES}
 #: Allowed raw values of a few registers [inclusive range]; others accept any value.
 VALID_RANGE: dict[str, tuple[int, int]] = {
     "torque_enable": (0, 1),
@@ -52,20 +35,14 @@ VALID_RANGE: dict[str, tuple[int, int]] = {
     "return_delay_time": (0, 254),
     "id": (0, 252),
 }
-#: Factory defaults by register name (raw units), applied after the model's own values.
-DEFAULTS: dict[str, dict[str, int]] = {
-    "dynamixel_x": {
-        "firmware_version": 46, "operating_mode": 3, "status_return_level": 2,
-        "temperature_limit": 72,
-        "max_voltage_limit": 140, "min_voltage_limit": 60, "velocity_limit": 265,
-        "present_input_voltage": 115, "present_temperature": 35,
-    },
-    "feetech_sts": {
-        "firmware_major": 3, "firmware_minor": 10, "status_return_level": 1,
-        "max_temperature_limit": 70, "max_voltage_limit": 140, "min_voltage_limit": 40,
-        "max_torque_limit": 1000, "torque_limit": 1000, "lock": 1,
-        "present_voltage": 74, "present_temperature": 35,
-    },
+#: Values where the manual prints "-" (firmware, sensors, tuning the factory sets per
+#: unit): what this emulator reports. The manual's initial values come from the table.
+UNPRINTED: dict[str, dict[str, int]] = {
+    "dynamixel_x": {"firmware_version": 46, "present_input_voltage": 115,
+                    "present_temperature": 35},
+    "feetech_sts": {"firmware_major": 3, "firmware_minor": 10, "max_voltage_limit": 140,
+                    "p_coefficient": 32, "d_coefficient": 32, "present_voltage": 74,
+                    "present_temperature": 35},
 }
 
 
@@ -104,7 +81,7 @@ class EmulatedServo:
         self.spec = spec
         self.model = MODELS[spec.model]
         self.family = self.model.family
-        self.table: dict[str, Register] = TABLES[self.family]
+        self.table: dict[str, Entry] = TABLES[self.family]
         self.mem = bytearray(max(r.address + r.size for r in self.table.values()))
         self._owner = bytearray(len(self.mem))  # 0: no register; else index+1
         self._regs = list(self.table.items())
@@ -117,7 +94,8 @@ class EmulatedServo:
         if spec.baud not in codes:
             raise ValueError(f"servo {spec.servo_id}: baud {spec.baud} is not a "
                              f"{self.family} rate; valid: {sorted(codes)}")
-        values = dict(DEFAULTS[self.family])
+        values = {n: e.initial for n, e in self.table.items() if e.initial is not None}
+        values.update(UNPRINTED[self.family])
         values.update(model_number=self.model.number, id=spec.servo_id,
                       baud_rate=codes[spec.baud], return_delay_time=spec.return_delay,
                       present_position=spec.zero_ticks, goal_position=spec.zero_ticks)
@@ -131,7 +109,7 @@ class EmulatedServo:
         self._t = now
         self.watchdog = COMM_WATCHDOG[self.family]
         self.heard = now    # time of the last instruction packet addressed to this servo [s]
-        self.eeprom_end = self.table["torque_enable"].address   # EEPROM below, RAM from here
+        self.eeprom_end = EEPROM_END[self.family]   # EEPROM below, RAM from here
         self._saved = bytes(self.mem[:self.eeprom_end])   # EEPROM as kept over power-off
         self._ram_at_power_on = bytes(self.mem[self.eeprom_end:])
 
@@ -237,8 +215,11 @@ class EmulatedServo:
         return self.get(self.error_register)
 
     def read(self, address: int, length: int) -> bytes | None:
-        """``length`` bytes from ``address``, or None when the range leaves the table."""
+        """``length`` bytes from ``address``; None when the range leaves the table or holds
+        no register at all (undefined address: the manual's Access Error)."""
         if address < 0 or length < 0 or address + length > len(self.mem):
+            return None
+        if length and not any(self._owner[address:address + length]):
             return None
         return bytes(self.mem[address:address + length])
 
@@ -247,7 +228,7 @@ class EmulatedServo:
         end = address + len(data)
         if address < 0 or end > len(self.mem) or not data:
             return WriteError.ACCESS
-        touched: list[tuple[str, Register]] = []
+        touched: list[tuple[str, Entry]] = []
         for a in range(address, end):
             owner = self._owner[a]
             if not owner:
@@ -257,12 +238,11 @@ class EmulatedServo:
                 touched.append((name, reg))
         if touched[0][1].address < address or touched[-1][1].address + touched[-1][1].size > end:
             return WriteError.LENGTH
-        eeprom_end = self.table["torque_enable"].address
         values: dict[str, int] = {}
         for name, reg in touched:
-            if name in READ_ONLY:
+            if name in READ_ONLY[self.family]:
                 return WriteError.ACCESS
-            if (self.family == "dynamixel_x" and reg.address < eeprom_end
+            if (self.family == "dynamixel_x" and reg.address < self.eeprom_end
                     and self.get("torque_enable")):
                 return WriteError.ACCESS
             raw = data[reg.address - address:reg.address - address + reg.size]

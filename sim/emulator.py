@@ -51,8 +51,9 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
-from robot.bus.tables import BAUD_CODES, BUS_FAMILIES, ERROR_BITS, MODELS, TABLES
+from robot.bus.tables import BUS_FAMILIES, ERROR_BITS, MODELS
 from robot.config import RobotConfig
+from sim.control_tables import BAUD_CODES, TABLES
 from sim.emulated_servo import ServoSpec
 from sim.emulator_server import ChainSpec, EmulatorError, Packet
 

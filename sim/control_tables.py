@@ -1,0 +1,188 @@
+"""The emulated servos' control tables, transcribed from the vendors' manuals.
+
+Independent of ``robot.bus.tables`` on purpose (the driver's tables are checked against
+these in ``tests/test_emulator_tables.py``). Each entry: name -> ``Entry(address, size,
+access, initial)``; ``access`` is "R" or "RW" as printed; ``initial`` is the manual's
+initial (factory) value, None where it prints "-" (the emulator then fills in a model value
+or 0). EEPROM is every address below ``EEPROM_END`` (saved over power-off), RAM the rest.
+
+- Dynamixel X: ROBOTIS e-Manual, XL430-W250 control table
+  (https://emanual.robotis.com/docs/en/dxl/x/xl430-w250/#control-table). The XL430 has no
+  current sensing (no Current Limit / Goal Current / Present Current; Present Load(126)).
+- Feetech STS: Feetech "STS series memory table" (FT-SMS-STS-emanual, STS3215 column).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+
+class Entry(NamedTuple):
+    """One control-table row: address, size [bytes], "R"/"RW", initial value (or None)."""
+
+    address: int
+    size: int
+    access: str
+    initial: int | None
+
+
+INDIRECT_COUNT = 56           # XL430: Indirect Address/Data 1..28 and 29..56
+INDIRECT_BLOCKS = ((168, 224, 28), (578, 634, 28))   # (first address, first data, count)
+INDIRECT_TARGET_RANGE = (64, 661)   # Indirect Address range printed in the manual
+
+
+def _indirect() -> dict[str, Entry]:
+    rows: dict[str, Entry] = {}
+    n = 0
+    for addr0, data0, count in INDIRECT_BLOCKS:
+        for k in range(count):
+            n += 1
+            # Initial value: each Indirect Address points at its own Indirect Data byte.
+            rows[f"indirect_address_{n}"] = Entry(addr0 + 2 * k, 2, "RW", data0 + k)
+            rows[f"indirect_data_{n}"] = Entry(data0 + k, 1, "RW", 0)
+    return rows
+
+
+DYNAMIXEL_X: dict[str, Entry] = {
+    # EEPROM (0-63): writable only while Torque Enable(64) is 0.
+    "model_number": Entry(0, 2, "R", None),          # 1060 on the XL430-W250
+    "model_information": Entry(2, 4, "R", None),
+    "firmware_version": Entry(6, 1, "R", None),
+    "id": Entry(7, 1, "RW", 1),
+    "baud_rate": Entry(8, 1, "RW", 1),               # 1 = 57600 bps
+    "return_delay_time": Entry(9, 1, "RW", 250),     # 2 us per step: 500 us
+    "drive_mode": Entry(10, 1, "RW", 0),
+    "operating_mode": Entry(11, 1, "RW", 3),         # 3 = position control
+    "secondary_id": Entry(12, 1, "RW", 255),
+    "protocol_type": Entry(13, 1, "RW", 2),
+    "homing_offset": Entry(20, 4, "RW", 0),
+    "moving_threshold": Entry(24, 4, "RW", 10),
+    "temperature_limit": Entry(31, 1, "RW", 72),
+    "max_voltage_limit": Entry(32, 2, "RW", 140),
+    "min_voltage_limit": Entry(34, 2, "RW", 60),
+    "pwm_limit": Entry(36, 2, "RW", 885),
+    "velocity_limit": Entry(44, 4, "RW", 265),
+    "max_position_limit": Entry(48, 4, "RW", 4095),
+    "min_position_limit": Entry(52, 4, "RW", 0),
+    "startup_configuration": Entry(60, 1, "RW", 0),
+    "shutdown": Entry(63, 1, "RW", 52),
+    # RAM (64-)
+    "torque_enable": Entry(64, 1, "RW", 0),
+    "led": Entry(65, 1, "RW", 0),
+    "status_return_level": Entry(68, 1, "RW", 2),
+    "registered_instruction": Entry(69, 1, "R", 0),
+    "hardware_error_status": Entry(70, 1, "R", 0),
+    "velocity_i_gain": Entry(76, 2, "RW", 1000),
+    "velocity_p_gain": Entry(78, 2, "RW", 100),
+    "position_d_gain": Entry(80, 2, "RW", 4000),
+    "position_i_gain": Entry(82, 2, "RW", 0),
+    "position_p_gain": Entry(84, 2, "RW", 640),
+    "feedforward_2nd_gain": Entry(88, 2, "RW", 0),
+    "feedforward_1st_gain": Entry(90, 2, "RW", 0),
+    "bus_watchdog": Entry(98, 1, "RW", 0),
+    "goal_pwm": Entry(100, 2, "RW", None),
+    "goal_velocity": Entry(104, 4, "RW", None),
+    "profile_acceleration": Entry(108, 4, "RW", 0),
+    "profile_velocity": Entry(112, 4, "RW", 0),
+    "goal_position": Entry(116, 4, "RW", None),
+    "realtime_tick": Entry(120, 2, "R", None),
+    "moving": Entry(122, 1, "R", 0),
+    "moving_status": Entry(123, 1, "R", 0),
+    "present_pwm": Entry(124, 2, "R", None),
+    "present_load": Entry(126, 2, "R", None),
+    "present_velocity": Entry(128, 4, "R", None),
+    "present_position": Entry(132, 4, "R", None),
+    "velocity_trajectory": Entry(136, 4, "R", None),
+    "position_trajectory": Entry(140, 4, "R", None),
+    "present_input_voltage": Entry(144, 2, "R", None),
+    "present_temperature": Entry(146, 1, "R", None),
+    "backup_ready": Entry(147, 1, "R", None),
+    **_indirect(),
+}
+
+FEETECH_STS: dict[str, Entry] = {
+    # EEPROM (0-39): saved only while Lock(55) is 0.
+    "firmware_major": Entry(0, 1, "R", None),
+    "firmware_minor": Entry(1, 1, "R", None),
+    "model_number": Entry(3, 2, "R", None),         # servo major/minor version: 777 = STS3215
+    "id": Entry(5, 1, "RW", 1),
+    "baud_rate": Entry(6, 1, "RW", 0),              # 0 = 1 Mbps
+    "return_delay_time": Entry(7, 1, "RW", 0),
+    "status_return_level": Entry(8, 1, "RW", 1),
+    "min_angle_limit": Entry(9, 2, "RW", 0),
+    "max_angle_limit": Entry(11, 2, "RW", 4095),
+    "max_temperature_limit": Entry(13, 1, "RW", 70),
+    "max_voltage_limit": Entry(14, 1, "RW", None),
+    "min_voltage_limit": Entry(15, 1, "RW", 40),
+    "max_torque_limit": Entry(16, 2, "RW", 1000),
+    "phase": Entry(18, 1, "RW", None),
+    "unloading_condition": Entry(19, 1, "RW", None),
+    "led_alarm_condition": Entry(20, 1, "RW", None),
+    "p_coefficient": Entry(21, 1, "RW", None),
+    "d_coefficient": Entry(22, 1, "RW", None),
+    "i_coefficient": Entry(23, 1, "RW", 0),
+    "minimum_startup_force": Entry(24, 1, "RW", None),
+    "integral_limit": Entry(25, 1, "RW", 0),
+    "cw_dead_zone": Entry(26, 1, "RW", 1),
+    "ccw_dead_zone": Entry(27, 1, "RW", 1),
+    "protection_current": Entry(28, 2, "RW", 511),
+    "angular_resolution": Entry(30, 1, "RW", 1),
+    "homing_offset": Entry(31, 2, "RW", 0),
+    "operating_mode": Entry(33, 1, "RW", 0),
+    "protective_torque": Entry(34, 1, "RW", 20),
+    "protection_time": Entry(35, 1, "RW", 200),
+    "overload_torque": Entry(36, 1, "RW", 80),
+    "speed_p_coefficient": Entry(37, 1, "RW", None),
+    "over_current_protection_time": Entry(38, 1, "RW", 200),
+    "velocity_i_coefficient": Entry(39, 1, "RW", None),
+    # SRAM (40-)
+    "torque_enable": Entry(40, 1, "RW", 0),
+    "acceleration": Entry(41, 1, "RW", 0),
+    "goal_position": Entry(42, 2, "RW", None),     # table: 0; the servo starts at present
+    "goal_time": Entry(44, 2, "RW", 0),
+    "goal_speed": Entry(46, 2, "RW", 0),
+    "torque_limit": Entry(48, 2, "RW", 1000),        # loaded from Max Torque(16)
+    "lock": Entry(55, 1, "RW", 1),
+    "present_position": Entry(56, 2, "R", None),
+    "present_speed": Entry(58, 2, "R", None),
+    "present_load": Entry(60, 2, "R", None),
+    "present_voltage": Entry(62, 1, "R", None),
+    "present_temperature": Entry(63, 1, "R", None),
+    "async_write_flag": Entry(64, 1, "R", 0),        # 1 while a Reg Write waits for Action
+    "status": Entry(65, 1, "R", 0),
+    "moving": Entry(66, 1, "R", 0),
+    "present_current": Entry(69, 2, "R", None),
+}
+
+TABLES: dict[str, dict[str, Entry]] = {"dynamixel_x": DYNAMIXEL_X, "feetech_sts": FEETECH_STS}
+EEPROM_END: dict[str, int] = {"dynamixel_x": 64, "feetech_sts": 40}
+
+#: Registers the X manual gives in two's complement.
+DXL_SIGNED: frozenset[str] = frozenset({
+    "homing_offset", "bus_watchdog", "goal_pwm", "goal_velocity", "goal_position",
+    "present_pwm", "present_load", "present_velocity", "present_position",
+    "velocity_trajectory", "position_trajectory",
+})
+#: Feetech STS sign-magnitude registers: (name, sign bit) (bit 15 direction; load bit 10).
+STS_SIGN_BIT: dict[str, int] = {
+    "homing_offset": 11, "goal_position": 15, "goal_speed": 15, "present_position": 15,
+    "present_speed": 15, "present_load": 10,
+}
+
+#: Baud Rate register codes [bit/s]: X manual "Baud Rate(8)"; STS memory table "Baud Rate(6)".
+BAUD_CODES: dict[str, dict[int, int]] = {
+    "dynamixel_x": {0: 9600, 1: 57600, 2: 115200, 3: 1_000_000, 4: 2_000_000,
+                    5: 3_000_000, 6: 4_000_000, 7: 4_500_000},
+    "feetech_sts": {0: 1_000_000, 1: 500_000, 2: 250_000, 3: 128_000, 4: 115_200,
+                    5: 76_800, 6: 57_600, 7: 38_400},
+}
+
+#: Profile Velocity(112) / Present Velocity(128) unit on X: 0.229 rev/min.
+DXL_VELOCITY_UNIT_RPM = 0.229
+#: STS3215 Goal Speed(46) / Present Speed(58) unit: 1 step/s (4096 steps/rev).
+STS_SPEED_UNIT_TICKS_S = 1.0
+
+
+def read_only(family: str) -> frozenset[str]:
+    """Names the manual marks "R"."""
+    return frozenset(n for n, e in TABLES[family].items() if e.access == "R")

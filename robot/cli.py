@@ -29,6 +29,7 @@ COMMANDS: tuple[str, ...] = (
     "panel",
     "render",
     "plot",
+    "setup_motors",
     "find_port",
     "monitor",
 )

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import logging
 import threading
+import time
 from collections.abc import Callable, Iterable, Mapping
 from types import ModuleType
 from typing import Any, ClassVar
@@ -259,6 +260,39 @@ class SdkBus(Bus):
         model, _ = self._transact("ping", servo_id, lambda: self._ph.ping(self._port, servo_id),
                                   missing_ok=True)
         return None if model is None else int(model)
+
+    def broadcast_ping(self) -> dict[int, int] | None:
+        """``{id: model number}`` of every servo that answers one broadcast ping at the
+        current baud (``{}`` when none does), or None when the SDK has no broadcast ping
+        (scservo_sdk). A garbled reply (two servos sharing an id) raises BusError."""
+        fn = getattr(self._ph, "broadcastPing", None)
+        if fn is None:
+            return None
+        with self._lock:
+            port = self._begin()
+            try:
+                data, result = fn(port)
+            except PORT_ERRORS as e:
+                port.is_using = False
+                raise self._error(None, "broadcast ping", f"port error: {e}", None) from e
+        if result not in (self.sdk.COMM_SUCCESS, self.sdk.COMM_RX_TIMEOUT):
+            raise self._error(None, "broadcast ping", self._ph.getTxRxResult(result), result)
+        return {int(sid): int(v[0]) for sid, v in data.items()}
+
+    def stray_bytes(self, *, wait_s: float = 0.02) -> int:
+        """How many bytes arrive within ``wait_s`` [s] after the last reply (then dropped):
+        more than 0 after a ping means a second servo answered with the same id (on a real
+        bus the replies collide) or line noise."""
+        with self._lock:
+            port = self._begin()
+            time.sleep(wait_s)
+            try:
+                n = int(port.ser.in_waiting)
+                if n:
+                    port.ser.reset_input_buffer()
+            except PORT_ERRORS as e:
+                raise self._error(None, "read stray bytes", f"port error: {e}", None) from e
+        return n
 
     def scan(self, ids: Iterable[int]) -> list[ServoInfo]:
         found: list[ServoInfo] = []

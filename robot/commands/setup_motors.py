@@ -1,0 +1,83 @@
+"""`biped setup-motors`: give each factory-new servo its joint's id and the robot's baud.
+
+Connect one servo at a time (alone on the bus). For each joint it is found at any id and
+any standard baud of the family, given the joint's id, the robot's baud rate and return
+delay 0 (torque off; EEPROM), and checked at the new baud. ``--joint NAME --yes`` does one
+joint without prompts. Refuses, with one line and nothing written, when more than one
+servo answers or the servo is not the robot's model.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+
+from robot.bus.dynamixel import DynamixelBus
+from robot.bus.feetech import FeetechBus
+from robot.bus.sdk_bus import SdkBus
+from robot.bus.tables import BUS_FAMILIES
+from robot.commands.common import add_robot_args, one_line_errors, robot_from
+from robot.config import RobotConfig
+from robot.errors import ConfigError
+from robot.motor_setup import FACTORY_BAUD, assign, check_model, find_servo, joints_to_set
+
+Ask = Callable[[str], str]
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    p = subparsers.add_parser("setup-motors", help="give new servos their joint ids and baud",
+                              description=__doc__)
+    add_robot_args(p, gait=False)
+    p.add_argument("--bus", choices=("dynamixel", "feetech"), default=None,
+                   help="servo bus (default: the robot's)")
+    p.add_argument("--port", default=None, metavar="DEV", help="serial device (default: config)")
+    p.add_argument("--joint", default=None, metavar="NAME",
+                   help="set up only this joint's servo (default: every joint, one by one)")
+    p.add_argument("--yes", action="store_true",
+                   help="no prompt: the servo is already connected (needs --joint)")
+    return one_line_errors(p)
+
+
+def _bus(args: argparse.Namespace, robot: RobotConfig) -> SdkBus:
+    kind = args.bus or robot.bus.kind
+    if kind != robot.bus.kind:
+        raise ConfigError(f"--bus {kind}: robot {robot.name} ({robot.source}) has "
+                          f"{robot.bus.kind} servos; use --bus {robot.bus.kind}")
+    cls = DynamixelBus if kind == "dynamixel" else FeetechBus
+    # No robot on the bus: a servo at id 1 is a new servo, not joint 1 (and no health check).
+    return cls(args.port or robot.bus.port, baud=FACTORY_BAUD[BUS_FAMILIES[kind]],
+               retries=robot.bus.retries, timeout_ms=robot.bus.timeout_ms, check_health=False)
+
+
+def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
+    robot = robot_from(args)
+    if args.yes and not args.joint:
+        raise ConfigError("--yes needs --joint NAME: the servos are set up one at a time, "
+                          "each connected alone")
+    joints = joints_to_set(robot, args.joint)
+    bus = _bus(args, robot)
+    print(f"setting up {len(joints)} {robot.bus.model} servo(s) of {robot.name} on "
+          f"{bus.port_name}: ids from the robot file, {robot.bus.baud} baud, return delay 0 "
+          "(a servo waits that long before every reply: latency in each control tick)")
+    bus.open()
+    try:
+        for joint in joints:
+            if not args.yes:
+                reply = ask(f"connect only the servo for {joint.name} (id {joint.servo_id}) "
+                            "and press Enter (q to stop) ")
+                if reply.strip().lower() == "q":
+                    print("stopped")
+                    return 1
+            found = find_servo(bus, robot, progress=lambda m: print(f"  {m}", flush=True))
+            check_model(found, robot, joint)
+            print(f"  found a {robot.bus.model} at id {found.id}, {found.baud} baud")
+            changes = assign(bus, found, joint, robot)
+            done = "; ".join(changes) if changes else "already set, nothing changed"
+            print(f"{joint.name}: id {joint.servo_id} at {robot.bus.baud} baud, checked "
+                  f"({done})")
+    finally:
+        bus.close(torque_off=False)
+    if not args.joint:
+        print(f"done: connect the chain and check with `biped scan --robot {args.robot} "
+              f"--port {bus.port_name}`")
+    return 0

@@ -1,0 +1,160 @@
+"""`biped setup-motors` end to end on factory-new emulated servos (both protocols)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+import robot.cli as cli
+from robot.bus.tables import BAUD_CODES, BUS_FAMILIES
+from robot.commands import setup_motors
+from robot.config import RobotConfig
+from robot.motor_setup import FACTORY_BAUD, baud_order
+from sim.emulator import Emulator
+
+pytest_plugins = ("bus_harness",)
+
+JOINTS = ("r_hip_yaw", "r_knee", "l_elbow")          # ids 1, 4, 18
+OTHER_MODEL = {"dynamixel": "XM430-W350", "feetech": "STS3032"}
+WRITES = ("write", "sync_write", "bulk_write", "reg_write")
+
+
+@pytest.fixture(autouse=True)
+def only_this_command(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Build the CLI from the command under test only (others may be unfinished)."""
+    monkeypatch.setattr(cli, "COMMANDS", ("setup_motors", "scan"))
+
+
+@pytest.fixture
+def fresh(protocol: str) -> Iterator[Emulator]:
+    with Emulator.factory_new(protocol, len(JOINTS)) as e:
+        yield e
+
+
+def setup(emu: Emulator, robot_toml: Path, *extra: str) -> int:
+    return cli.main(["setup-motors", "--robot", str(robot_toml), "--bus", emu.protocol,
+                     "--port", emu.port, *extra])
+
+
+def writes(emu: Emulator) -> list[str]:
+    return [p.instruction for p in emu.log() if p.instruction in WRITES]
+
+
+def test_baud_order_puts_factory_and_robot_rates_first() -> None:
+    for family, codes in BAUD_CODES.items():
+        order = baud_order(family, 1_000_000)
+        assert order[0] == FACTORY_BAUD[family]
+        assert order[1] == 1_000_000 or FACTORY_BAUD[family] == 1_000_000
+        assert sorted(order) == sorted(codes.values())
+
+
+def test_each_new_servo_gets_its_joint_id_and_the_robot_baud(
+        fresh: Emulator, robot: RobotConfig, robot_toml: Path, bus_factory,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    family = BUS_FAMILIES[robot.bus.kind]
+    for index, joint in enumerate(JOINTS):
+        fresh.plug(index)
+        assert setup(fresh, robot_toml, "--joint", joint, "--yes") == 0
+        out = capsys.readouterr().out
+        assert f"{joint}: id {robot.joint(joint).servo_id} at {robot.bus.baud} baud" in out
+        regs = fresh.registers_of(index)
+        assert regs["id"] == robot.joint(joint).servo_id
+        assert BAUD_CODES[family][regs["baud_rate"]] == robot.bus.baud
+        assert regs["return_delay_time"] == 0
+        assert regs["torque_enable"] == 0
+        if fresh.protocol == "dynamixel":   # factory 57600 baud, return delay 500 us
+            assert "baud 57600 -> 1000000" in out and "return delay 500 µs -> 0" in out
+    fresh.plug_all()
+    bus = bus_factory(fresh, robot, check_health=False)
+    try:
+        found = {s.id: s for s in bus.scan(range(0, 21))}
+    finally:
+        bus.close(torque_off=False)
+    assert sorted(found) == sorted(robot.joint(j).servo_id for j in JOINTS)
+    assert {s.model for s in found.values()} == {robot.bus.servo.number}
+    assert {s.return_delay_us for s in found.values()} == {0.0}
+
+
+def test_two_servos_connected_is_refused_with_nothing_written(
+        fresh: Emulator, robot_toml: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    fresh.plug_all()          # three new servos, all id 1 at the factory baud
+    fresh.log(clear=True)
+    assert setup(fresh, robot_toml, "--joint", "r_knee", "--yes") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "more than one servo answers as id 1" in err
+    assert "connect only the servo" in err
+    assert writes(fresh) == []
+    assert all(fresh.registers_of(i)["id"] == 1 for i in range(len(JOINTS)))
+
+
+def test_a_set_up_servo_left_on_the_chain_is_refused(
+        fresh: Emulator, robot_toml: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    fresh.plug(0)
+    assert setup(fresh, robot_toml, "--joint", "r_knee", "--yes") == 0
+    fresh.plug_all()          # the r_knee servo (id 4) and two new ones at id 1
+    capsys.readouterr()
+    fresh.log(clear=True)
+    assert setup(fresh, robot_toml, "--joint", "l_elbow", "--yes") == 2
+    assert "more than one servo" in capsys.readouterr().err
+    assert writes(fresh) == []
+
+
+def test_wrong_model_is_refused(protocol: str, robot_toml: Path,
+                                capsys: pytest.CaptureFixture[str]) -> None:
+    with Emulator.factory_new(protocol, 1, model=OTHER_MODEL[protocol]) as emu:
+        emu.plug(0)
+        emu.log(clear=True)
+        assert setup(emu, robot_toml, "--joint", "r_knee", "--yes") == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1
+        assert f"is a {OTHER_MODEL[protocol]}" in err and "for r_knee" in err
+        assert "bus.model" in err
+        assert writes(emu) == []
+
+
+def test_nothing_connected_says_check_power(fresh: Emulator, robot_toml: Path,
+                                            capsys: pytest.CaptureFixture[str],
+                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr("robot.motor_setup.ALL_IDS", range(0, 3))   # keep the sweep short
+    monkeypatch.setattr("robot.motor_setup.baud_order",
+                        lambda family, baud: sorted({FACTORY_BAUD[family], baud}))
+    assert setup(fresh, robot_toml, "--joint", "r_knee", "--yes") == 2
+    assert "no servo answers" in capsys.readouterr().err
+
+
+def test_bad_options_are_one_line(fresh: Emulator, robot_toml: Path,
+                                  capsys: pytest.CaptureFixture[str]) -> None:
+    assert setup(fresh, robot_toml, "--yes") == 2
+    assert "--yes needs --joint" in capsys.readouterr().err
+    assert setup(fresh, robot_toml, "--joint", "tail", "--yes") == 2
+    assert "no joint 'tail'" in capsys.readouterr().err
+    other = "feetech" if fresh.protocol == "dynamixel" else "dynamixel"
+    assert cli.main(["setup-motors", "--robot", str(robot_toml), "--bus", other, "--port",
+                     fresh.port, "--joint", "r_knee", "--yes"]) == 2
+    assert f"use --bus {fresh.protocol}" in capsys.readouterr().err
+
+
+def test_prompts_walk_the_joints_in_order(fresh: Emulator, robot: RobotConfig,
+                                          robot_toml: Path,
+                                          capsys: pytest.CaptureFixture[str]) -> None:
+    prompts: list[str] = []
+
+    def ask(prompt: str) -> str:
+        prompts.append(prompt)
+        if len(prompts) > 2:
+            return "q"
+        fresh.plug(len(prompts) - 1)     # the user connects the next new servo
+        return ""
+
+    args = cli.build_parser().parse_args(["setup-motors", "--robot", str(robot_toml),
+                                          "--port", fresh.port])
+    assert setup_motors.run(args, ask=ask) == 1
+    first, second = robot.joints[0], robot.joints[1]
+    assert prompts[0].startswith(f"connect only the servo for {first.name} "
+                                 f"(id {first.servo_id}) and press Enter")
+    assert f"for {second.name} (id {second.servo_id})" in prompts[1]
+    assert fresh.registers_of(0)["id"] == first.servo_id
+    assert fresh.registers_of(1)["id"] == second.servo_id
+    assert "stopped" in capsys.readouterr().out

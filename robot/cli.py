@@ -30,6 +30,7 @@ COMMANDS: tuple[str, ...] = (
     "render",
     "plot",
     "setup_motors",
+    "calibrate",
     "find_port",
     "monitor",
 )

@@ -200,6 +200,17 @@ def assign(bus: SdkBus, found: Found, joint: JointConfig, robot: RobotConfig) ->
     return changes
 
 
+def answered(ask: Callable[[str], str], consequence: str) -> Callable[[str], str]:
+    """``ask`` with end of input (stdin closed, Ctrl-D) turned into a one-line ConfigError."""
+    def wrapped(prompt: str) -> str:
+        try:
+            return ask(prompt)
+        except EOFError:
+            raise ConfigError(f"input ended before the last prompt was answered; "
+                              f"{consequence}") from None
+    return wrapped
+
+
 def joints_to_set(robot: RobotConfig, name: str | None) -> Sequence[JointConfig]:
     """The joint ``name`` (ConfigError naming the valid ones), or every joint in order."""
     return [robot.joint(name)] if name else list(robot.joints)

@@ -19,7 +19,14 @@ from robot.bus.tables import BUS_FAMILIES
 from robot.commands.common import add_robot_args, one_line_errors, robot_from
 from robot.config import RobotConfig
 from robot.errors import ConfigError
-from robot.motor_setup import FACTORY_BAUD, assign, check_model, find_servo, joints_to_set
+from robot.motor_setup import (
+    FACTORY_BAUD,
+    answered,
+    assign,
+    check_model,
+    find_servo,
+    joints_to_set,
+)
 
 Ask = Callable[[str], str]
 
@@ -55,6 +62,7 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
         raise ConfigError("--yes needs --joint NAME: the servos are set up one at a time, "
                           "each connected alone")
     joints = joints_to_set(robot, args.joint)
+    ask = answered(ask, "the servos set up so far keep their new id")
     bus = _bus(args, robot)
     print(f"setting up {len(joints)} {robot.bus.model} servo(s) of {robot.name} on "
           f"{bus.port_name}: ids from the robot file, {robot.bus.baud} baud, return delay 0 "

@@ -1,0 +1,168 @@
+"""`biped calibrate`: measure zero_ticks, sign and (optionally) limits by hand; write a new
+robot TOML.
+
+Torque stays off the whole time and no goal is ever written: the robot does not move by
+itself. Step 1: hold the robot in its zero pose (every joint at 0 rad: standing straight,
+feet flat and parallel, arms hanging at the sides) and zero_ticks are read from the present
+positions. Step 2: move each joint by hand the way the prompt says; the direction of the
+tick change confirms or flips its sign. Step 3 (``--limits``): move each joint to both ends
+of its free range; min_rad/max_rad are recorded inside the servo's own limits. The output
+keeps the input's comments and layout and is validated before it is written.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+from pathlib import Path
+
+from robot.bus.base import Bus
+from robot.calibration import (
+    MOVE_THRESHOLD_RAD,
+    detect_sign,
+    direction_words,
+    limits_from_ends,
+    probe_direction,
+    zero_ticks,
+)
+from robot.commands.common import (
+    add_bus_args,
+    add_robot_args,
+    bus_from,
+    one_line_errors,
+    output_file,
+    robot_from,
+)
+from robot.config import JointConfig, RobotConfig
+from robot.errors import ConfigError
+from robot.motor_setup import answered
+from robot.robot_toml_edit import same_path, write_validated
+
+Ask = Callable[[str], str]
+#: Prompts per joint in step 2 before its sign is kept as it was.
+SIGN_TRIES = 3
+#: The servo's own position-limit registers, per bus kind.
+LIMIT_REGISTERS = {"dynamixel": ("min_position_limit", "max_position_limit"),
+                   "feetech": ("min_angle_limit", "max_angle_limit")}
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    p = subparsers.add_parser("calibrate", help="measure zero, sign and limits by hand "
+                              "(torque off) into a new robot TOML", description=__doc__)
+    add_robot_args(p, gait=False)
+    add_bus_args(p, choices=("dynamixel", "feetech"))
+    p.add_argument("--out", required=True, type=output_file, metavar="NEW.toml",
+                   help="robot TOML to write (a copy of --robot with the measured values)")
+    p.add_argument("--overwrite", action="store_true", help="allow --out to be the --robot file")
+    p.add_argument("--zero", action="store_true", help="step 1 only (zero_ticks)")
+    p.add_argument("--limits", action="store_true", help="also step 3: record min/max_rad")
+    p.add_argument("--yes", action="store_true",
+                   help="no prompt: the robot is already held in its zero pose (needs --zero)")
+    return one_line_errors(p)
+
+
+def _position(bus: Bus, joint: JointConfig) -> int:
+    return bus.read_positions([joint.servo_id])[joint.servo_id]
+
+
+def _signs(bus: Bus, robot: RobotConfig, ask: Ask) -> dict[str, int]:
+    """Step 2: ``{joint: sign}`` from one hand move per joint."""
+    res = robot.bus.servo.resolution
+    out: dict[str, int] = {}
+    print(f"step 2: move each joint by hand, about 20-30 degrees, the way it says "
+          f"(a move under {MOVE_THRESHOLD_RAD} rad does not count)")
+    for j in robot.joints:
+        direction = probe_direction(robot, j.name)
+        for _ in range(SIGN_TRIES):
+            before = _position(bus, j)
+            ask(f"{j.name} (id {j.servo_id}): move it so that {direction_words(j.name, direction)}"
+                f" ({'+' if direction > 0 else '-'} direction), hold it and press Enter ")
+            reading = detect_sign(before, _position(bus, j), direction=direction,
+                                  resolution=res)
+            if reading.sign is not None:
+                out[j.name] = reading.sign
+                flip = " (flipped)" if reading.sign != j.sign else ""
+                print(f"  {j.name}: {reading.delta:+d} ticks -> sign {reading.sign:+d}{flip}")
+                break
+            print(f"  {j.name}: moved only {reading.delta:+d} ticks; again, further")
+        else:
+            print(f"  {j.name}: no move seen; sign kept at {j.sign:+d}")
+            out[j.name] = j.sign
+        ask(f"put {j.name} back to its zero pose and press Enter ")
+    return out
+
+
+def _limits(bus: Bus, robot: RobotConfig, zeros: dict[str, int], signs: dict[str, int],
+            kind: str, ask: Ask) -> dict[str, tuple[float, float]]:
+    """Step 3: ``{joint: (min_rad, max_rad)}`` from the two ends of each joint's free range."""
+    res = robot.bus.servo.resolution
+    read = getattr(bus, "read_register", None)
+    out: dict[str, tuple[float, float]] = {}
+    print("step 3: move each joint by hand to both ends of its free range (where it touches "
+          "the frame or a cable pulls), gently")
+    for j in robot.joints:
+        ends = []
+        for which in ("one end", "the other end"):
+            ask(f"{j.name} (id {j.servo_id}): hold it at {which} of its free range and "
+                "press Enter ")
+            ends.append(_position(bus, j))
+        servo_limits = None
+        if read is not None:
+            lo, hi = (int(read(j.servo_id, r)) for r in LIMIT_REGISTERS[kind])
+            servo_limits = (lo, hi) if lo < hi else None
+        out[j.name] = limits_from_ends(*ends, zero=zeros[j.name], sign=signs[j.name],
+                                       resolution=res, servo_limits=servo_limits)
+        print(f"  {j.name}: [{out[j.name][0]:+.3f}, {out[j.name][1]:+.3f}] rad")
+        ask(f"put {j.name} back to its zero pose and press Enter ")
+    return out
+
+
+def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
+    robot = robot_from(args)
+    source, out = Path(robot.source), Path(args.out)   # --robot may be a bundled name
+    if same_path(source, out) and not args.overwrite:
+        raise ConfigError(f"--out {args.out}: is the --robot file ({source}); write a new "
+                          "file and compare, or add --overwrite")
+    ask = answered(ask, "nothing was written")
+    if args.yes and not args.zero:
+        raise ConfigError("--yes needs --zero: steps 2 and 3 need a human moving the joints")
+    if args.zero and args.limits:
+        raise ConfigError("--zero runs step 1 alone; drop --limits or --zero")
+    kind = args.bus or robot.bus.kind
+    bus = bus_from(args, robot)
+    bus.open()
+    try:
+        bus.set_torque(robot.ids, enabled=False)
+        print(f"torque OFF on {len(robot.ids)} servos: the robot is limp and will not move "
+              "by itself; support it")
+        if not args.yes:
+            ask("step 1: hold the robot in its zero pose (standing straight, feet flat and "
+                "parallel, arms hanging at the sides) and press Enter ")
+        zeros = zero_ticks(bus.read_positions(robot.ids), robot)
+        signs = {j.name: j.sign for j in robot.joints}
+        limits: dict[str, tuple[float, float]] = {}
+        if not args.zero:
+            signs = _signs(bus, robot, ask)
+            if args.limits:
+                limits = _limits(bus, robot, zeros, signs, kind, ask)
+    finally:
+        bus.close(torque_off=False)
+    changes: dict[str, dict[str, int | float]] = {}
+    for j in robot.joints:
+        changes[j.name] = {"zero_ticks": zeros[j.name], "sign": signs[j.name]}
+        if j.name in limits:
+            changes[j.name].update(min_rad=limits[j.name][0], max_rad=limits[j.name][1])
+    write_validated(source, out, changes)
+    _report(robot, changes, out)
+    return 0
+
+
+def _report(robot: RobotConfig, changes: dict[str, dict[str, int | float]], out: Path) -> None:
+    print(f"{'joint':<18} {'zero_ticks':>15} {'sign':>9}  limits [rad]")
+    for j in robot.joints:
+        c = changes[j.name]
+        lim = (f"[{c['min_rad']:+.3f}, {c['max_rad']:+.3f}]" if "min_rad" in c
+               else f"[{j.min_rad:+.3f}, {j.max_rad:+.3f}] (kept)")
+        print(f"{j.name:<18} {j.zero_ticks:>6} -> {c['zero_ticks']:<5} "
+              f"{j.sign:+d} -> {c['sign']:+d}  {lim}")
+    print(f"wrote {out}; check it with `biped monitor --robot {out}` by moving joints by hand")

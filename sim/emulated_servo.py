@@ -23,18 +23,9 @@ import math
 from dataclasses import dataclass
 
 from robot.bus.tables import COMM_WATCHDOG, ERROR_BITS, MODELS, RETURN_DELAY_UNIT_S
-from sim.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, Entry, read_only
+from sim import servo_motion, servo_write
+from sim.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, Entry
 
-#: Registers a host may not write (the manual marks them "R"; an access error).
-READ_ONLY: dict[str, frozenset[str]] = {fam: read_only(fam) for fam in TABLES}
-#: Allowed raw values of a few registers [inclusive range]; others accept any value.
-VALID_RANGE: dict[str, tuple[int, int]] = {
-    "torque_enable": (0, 1),
-    "led": (0, 1),
-    "status_return_level": (0, 2),
-    "return_delay_time": (0, 254),
-    "id": (0, 252),
-}
 #: Values where the manual prints "-" (firmware, sensors, tuning the factory sets per
 #: unit): what this emulator reports. The manual's initial values come from the table.
 UNPRINTED: dict[str, dict[str, int]] = {
@@ -112,6 +103,12 @@ class EmulatedServo:
         self.eeprom_end = EEPROM_END[self.family]   # EEPROM below, RAM from here
         self._saved = bytes(self.mem[:self.eeprom_end])   # EEPROM as kept over power-off
         self._ram_at_power_on = bytes(self.mem[self.eeprom_end:])
+        self.pending: tuple[int, bytes] | None = None     # a Reg Write waiting for Action
+        self._registered = ("registered_instruction" if self.family == "dynamixel_x"
+                            else "async_write_flag")
+        # Indirect Data address -> name of the Indirect Address register pointing it (X).
+        self._indirect = {e.address: name.replace("data", "address")
+                          for name, e in self.table.items() if name.startswith("indirect_data")}
 
     # ------------------------------------------------------------------ raw access
     def get(self, name: str) -> int:
@@ -120,6 +117,12 @@ class EmulatedServo:
         signed = self.family == "dynamixel_x" and name in DXL_SIGNED
         return int.from_bytes(self.mem[reg.address:reg.address + reg.size], "little",
                               signed=signed)
+
+    def set_raw(self, name: str, value: int) -> None:
+        """Store a register by name, leaving the position model alone."""
+        reg = self.table[name]
+        self.mem[reg.address:reg.address + reg.size] = (value % (1 << 8 * reg.size)).to_bytes(
+            reg.size, "little")
 
     def set(self, name: str, value: int) -> None:
         """Store a register by name without any check (the emulator's back door)."""
@@ -187,16 +190,7 @@ class EmulatedServo:
     def _advance(self, now: float) -> None:
         dt = max(0.0, now - self._t)
         self._t = now
-        goal = self.get("goal_position")
-        if self.get("torque_enable") and not self.stuck:
-            step = self.speed_tps * dt
-            self._pos = min(goal, self._pos + step) if goal > self._pos else max(
-                goal, self._pos - step)
-        present = round(self._pos)
-        reg = self.table["present_position"]
-        self.mem[reg.address:reg.address + reg.size] = (present % (1 << 8 * reg.size)).to_bytes(
-            reg.size, "little")
-        self.set("moving", int(present != goal and bool(self.get("torque_enable"))))
+        self._pos = servo_motion.advance(self, self._pos, dt)
 
     def _assert_faults(self) -> None:
         bits = {name: bit for bit, name in ERROR_BITS[self.family].items()}
@@ -216,51 +210,85 @@ class EmulatedServo:
 
     def read(self, address: int, length: int) -> bytes | None:
         """``length`` bytes from ``address``; None when the range leaves the table or holds
-        no register at all (undefined address: the manual's Access Error)."""
+        no register at all (undefined address: the manual's Access Error). Indirect Data
+        bytes read the byte their Indirect Address points at."""
         if address < 0 or length < 0 or address + length > len(self.mem):
             return None
         if length and not any(self._owner[address:address + length]):
             return None
-        return bytes(self.mem[address:address + length])
+        out = bytearray(self.mem[address:address + length])
+        for i in range(length):
+            target = self._indirect_target(address + i)
+            if target is not None:
+                out[i] = self.mem[target]
+        return bytes(out)
 
     def write(self, address: int, data: bytes) -> WriteError:
-        """Apply a host write if every byte lands in whole, writable registers."""
-        end = address + len(data)
-        if address < 0 or end > len(self.mem) or not data:
-            return WriteError.ACCESS
-        touched: list[tuple[str, Entry]] = []
-        for a in range(address, end):
-            owner = self._owner[a]
-            if not owner:
-                return WriteError.ACCESS
-            name, reg = self._regs[owner - 1]
-            if not touched or touched[-1][0] != name:
-                touched.append((name, reg))
-        if touched[0][1].address < address or touched[-1][1].address + touched[-1][1].size > end:
-            return WriteError.LENGTH
-        values: dict[str, int] = {}
-        for name, reg in touched:
-            if name in READ_ONLY[self.family]:
-                return WriteError.ACCESS
-            if (self.family == "dynamixel_x" and reg.address < self.eeprom_end
-                    and self.get("torque_enable")):
-                return WriteError.ACCESS
-            raw = data[reg.address - address:reg.address - address + reg.size]
-            values[name] = decode_value(self.family, reg.address, raw)
-            err = self._check(name, values[name])
+        """Apply a host write if every byte lands in whole, writable registers (Indirect
+        Data bytes land where their Indirect Address points); all or nothing."""
+        plans = []
+        for run_address, run in self._runs(address, data):
+            err, values = servo_write.plan(self, run_address, run)
             if err is not WriteError.NONE:
                 return err
-            if name == "goal_position" and self.family == "feetech_sts":
-                values[name] = min(max(values[name], self.get("min_angle_limit")),
-                                   self.get("max_angle_limit"))
-        shutdown = self.family == "dynamixel_x" and self.get("hardware_error_status") != 0
-        for name, v in values.items():
-            if name == "torque_enable" and shutdown:
-                continue  # refused while in shutdown; the status carries the alert bit
-            self.set(name, v)
+            plans.append(values)
+        for values in plans:
+            servo_write.apply(self, values)
         if address < self.eeprom_end and self._keeps_eeprom():
             self._saved = bytes(self.mem[:self.eeprom_end])
         return WriteError.NONE
+
+    def _indirect_target(self, address: int) -> int | None:
+        name = self._indirect.get(address)
+        return None if name is None else self.get(name)
+
+    def _runs(self, address: int, data: bytes) -> list[tuple[int, bytes]]:
+        """The write as (address, bytes) runs after indirect translation."""
+        runs: list[tuple[int, bytearray]] = []
+        for i, b in enumerate(data):
+            target = self._indirect_target(address + i)
+            a = address + i if target is None else target
+            if runs and runs[-1][0] + len(runs[-1][1]) == a:
+                runs[-1][1].append(b)
+            else:
+                runs.append((a, bytearray([b])))
+        return [(a, bytes(d)) for a, d in runs] or [(address, b"")]
+
+    # ------------------------------------------------------------------ instructions
+    def reg_write(self, address: int, data: bytes) -> WriteError:
+        """Reg Write: hold the write until Action; the flag register reads 1 meanwhile."""
+        if address < 0 or address + len(data) > len(self.mem) or not data:
+            return WriteError.ACCESS
+        self.pending = (address, bytes(data))
+        self.set(self._registered, 1)
+        return WriteError.NONE
+
+    def action(self) -> WriteError:
+        """Action: execute the registered write, if any."""
+        pending, self.pending = self.pending, None
+        self.set(self._registered, 0)
+        return WriteError.NONE if pending is None else self.write(*pending)
+
+    def factory_reset(self, option: int) -> None:
+        """X Factory Reset: 0xFF everything, 0x01 all but ID, 0x02 all but ID and baud."""
+        keep = {0x01: ("id",), 0x02: ("id", "baud_rate")}.get(option, ())
+        kept = {name: self.get(name) for name in keep}
+        pos = round(self._pos)
+        for name, e in self.table.items():
+            self.set_raw(name, e.initial if e.initial is not None else 0)
+        for name, v in {**UNPRINTED[self.family], "model_number": self.model.number,
+                        **kept}.items():
+            self.set_raw(name, v)
+        self._saved = bytes(self.mem[:self.eeprom_end])
+        self.set("present_position", pos)
+        self.set("goal_position", pos)
+
+    def clear_multi_turn(self) -> None:
+        """X Clear (multi-turn): present position back within one turn, while stopped."""
+        if not self.get("moving"):
+            pos = round(self._pos) % self.model.resolution
+            self.set("present_position", pos)
+            self.set("goal_position", pos)
 
     def _keeps_eeprom(self) -> bool:
         """Whether an EEPROM write survives power-off: always on Dynamixel X; on Feetech
@@ -282,30 +310,10 @@ class EmulatedServo:
         self.set("goal_position", pos)
         self._t = self.heard = now
 
-    def _check(self, name: str, value: int) -> WriteError:
-        lo_hi = VALID_RANGE.get(name)
-        if lo_hi and not lo_hi[0] <= value <= lo_hi[1]:
-            return WriteError.RANGE
-        if name == "baud_rate" and value not in BAUD_CODES[self.family]:
-            return WriteError.RANGE
-        wd = self.watchdog
-        if wd is not None and name == wd.register and not (
-                value == wd.off or wd.steps[0] <= value <= wd.steps[1]):
-            return WriteError.RANGE
-        if name == "goal_position" and self.watchdog_tripped:
-            return WriteError.RANGE     # goals are read-only until the watchdog is cleared
-        if name == "goal_position" and self.family == "dynamixel_x":
-            if not self.get("min_position_limit") <= value <= self.get("max_position_limit"):
-                return WriteError.LIMIT
-        return WriteError.NONE
-
     def reboot(self) -> None:
-        """Dynamixel reboot: clear latched errors, torque and the watchdog; goal := present."""
-        self.set("hardware_error_status", 0)
-        if self.watchdog is not None:
-            self.set(self.watchdog.register, self.watchdog.off)
-        self.set("torque_enable", 0)
-        self.set("goal_position", round(self._pos))
+        """Reboot: like a power cycle (RAM to its power-on values, latched errors gone)."""
+        self.power_on(self._t)
+        self.pending = None
         self._assert_faults()
 
 

@@ -66,11 +66,20 @@ def is_name(text: str) -> bool:
     return "/" not in text and "\\" not in text and not text.endswith(".toml")
 
 
+def _existing(option: str, path: Path, names: str) -> Path:
+    """``path`` if it exists (read_toml reports what else is wrong with it); else a one-line
+    ConfigError that also lists the bundled names (given without ``.toml``)."""
+    if not path.exists():
+        raise ConfigError(f"{option} {path}: file not found; give an existing .toml path or "
+                          f"a name without .toml ({names})")
+    return path
+
+
 def resolve_robot_path(name_or_path: str | Path) -> Path:
     """A bundled robot name (``biped18-feetech``) or a path to a TOML file → a path."""
     s = str(name_or_path)
     if isinstance(name_or_path, Path) or not is_name(s):
-        return Path(s)
+        return _existing("--robot", Path(s), f"bundled robots: {', '.join(robot_names())}")
     p = ROBOTS_DIR / f"{s}.toml"
     if not p.is_file():
         raise ConfigError(f"--robot: unknown robot {s!r}; valid: {', '.join(robot_names())} "
@@ -83,7 +92,7 @@ def resolve_gait_path(name_or_path: str | Path) -> Path:
     TOML file → a path."""
     s = str(name_or_path)
     if isinstance(name_or_path, Path) or not is_name(s):
-        return Path(s)
+        return _existing("--gait", Path(s), f"bundled presets: {', '.join(gait_names())}")
     bundled = GAITS_DIR / f"{s}.toml"
     if bundled.is_file():
         return bundled

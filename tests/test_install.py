@@ -117,6 +117,18 @@ def test_unknown_names_list_the_valid_ones() -> None:
     assert all(n in msg for n in gait_names()) and "path" in msg
 
 
+def test_a_missing_path_lists_the_bundled_names(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError) as e:
+        load_robot("biped18-feetech.toml")   # a name given as a file name
+    msg = str(e.value)
+    assert msg.startswith("--robot biped18-feetech.toml: file not found") and "\n" not in msg
+    assert all(n in msg for n in robot_names())
+    with pytest.raises(ConfigError) as e:
+        load_gait(str(tmp_path / "nowhere.toml"))
+    msg = str(e.value)
+    assert "nowhere.toml: file not found" in msg and all(n in msg for n in gait_names())
+
+
 def test_gait_name_finds_a_user_preset_after_the_bundled_ones(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path))

@@ -158,3 +158,26 @@ def test_prompts_walk_the_joints_in_order(fresh: Emulator, robot: RobotConfig,
     assert fresh.registers_of(0)["id"] == first.servo_id
     assert fresh.registers_of(1)["id"] == second.servo_id
     assert "stopped" in capsys.readouterr().out
+
+
+def test_a_servo_at_an_odd_id_and_baud_is_found_by_the_sweep(
+        protocol: str, robot: RobotConfig, robot_toml: Path,
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    family = BUS_FAMILIES[protocol]
+    odd_baud = 115_200
+    monkeypatch.setattr("robot.motor_setup.ALL_IDS", range(25, 36))   # per-id pings: short
+    monkeypatch.setattr("robot.motor_setup.baud_order",
+                        lambda fam, baud: [FACTORY_BAUD[fam], baud, odd_baud])
+    with Emulator.factory_new(protocol, 1) as emu:
+        emu.plug(0)
+        emu.set_register(1, "id", 30)
+        codes = {b: c for c, b in BAUD_CODES[family].items()}
+        emu.set_register(30, "baud_rate", codes[odd_baud])
+        assert setup(emu, robot_toml, "--joint", "l_knee", "--yes") == 0
+        out = capsys.readouterr().out
+        assert f"scanning every id at {odd_baud} baud" in out
+        assert f"id 30 -> 10; baud {odd_baud} -> {robot.bus.baud}" in out
+        regs = emu.registers_of(0)
+        assert regs["id"] == 10 and BAUD_CODES[family][regs["baud_rate"]] == robot.bus.baud
+        broadcast = [p for p in emu.log() if p.instruction == "ping" and p.ids == (0xFE,)]
+        assert bool(broadcast) == (protocol == "dynamixel")   # scservo_sdk has none

@@ -37,7 +37,6 @@ from robot.joint_names import (  # noqa: F401 (re-exported)
 from robot.params import SPECS, GaitParams, canonical_name, check_value
 from robot.toml_io import Range, build, number, read_toml, show, spec, table
 
-
 # Valid ranges of the numeric fields (checked at load; see robot/toml_io.py).
 #: bus.retries: extra attempts per transaction; more than 10 only hides a broken bus.
 RETRIES = Range(0, 10)

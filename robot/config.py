@@ -24,17 +24,18 @@ from robot.bundled import (  # noqa: F401  (re-exported: where configs come from
     robot_names,
 )
 from robot.bus.tables import MODELS, ServoModel
-from robot.config_checks import check_bus, check_ticks
+from robot.config_checks import check_bus, check_joint_extras, check_joint_set, check_ticks
 from robot.errors import ConfigError
+from robot.joint_names import (  # noqa: F401 (re-exported)
+    ARM_JOINTS,
+    ARM_NAMES,
+    JOINT_NAMES,
+    LEG_JOINTS,
+    LEG_NAMES,
+    SIDES,
+)
 from robot.params import SPECS, GaitParams, canonical_name, check_value
 from robot.toml_io import Range, build, number, read_toml, show, spec, table
-
-SIDES = ("r", "l")
-LEG_JOINTS = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
-ARM_JOINTS = ("shoulder_pitch", "shoulder_roll", "elbow")
-LEG_NAMES = tuple(f"{s}_{j}" for s in SIDES for j in LEG_JOINTS)
-ARM_NAMES = tuple(f"{s}_{j}" for s in SIDES for j in ARM_JOINTS)
-JOINT_NAMES = LEG_NAMES + ARM_NAMES
 
 # Valid ranges of the numeric fields (checked at load; see robot/toml_io.py).
 #: bus.retries: extra attempts per transaction; more than 10 only hides a broken bus.
@@ -91,9 +92,9 @@ class Geometry:
     foot_forward: float = field(metadata=spec(LENGTH))
     torso_height: float = field(metadata=spec(LENGTH))
     torso_depth: float = field(metadata=spec(LENGTH))
-    shoulder_width: float = field(metadata=spec(LENGTH))
-    upper_arm: float = field(metadata=spec(LENGTH))
-    forearm: float = field(metadata=spec(LENGTH))
+    shoulder_width: float = field(default=0.0, metadata=spec(LENGTH))  # arms only
+    upper_arm: float = field(default=0.0, metadata=spec(LENGTH))       # arms only
+    forearm: float = field(default=0.0, metadata=spec(LENGTH))         # arms only
 
     @property
     def leg_length(self) -> float:
@@ -112,15 +113,15 @@ class Masses:
     shin: float = field(metadata=spec(MASS))
     ankle_link: float = field(metadata=spec(MASS))
     foot: float = field(metadata=spec(MASS))
-    upper_arm: float = field(metadata=spec(MASS))
-    forearm: float = field(metadata=spec(MASS))
+    upper_arm: float = field(default=0.0, metadata=spec(MASS))   # arms only
+    forearm: float = field(default=0.0, metadata=spec(MASS))     # arms only
     shoulder_link: float = field(default=0.03, metadata=spec(MASS))
 
     @property
     def total(self) -> float:
         leg = (self.hip_yaw_link + self.hip_roll_link + self.thigh + self.shin
                + self.ankle_link + self.foot)
-        arm = self.shoulder_link + self.upper_arm + self.forearm
+        arm = self.shoulder_link + self.upper_arm + self.forearm if self.upper_arm else 0.0
         return self.torso + 2 * leg + 2 * arm
 
 
@@ -129,7 +130,10 @@ class JointConfig:
     """One joint and its servo.
 
     servo_id: bus id; sign: +1/-1 (servo direction vs joint axis); zero_ticks: ticks at
-    0 rad; min_rad, max_rad: joint limits [rad]; max_speed_rad_s: slew limit [rad/s].
+    0 rad; min_rad, max_rad: joint limits [rad]; max_speed_rad_s: slew limit [rad/s];
+    model: this joint's servo model when it differs from ``bus.model`` (same family, e.g.
+    stronger knees); fixed_rad: an extra joint (head pan, tilt, ...) held at this angle
+    [rad] while the gait runs (only for joints the gait does not drive).
     """
 
     name: str
@@ -139,6 +143,8 @@ class JointConfig:
     min_rad: float = field(metadata=spec(ANGLE))
     max_rad: float = field(metadata=spec(ANGLE))
     max_speed_rad_s: float = field(metadata=spec(SPEED))
+    model: str | None = None
+    fixed_rad: float | None = field(default=None, metadata=spec(ANGLE))
 
 
 @dataclass(frozen=True)
@@ -165,6 +171,27 @@ class RobotConfig:
     @property
     def has_arms(self) -> bool:
         return any(j.name in ARM_NAMES for j in self.joints)
+
+    @property
+    def has_hip_yaw(self) -> bool:
+        """False for 5-DoF legs (no hip yaw: the gait cannot turn by yawing the feet)."""
+        return "r_hip_yaw" in self.joint_names
+
+    def servo(self, joint: JointConfig) -> ServoModel:
+        """The servo model of ``joint`` (its own ``model``, else the bus's)."""
+        return MODELS[joint.model or self.bus.model]
+
+    @property
+    def layout(self) -> tuple[tuple[int, float], ...] | None:
+        """How the engine's full joint vector (``JOINT_NAMES`` order, legs then arms) maps
+        onto this robot's joints: per joint (index into it, or -1 and the fixed angle).
+        None when the robot is exactly the leading part of ``JOINT_NAMES`` (no mapping)."""
+        full = JOINT_NAMES if self.has_arms else LEG_NAMES
+        if self.joint_names == full:
+            return None
+        index = {n: i for i, n in enumerate(full)}
+        return tuple((index[j.name], 0.0) if j.fixed_rad is None else (-1, j.fixed_rad)
+                     for j in self.joints)
 
     @property
     def ids(self) -> tuple[int, ...]:
@@ -215,26 +242,22 @@ def parse_robot(data: Mapping[str, Any], *, source: str = "<memory>") -> RobotCo
     mass = build(Masses, src, "mass", data["mass"])
 
     jtab = table(src, "joints", data["joints"])
-    unknown = sorted(set(jtab) - set(JOINT_NAMES))
-    if unknown:
-        raise ConfigError(f"{src}: joints.{unknown[0]}: unknown joint; valid: "
-                          f"{', '.join(JOINT_NAMES)}")
-    missing = [n for n in LEG_NAMES if n not in jtab]
-    if missing:
-        raise ConfigError(f"{src}: joints.{missing[0]}: missing (every leg joint is required)")
-    arms = [n for n in ARM_NAMES if n in jtab]
-    if arms and len(arms) != len(ARM_NAMES):
-        absent = next(n for n in ARM_NAMES if n not in jtab)
-        raise ConfigError(f"{src}: joints.{absent}: missing (arms need all of "
-                          f"{', '.join(ARM_NAMES)}, or none)")
-    resolution = MODELS[bus.model].resolution
+    check_joint_set(src, jtab)
+    if any(n in jtab for n in ARM_NAMES):
+        for sect, obj in (("geometry", geometry), ("mass", mass)):
+            for f in ("shoulder_width", "upper_arm", "forearm"):
+                if getattr(obj, f, None) == 0.0:
+                    raise ConfigError(f"{src}: {sect}.{f}: missing (the robot has arms)")
+    extras = [n for n in jtab if n not in JOINT_NAMES]
     joints: list[JointConfig] = []
     seen: dict[int, str] = {}
-    for jn in JOINT_NAMES:
+    for jn in [*JOINT_NAMES, *extras]:
         if jn not in jtab:
             continue
         jp = f"joints.{jn}"
         j = build(JointConfig, src, jp, jtab[jn], overrides={"name": jn})
+        check_joint_extras(src, jp, j, bus, extra=jn in extras)
+        resolution = MODELS[j.model or bus.model].resolution
         if j.servo_id in seen:
             raise ConfigError(f"{src}: {jp}.servo_id: duplicate servo id {j.servo_id} "
                               f"(also joints.{seen[j.servo_id]})")

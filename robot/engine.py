@@ -43,6 +43,9 @@ def solve(t: BodyTargets, robot: RobotConfig) -> tuple[list[Num], Num]:
         la = arm_ik(g, t.l_hand)
         q += [*ra.q, *la.q]
         ok = ok & ra.reachable & la.reachable
+    layout = robot.layout
+    if layout is not None:   # 5-DoF legs, extra joints held at fixed angles
+        q = [q[i] if i >= 0 else fixed for i, fixed in layout]
     return q, ok
 
 
@@ -61,9 +64,14 @@ class GaitEngine:
     """
 
     def __init__(self, robot: RobotConfig, params: GaitParams) -> None:
-        if robot.joint_names != tuple(n for n in JOINT_NAMES if n in robot.joint_names):
+        driven = tuple(n for n in robot.joint_names if n in JOINT_NAMES)
+        if driven != tuple(n for n in JOINT_NAMES if n in driven):
             raise ValueError("robot joints must be in canonical order")
         self.robot = robot
+        self._leg_yaw = robot.has_hip_yaw
+        if not self._leg_yaw and params.turn != 0.0:
+            log.warning("%s has no hip yaw (5-DoF legs): turn = %g is ignored", robot.name,
+                        params.turn)
         self._params = params
         self._live = params
         self.phase = gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0)
@@ -137,7 +145,8 @@ class GaitEngine:
         a = self.amplitude if amplitude is None else amplitude
         p = self._live
         ch = gait.channels(self.phase, p, amplitude=a)
-        q, ok = solve(body_targets(ch, p, self.robot.geometry, amplitude=a), self.robot)
+        q, ok = solve(body_targets(ch, p, self.robot.geometry, amplitude=a,
+                                   leg_yaw=self._leg_yaw), self.robot)
         if not ok:
             self.unreachable_ticks += 1
             if self.unreachable_ticks in (1, 10, 100) or self.unreachable_ticks % 1000 == 0:
@@ -191,7 +200,8 @@ class GaitEngine:
         for i in range(0, n, chunk):
             sl = slice(i, min(i + chunk, n))
             ch = gait.curves(times[sl], self._params)
-            q, _ = solve(body_targets(ch, self._params, self.robot.geometry), self.robot)
+            q, _ = solve(body_targets(ch, self._params, self.robot.geometry,
+                                      leg_yaw=self._leg_yaw), self.robot)
             for name in names:
                 out_ch[name][sl] = ch[name]
             for j, v in enumerate(q):

@@ -24,11 +24,11 @@ class ServoMap:
     """
 
     def __init__(self, robot: RobotConfig) -> None:
-        res = robot.bus.servo.resolution
         self.names: tuple[str, ...] = robot.joint_names
         self.ids: tuple[int, ...] = robot.ids
-        self.resolution = res
-        self.ticks_per_rad = res / (2.0 * math.pi)
+        #: ticks per turn of each joint's servo (a robot may mix models)
+        self.resolution = np.array([robot.servo(j).resolution for j in robot.joints])
+        self.ticks_per_rad = self.resolution / (2.0 * math.pi)
         self.sign = np.array([j.sign for j in robot.joints], dtype=float)
         self.zero = np.array([j.zero_ticks for j in robot.joints], dtype=float)
         self.q_min = np.array([j.min_rad for j in robot.joints])

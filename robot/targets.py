@@ -63,8 +63,12 @@ def scale(g: Geometry, p: GaitParams) -> float:
 
 
 def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
-                 amplitude: float = 1.0) -> BodyTargets:
-    """Map the paper's channels (robot.gait.channels at ``amplitude``) to body targets."""
+                 amplitude: float = 1.0, leg_yaw: bool = True) -> BodyTargets:
+    """Map the paper's channels (robot.gait.channels at ``amplitude``) to body targets.
+
+    leg_yaw: False for 5-DoF legs (no hip yaw): no foot yaws relative to the pelvis, so
+    ``turn`` and the pelvis yaw of eq 14/15 are left out and the IK's hip yaw is 0.
+    """
     s = scale(g, p)
     a_delta = amplitude * p.delta_f
     ty, tz = ch["ty"], ch["tz"]
@@ -72,7 +76,7 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
     # Pelvis: height from eq 14/15 tY, forward shift and yaw from their tZ.
     hip_h = p.stance * g.leg_length + g.ankle_height + s * ch["RightUpLeg_tY"]
     px = s * 0.5 * (ch["RightUpLeg_tZ"] + ch["LeftUpLeg_tZ"])
-    yaw = s * (ch["RightUpLeg_tZ"] - ch["LeftUpLeg_tZ"]) / g.hip_width
+    yaw = s * (ch["RightUpLeg_tZ"] - ch["LeftUpLeg_tZ"]) / g.hip_width if leg_yaw else 0.0
     py = p.sway * (sin_t * xm.cos(p.sway_phase) - tz * xm.sin(p.sway_phase))
     pitch = p.torso_lean + p.spine_gain * (ch["StZ_ik"] - ch["CtZ"])
     pelvis_rot = xm.rz_ry(yaw, pitch)
@@ -92,11 +96,12 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
              -hip_h + lift_l)
     w_r = xm.clip(ty, 0.0, 1.0)
     w_l = xm.clip(ty_l, 0.0, 1.0)
-    yaw_r = -0.5 * p.turn * tz
-    yaw_l = 0.5 * p.turn * tz
+    turn = p.turn if leg_yaw else 0.0
+    yaw_r = -0.5 * turn * tz
+    yaw_l = 0.5 * turn * tz
     r_rot = xm.rz_ry(yaw_r, -p.toe_gain * ch["RightToe_tY"] * w_r)
     l_rot = xm.rz_ry(yaw_l, -p.toe_gain * ch["LeftToe_tY"] * w_l)
-    if p.turn != 0.0:
+    if turn != 0.0:
         # Turning: the body rotates about its own vertical axis over the planted foot, so
         # each foot's position turns with its yaw too (otherwise it would have to slip).
         r_pos = _yawed(r_pos, yaw_r)

@@ -140,11 +140,12 @@ def build(cls: Any, src: str, path: str, data: Any, *,
                 continue
             raise ConfigError(f"{src}: {fpath}: missing (expected {f.type})")
         v = data[f.name]
-        if f.type in ("str", str):
+        kind = f.type.removesuffix(" | None") if isinstance(f.type, str) else f.type
+        if kind in ("str", str):
             if not isinstance(v, str) or not v:
                 raise ConfigError(f"{src}: {fpath}: expected a non-empty string, got {show(v)}")
             kwargs[f.name] = v
         else:
             kwargs[f.name] = number(src, fpath, v, f.metadata.get("range"),
-                                    integer=f.type in ("int", int))
+                                    integer=kind in ("int", int))
     return cls(**kwargs)

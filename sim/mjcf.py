@@ -162,5 +162,6 @@ def build_mjcf(robot: RobotConfig, *, timestep: float | None = None) -> Mjcf:
     if not 0 < dt <= 0.01:
         raise ConfigError(f"MJCF: timestep must be in (0, 0.01] s, got {dt}")
     bare = _compile(robot_xml(robot, timestep=dt))
-    home = standing_qpos(bare, robot.rest)
+    fixed = {j.name: j.fixed_rad for j in robot.joints if j.fixed_rad is not None}
+    home = standing_qpos(bare, {**robot.rest, **fixed})
     return Mjcf(robot=robot_xml(robot, timestep=dt, home=home), scene=scene_xml(robot))

@@ -12,12 +12,16 @@ import xml.etree.ElementTree as ET
 from typing import NamedTuple
 
 from robot.bus.tables import ServoModel
-from robot.config import RobotConfig
+from robot.config import JOINT_NAMES, RobotConfig
 
 AXES = {"hip_yaw": "0 0 1", "hip_roll": "1 0 0", "hip_pitch": "0 1 0", "knee": "0 1 0",
         "ankle_pitch": "0 1 0", "ankle_roll": "1 0 0", "shoulder_pitch": "0 1 0",
         "shoulder_roll": "1 0 0", "elbow": "0 1 0"}
 SIDE_Y = {"r": -1.0, "l": 1.0}
+#: Extra joints (head pan, tilt, ...) are modelled as a small servo on top of the torso
+#: turning about z: held at a fixed angle, their axis does not change the walk.
+EXTRA_AXIS = "0 0 1"
+EXTRA_MASS_KG = 0.02
 #: Collision bits: floor/world 1, right leg 2, left leg 4. Legs collide with the floor and
 #: the other leg; torso and arms only with the floor (never parent-child, never same leg).
 CONTACT = {"r_leg": ("2", "5"), "l_leg": ("4", "3"), "body": ("0", "1")}
@@ -68,33 +72,41 @@ def _sub(parent: ET.Element, tag: str, **attrs: str) -> ET.Element:
 
 
 def joint_class(robot: RobotConfig, name: str) -> str:
-    """Default class of joint ``name``: its group ("knee"), or per side if sides differ."""
+    """Default class of joint ``name``: its group ("knee"), or per side if the sides differ
+    (limits or servo model); an extra joint (head_pan) has its own."""
+    if name not in JOINT_NAMES:
+        return name
     group = name[2:]
     other = robot.joint(("l_" if name.startswith("r_") else "r_") + group)
     mine = robot.joint(name)
-    return group if (mine.min_rad, mine.max_rad) == (other.min_rad, other.max_rad) else name
+    same = ((mine.min_rad, mine.max_rad, robot.servo(mine).name)
+            == (other.min_rad, other.max_rad, robot.servo(other).name))
+    return group if same else name
 
 
 def add_defaults(root: ET.Element, robot: RobotConfig) -> None:
-    servo = robot.bus.servo
-    dyn = servo_dynamics(servo)
     default = _sub(root, "default")
     top = _sub(default, "default", class_=robot.name)
     _sub(top, "geom", friction="1 0.005 0.0001", solref="0.005 1")
     _sub(top, "site", group="5", size="0.005", rgba="1 0.2 0.2 1")
-    model = _sub(top, "default", class_=servo.name)
-    _sub(model, "joint", armature=num(dyn.armature), damping=num(dyn.damping),
-         frictionloss=num(dyn.frictionloss))
-    _sub(model, "position", kp=num(dyn.kp), kv=num(dyn.kv),
-         forcerange=num(-dyn.forcerange, dyn.forcerange))
+    models: dict[str, ET.Element] = {}   # one class per servo model (a robot may mix them)
     done: set[str] = set()
     for j in robot.joints:
+        servo = robot.servo(j)
+        if servo.name not in models:
+            dyn = servo_dynamics(servo)
+            model = models[servo.name] = _sub(top, "default", class_=servo.name)
+            _sub(model, "joint", armature=num(dyn.armature), damping=num(dyn.damping),
+                 frictionloss=num(dyn.frictionloss))
+            _sub(model, "position", kp=num(dyn.kp), kv=num(dyn.kv),
+                 forcerange=num(-dyn.forcerange, dyn.forcerange))
         cls = joint_class(robot, j.name)
         if cls in done:
             continue
         done.add(cls)
-        group = _sub(model, "default", class_=cls)
-        _sub(group, "joint", axis=AXES[j.name[2:]], range=fmt(j.min_rad, j.max_rad))
+        group = _sub(models[servo.name], "default", class_=cls)
+        _sub(group, "joint", axis=AXES.get(j.name[2:], EXTRA_AXIS),
+             range=fmt(j.min_rad, j.max_rad))
         _sub(group, "position", ctrlrange=fmt(j.min_rad, j.max_rad))
     visual = _sub(top, "default", class_="visual")
     _sub(visual, "geom", contype="0", conaffinity="0", group="2", density="0")
@@ -117,7 +129,7 @@ def _inertial(body: ET.Element, mass: float, centre: tuple[float, float, float],
 def _body(parent: ET.Element, name: str, pos: tuple[float, float, float],
           joint: str | None, robot: RobotConfig) -> ET.Element:
     body = _sub(parent, "body", name=name, pos=fmt(*pos))
-    if joint is not None:
+    if joint is not None and joint in robot.joint_names:   # 5-DoF legs: no hip yaw joint
         _sub(body, "joint", name=joint, class_=joint_class(robot, joint))
     return body
 
@@ -176,6 +188,7 @@ def add_worldbody(root: ET.Element, robot: RobotConfig) -> None:
         _sub(b, "geom", class_="visual", type="box", pos=plate, size=half, material="foot")
         _sub(b, "site", name=f"{side}_sole", pos=fmt(0, 0, -g.ankle_height))
     if not robot.has_arms:
+        add_extra_joints(torso, robot, s)   # after the legs and arms: robot.joints order
         return
     for side in ("r", "l"):
         y = SIDE_Y[side]
@@ -195,6 +208,18 @@ def add_worldbody(root: ET.Element, robot: RobotConfig) -> None:
             _sub(b, "geom", class_=cls, type="capsule", size=fmt(0.8 * r),
                  fromto=fmt(0, 0, 0, 0, 0, -g.forearm), material="link")
         _sub(b, "site", name=f"{side}_hand", pos=fmt(0, 0, -g.forearm))
+    add_extra_joints(torso, robot, s)
+
+
+def add_extra_joints(torso: ET.Element, robot: RobotConfig, s: float) -> None:
+    """One small body per extra joint on top of the torso. Added after the legs and arms,
+    so qpos and the actuators follow ``robot.joints`` order."""
+    g = robot.geometry
+    for j in robot.joints:
+        if j.name in JOINT_NAMES:
+            continue
+        b = _body(torso, f"{j.name}_link", (0, 0, g.torso_height + s), j.name, robot)
+        _inertial(b, EXTRA_MASS_KG, (0, 0, 0), (s / 2, s / 2, s / 2))
 
 
 def add_actuators_and_sensors(root: ET.Element, robot: RobotConfig) -> None:

@@ -135,7 +135,7 @@ class MujocoBus(Bus):
         self._act = np.array([model.actuator(n).id for n in names])
         self._kp = model.actuator_gainprm[self._act, 0].copy()
         self._kv = -model.actuator_biasprm[self._act, 2].copy()
-        self._stall = float(self.robot.bus.servo.stall_torque)
+        self._stall = np.array([self.robot.servo(j).stall_torque for j in self.robot.joints])
         self._floor = model.geom("floor").id
         self._feet = tuple(model.geom(n).id for n in FOOT_GEOMS)
         self._torso = model.body("torso").id
@@ -205,13 +205,14 @@ class MujocoBus(Bus):
 
     def ping(self, servo_id: int) -> int | None:
         self.model  # noqa: B018  (raises BusError if closed)
-        return self.robot.bus.servo.number if servo_id in self.robot.ids else None
+        joint = self.robot.joint_by_id(servo_id)
+        return None if joint is None else self.robot.servo(joint).number
 
     def scan(self, ids: Iterable[int]) -> list[ServoInfo]:
-        servo = self.robot.bus.servo
         return [ServoInfo(id=i, model=servo.number, model_name=servo.name, firmware=None,
                           return_delay_us=0.0, baud=self.robot.bus.baud)
-                for i in sorted(set(ids)) if self.ping(i) is not None]
+                for i in sorted(set(ids)) if self.ping(i) is not None
+                for servo in [self.robot.servo(self.robot.joint_by_id(i))]]  # type: ignore[arg-type]
 
     def set_torque(self, ids: Iterable[int], *, enabled: bool) -> None:
         idx = self._indices(ids)
@@ -227,7 +228,7 @@ class MujocoBus(Bus):
             return
         idx = np.array(self._indices(goals))
         q = (np.array(list(goals.values()), float) - self.servo_map.zero[idx]) \
-            * self.servo_map.sign[idx] / self.servo_map.ticks_per_rad
+            * self.servo_map.sign[idx] / self.servo_map.ticks_per_rad[idx]
         self._goal[idx] = np.clip(q, self.servo_map.q_min[idx], self.servo_map.q_max[idx])
 
     def read_state(self, ids: Iterable[int]) -> dict[int, ServoState]:

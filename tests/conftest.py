@@ -20,6 +20,12 @@ def any_robot(request: pytest.FixtureRequest) -> RobotConfig:
     return load_robot(ROBOTS_DIR / request.param)
 
 
+@pytest.fixture(params=[f for f in ROBOT_FILES if load_robot(ROBOTS_DIR / f).has_arms])
+def armed_robot(request: pytest.FixtureRequest) -> RobotConfig:
+    """Each bundled robot config that has arms."""
+    return load_robot(ROBOTS_DIR / request.param)
+
+
 @pytest.fixture(params=GAIT_FILES)
 def any_gait(request: pytest.FixtureRequest) -> Gait:
     """Each bundled gait preset in turn."""

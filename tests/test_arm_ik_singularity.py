@@ -378,11 +378,11 @@ def test_sweep_across_the_singular_sphere_out_of_plane_does_not_flip(y: float) -
     assert fine < coarse / 8
 
 
-def test_raising_the_hands_through_the_singularity_is_smooth(any_robot: RobotConfig) -> None:
+def test_raising_the_hands_through_the_singularity_is_smooth(armed_robot: RobotConfig) -> None:
     """The issue's case: wrist height Ahgt raised in small steps brings the hands to ~4 cm
     from the shoulders. The arm joints move smoothly, the flag turns False exactly where
     |y| = HAND_OUT exceeds the lateral reach, and FK(IK) is exact while reachable."""
-    robot = any_robot
+    robot = armed_robot
     g = robot.geometry
     base = load_gait("walk").params
     prev: np.ndarray | None = None
@@ -406,14 +406,14 @@ def test_raising_the_hands_through_the_singularity_is_smooth(any_robot: RobotCon
 
 
 def test_presets_keep_the_arms_reachable_and_within_servo_speed(
-        any_robot: RobotConfig, any_gait: Gait) -> None:
+        armed_robot: RobotConfig, any_gait: Gait) -> None:
     """Every preset on both robots, ticked through start, two cycles and stop: every arm
     target is reachable and the arm joints never move faster than their servos."""
-    p, g = any_gait.params, any_robot.geometry
+    p, g = any_gait.params, armed_robot.geometry
     t = body_targets(gait.curves(cycles(p, 3), p), p, g)
     for hand in (t.r_hand, t.l_hand):
         assert np.all(arm_ik(g, hand).reachable)
-    e = GaitEngine(any_robot, p)
+    e = GaitEngine(armed_robot, p)
     qs = [e.start_pose()]
     e.start()
     for _ in range(round((p.ramp_cycles + 2) * p.cycle_s / DT)):
@@ -423,5 +423,5 @@ def test_presets_keep_the_arms_reachable_and_within_servo_speed(
         qs.append(e.tick(DT))
     assert e.unreachable_ticks == 0
     arm = np.array(qs)[:, 12:]
-    speed = np.array([j.max_speed_rad_s for j in any_robot.joints[12:]])
+    speed = np.array([j.max_speed_rad_s for j in armed_robot.joints[12:]])
     assert np.all(steps(arm, axis=0).max(axis=0) <= speed * DT)

@@ -106,7 +106,7 @@ def test_a_joint_moves_no_faster_than_its_max_speed(bus: MujocoBus) -> None:
         bus.clock.sleep_until(bus.clock.now() + dt)
         qs.append(SM.to_rad([bus.read_positions([j.servo_id])[j.servo_id]])[0])
     speed = np.abs(np.diff(qs)) / dt
-    tick = 2 * math.pi / SM.resolution
+    tick = 2 * math.pi / SM.resolution[i]
     assert speed.max() <= j.max_speed_rad_s + 2 * tick / dt
     assert speed.max() > 0.8 * j.max_speed_rad_s  # it does slew at about full speed
     assert qs[-1] == pytest.approx(-1.5, abs=0.02)  # and gets there

@@ -14,7 +14,10 @@ from robot.config import ROBOTS_DIR, RobotConfig, load_robot
 from robot.errors import BipedError
 from robot.servo_map import ServoMap
 
-ROBOTS = {p.stem: load_robot(p) for p in sorted(ROBOTS_DIR.glob("*.toml"))}
+# The 18-joint robots (the property tests draw one vector length for all of them; the
+# 12-joint robot's map is a subset of the Dynamixel one's).
+ROBOTS = {p.stem: r for p in sorted(ROBOTS_DIR.glob("*.toml"))
+          if len((r := load_robot(p)).joints) == 18}
 MAPS = {name: ServoMap(r) for name, r in ROBOTS.items()}
 N = len(next(iter(ROBOTS.values())).joints)
 robot_names = st.sampled_from(sorted(ROBOTS))

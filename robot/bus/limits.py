@@ -17,9 +17,9 @@ class TickLimits:
             from robot.servo_map import ServoMap
 
             sm = ServoMap(robot)
-            for sid, lo, hi in zip(sm.ids, sm.tick_min.tolist(), sm.tick_max.tolist(),
-                                   strict=True):
-                self.by_id[sid] = (max(int(lo), 0), min(int(hi), sm.resolution - 1))
+            for sid, lo, hi, res in zip(sm.ids, sm.tick_min.tolist(), sm.tick_max.tolist(),
+                                        sm.resolution.tolist(), strict=True):
+                self.by_id[sid] = (max(int(lo), 0), min(int(hi), int(res) - 1))
 
     def check(self, sid: int, ticks: int) -> int:
         """``ticks`` as an int if allowed for servo ``sid``, else BusError. Hot path: runs

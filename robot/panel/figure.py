@@ -51,7 +51,7 @@ def stick_figure(robot: RobotConfig, q: Sequence[float]) -> dict[str, list[Point
     lines: dict[str, list[Point]] = {}
     for side in ("r", "l"):
         lines[f"{side}_leg"] = _leg_points(
-            g, side, tuple(angles[f"{side}_{j}"] for j in LEG_JOINTS))
+            g, side, tuple(angles.get(f"{side}_{j}", 0.0) for j in LEG_JOINTS))  # 5-DoF: yaw 0
     hips = [_vec(hip_centre(g, "r")), _vec(hip_centre(g, "l"))]
     neck = (0.0, 0.0, g.torso_height)
     lines["torso"] = [hips[0], hips[1], (0.0, 0.0, 0.0), neck]

@@ -1,0 +1,18 @@
+"""The joints the gait drives, by name (sides r/l; legs then arms), and the rules for the
+joints a robot file may have: every leg joint (hip yaw optional on both sides: 5-DoF
+legs), all arm joints or none, and extra joints (head pan, tilt, ...) held at a fixed
+angle."""
+
+from __future__ import annotations
+
+import re
+
+SIDES = ("r", "l")
+LEG_JOINTS = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
+ARM_JOINTS = ("shoulder_pitch", "shoulder_roll", "elbow")
+LEG_NAMES = tuple(f"{s}_{j}" for s in SIDES for j in LEG_JOINTS)
+ARM_NAMES = tuple(f"{s}_{j}" for s in SIDES for j in ARM_JOINTS)
+JOINT_NAMES = LEG_NAMES + ARM_NAMES
+HIP_YAW_NAMES = ("r_hip_yaw", "l_hip_yaw")
+#: Names of extra joints: lowercase letters, digits and '_', starting with a letter.
+EXTRA_NAME = re.compile(r"^[a-z][a-z0-9_]{0,31}$")

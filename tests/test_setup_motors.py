@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -16,6 +18,7 @@ from sim.emulator import Emulator
 
 pytest_plugins = ("bus_harness",)
 
+REPO = Path(__file__).resolve().parent.parent
 JOINTS = ("r_hip_yaw", "r_knee", "l_elbow")          # ids 1, 4, 18
 OTHER_MODEL = {"dynamixel": "XM430-W350", "feetech": "STS3032"}
 WRITES = ("write", "sync_write", "bulk_write", "reg_write")
@@ -181,3 +184,20 @@ def test_a_servo_at_an_odd_id_and_baud_is_found_by_the_sweep(
         assert regs["id"] == 10 and BAUD_CODES[family][regs["baud_rate"]] == robot.bus.baud
         broadcast = [p for p in emu.log() if p.instruction == "ping" and p.ids == (0xFE,)]
         assert bool(broadcast) == (protocol == "dynamixel")   # scservo_sdk has none
+
+
+def test_prompt_answered_on_stdin(fresh: Emulator, robot_toml: Path) -> None:
+    """The real ``input()``: one joint with its prompt answered by a line on stdin."""
+    fresh.plug(1)
+    code = ("import sys, robot.cli as c; c.COMMANDS = ('setup_motors',); "
+            "sys.exit(c.main(sys.argv[1:]))")
+    cmd = [sys.executable, "-c", code, "setup-motors", "--robot", str(robot_toml), "--port",
+           fresh.port, "--joint", "r_knee"]
+    done = subprocess.run(cmd, cwd=REPO, input="\n", capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert "connect only the servo for r_knee (id 4) and press Enter" in done.stdout
+    assert fresh.registers_of(1)["id"] == 4
+    ended = subprocess.run(cmd, cwd=REPO, input="", capture_output=True, text=True,
+                           timeout=60)
+    assert ended.returncode == 2 and "input ended" in ended.stderr

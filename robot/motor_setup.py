@@ -105,21 +105,22 @@ def find_servo(bus: SdkBus, robot: RobotConfig, *,
     """The one servo on ``bus`` (open; left at its original baud). SetupRefused when none,
     or more than one, answers."""
     family = BUS_FAMILIES[robot.bus.kind]
-    bauds = baud_order(family, robot.bus.baud)
     original = bus.baud
     try:
+        bauds = [b for b in baud_order(family, robot.bus.baud) if _try_baud(bus, b)]
+        skipped = sorted(set(BAUD_CODES[family].values()) - set(bauds))
+        progress(f"looking for id {FACTORY_ID} at {', '.join(map(str, bauds))} baud"
+                 + (f" ({', '.join(map(str, skipped))}: the SDK cannot set it)" if skipped
+                    else ""))
         found: list[Found] = []
-        progress(f"looking for id {FACTORY_ID} at {', '.join(map(str, bauds))} baud")
         for baud in bauds:
-            if not _try_baud(bus, baud):
-                continue
+            bus.set_baud(baud)
             ids = [FACTORY_ID] + ([i for i in robot.ids if i != FACTORY_ID]
                                   if baud == robot.bus.baud else [])
             found += _ping_all(bus, ids)
         if not found:
             for baud in bauds:
-                if not _try_baud(bus, baud):
-                    continue
+                bus.set_baud(baud)
                 progress(f"scanning every id at {baud} baud")
                 found = _sweep(bus)
                 if found:

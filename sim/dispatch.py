@@ -81,17 +81,22 @@ def handle(p: Protocol, servo_id: int, inst: int, params: bytes,
     values: dict[int, int] = {}
     w = p.addr_width
 
-    def reply(s: EmulatedServo, sid: int, err: int, level: int, data: bytes = b"") -> None:
-        if not broadcast and s.status_return_level >= level:
-            packet = p.status(sid, err | p.alert(s), data)
-            replies.append(Reply(sid, packet, s.return_delay_s))
+    def before(s: EmulatedServo) -> tuple[int, int, float]:
+        """What the reply to a write uses: id, level and delay as they were (a new one
+        takes effect after the reply)."""
+        return s.servo_id, s.status_return_level, s.return_delay_s
+
+    def reply(s: EmulatedServo, was: tuple[int, int, float], err: int, level: int) -> None:
+        sid, srl, delay = was
+        if not broadcast and srl >= level:
+            replies.append(Reply(sid, p.status(sid, err | p.alert(s), b""), delay))
 
     def status_of(outcome: WriteError) -> int:
         return p.write_errors.get(outcome, 0)
 
     if inst not in p.instructions:
         if servo is not None and p.instruction_error is not None:
-            reply(servo, servo_id, p.instruction_error, p.level_read)
+            reply(servo, before(servo), p.instruction_error, p.level_read)
     elif inst == PING:
         for s in sorted(targets, key=lambda s: s.servo_id):
             packet = p.status(s.servo_id, p.alert(s), p.ping_params(s))
@@ -106,15 +111,15 @@ def handle(p: Protocol, servo_id: int, inst: int, params: bytes,
         length = len(data)
         values[servo_id] = decode_value(p.family, address, data)
         for s in targets:
-            sid = s.servo_id   # a new id takes effect after the reply (sent as the old id)
+            was = before(s)
             outcome = s.write(address, data) if inst == WRITE else s.reg_write(address, data)
-            reply(s, sid, status_of(outcome), p.level_all)
+            reply(s, was, status_of(outcome), p.level_all)
     elif inst == ACTION:
         for s in targets:
-            sid = s.servo_id
-            reply(s, sid, status_of(s.action()), p.level_all)
+            was = before(s)
+            reply(s, was, status_of(s.action()), p.level_all)
     elif inst in (REBOOT, FACTORY_RESET, CLEAR) and servo is not None:
-        reply(servo, servo_id, 0, p.level_all)       # the status goes out first
+        reply(servo, before(servo), 0, p.level_all)       # the status goes out first
         if inst == REBOOT:
             servo.reboot()
         elif inst == FACTORY_RESET:

@@ -227,6 +227,11 @@ class SdkBus(Bus):
                 except PORT_ERRORS as e:
                     port.is_using = False
                     raise self._error(sid, what, f"port error: {e}", None) from e
+                except IndexError:
+                    # scservo_sdk indexes a reply it misparsed (e.g. two servos answering
+                    # one ping): a garbled reply, retried like a bad checksum.
+                    port.is_using = False
+                    value, result, error = None, self.sdk.COMM_RX_CORRUPT, 0
                 if result == self.sdk.COMM_SUCCESS:
                     if self._status_failed(error):
                         raise self._error(sid, what, self._ph.getRxPacketError(error), result)

@@ -1,10 +1,14 @@
-"""One emulated servo: a control table (bytearray) laid out by ``robot.bus.tables``.
+"""One emulated servo: a control table (bytearray) laid out by ``sim.control_tables``
+(the manuals' tables, initial values included).
 
-The servo is protocol-agnostic: the wire codecs (``sim.dxl_protocol``, ``sim.sts_protocol``)
-call :meth:`EmulatedServo.read` / :meth:`EmulatedServo.write` with raw addresses and bytes.
+The servo is protocol-agnostic: ``sim.dispatch`` calls :meth:`EmulatedServo.read` /
+:meth:`EmulatedServo.write` (checked in ``sim.servo_write``) with raw addresses and bytes,
+and the instruction methods (reg write / action, reboot, factory reset, clear multi-turn).
+Power: EEPROM (below ``EEPROM_END``) survives unplugging; RAM comes back at its power-on
+values (a reboot is the same).
 Motion is evaluated lazily: call :meth:`EmulatedServo.update` with the current time [s]
-before touching the table; present position then moves toward goal position at the model's
-no-load speed while torque is enabled.
+before touching the table; present position then moves toward goal position
+(``sim.servo_motion``) while torque is enabled.
 
 Communication watchdog (Dynamixel X "Bus Watchdog", ``tables.COMM_WATCHDOG``): the chain
 calls :meth:`EmulatedServo.hear` for every instruction packet addressed to the servo (its id,

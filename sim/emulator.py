@@ -26,7 +26,13 @@ adapter and talk Dynamixel Protocol 2.0 (``sim.dxl_protocol``) or Feetech STS
   (signed for Dynamixel's signed registers); for bulk reads ``values`` maps id → address.
 - Servos: present position starts at the joint's ``zero_ticks`` (2048 without a robot),
   position limits are the joint limits in ticks (rounded outward). Sync/bulk reads answer
-  in the order the ids appear in the packet; a missing servo silences the rest.
+  in the order the ids appear in the packet; a missing servo silences the rest. A chain
+  built from a robot is one already set up (return delay 0).
+- Factory-new servos (:meth:`Emulator.factory_new`): id 1, factory baud and return delay,
+  unplugged until :meth:`Emulator.plug` / :meth:`Emulator.plug_all`. Unplugging powers a
+  servo off: it keeps its EEPROM (on STS only what was written with Lock 0), RAM restarts.
+  Servos sharing an id all execute a packet and all answer, one status each (a real bus
+  would garble the overlapping replies; here the host sees both).
 - Closing the port (``set_faults(close_port=True)``) makes the SDK's next call raise
   (``termios.error``/``SerialException``, EIO) and leaves ``PortHandler.is_using`` set.
 - dynamixel_sdk 4.1 does not byte-stuff what it sends (``addStuffing``'s result is

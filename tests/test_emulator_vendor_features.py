@@ -289,3 +289,20 @@ def test_sts_status_return_level_zero_still_answers_reads(
     assert ph.write1ByteTxRx(port, 1, S_LEVEL, 0) == (0, 0)   # reply goes out at level 1
     assert ok(ph.read1ByteTxRx(port, 1, S_DELAY)) == 0        # 0: ping and read only
     assert ph.write1ByteTxRx(port, 1, S_DELAY, 0)[0] == scs.COMM_RX_TIMEOUT
+
+
+def test_multi_port_two_chains_at_once() -> None:
+    with Emulator("dynamixel", ids=[1], baud=BAUD) as a, \
+            Emulator("dynamixel", ids=[2], baud=57600) as b:
+        ports = [dxl.PortHandler(a.port), dxl.PortHandler(b.port)]
+        ph = dxl.PacketHandler(2.0)
+        for port, baud in zip(ports, (BAUD, 57600), strict=True):
+            assert port.openPort() and port.setBaudRate(baud)
+        for port, sid in zip(ports, (1, 2), strict=True):
+            assert ph.write1ByteTxRx(port, sid, X_TORQUE, 1) == (0, 0)
+            assert ph.write4ByteTxRx(port, sid, X_GOAL, 2048 + 10 * sid) == (0, 0)
+        assert until(lambda: [ok(ph.read4ByteTxRx(p, s, X_PRESENT)) for p, s in
+                              zip(ports, (1, 2), strict=True)] == [2058, 2068])
+        assert ph.ping(ports[0], 2)[1] == dxl.COMM_RX_TIMEOUT    # each chain its own
+        for port in ports:
+            port.closePort()

@@ -120,11 +120,12 @@ class Emulator:
         if baud not in BAUD_CODES[self.family].values():
             raise EmulatorError(f"baud: {baud} is not a {protocol} rate; valid: "
                                 f"{sorted(BAUD_CODES[self.family].values())}")
-        resolution = MODELS[model].resolution
         specs = []
         for sid in ids:
-            zero, lo, hi = _limits(robot, sid, resolution)
-            specs.append(ServoSpec(sid, model, zero, lo, hi, baud))
+            joint = robot.joint_by_id(sid) if robot is not None and same_kind else None
+            own = joint.model if joint is not None and joint.model else model  # mixed models
+            zero, lo, hi = _limits(robot, sid, MODELS[own].resolution)
+            specs.append(ServoSpec(sid, own, zero, lo, hi, baud))
         self.model = model
         self.baud = baud
         self.ids = tuple(ids)

@@ -158,3 +158,21 @@ def test_arms_need_their_geometry(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match=r"geometry\.upper_arm: missing \(the robot has arms\)"):
         load_robot(path)
     assert mujoco is not None
+
+
+def test_mixed_models_on_the_emulated_chain(five: RobotConfig, tmp_path: Path) -> None:
+    """The pty emulator serves each joint's own model: a scan with the real SDK reports the
+    XM430 knees (model number 1020, ROBOTIS e-Manual) among XL430s (1060)."""
+    from robot.bus.factory import make_bus
+    from sim.emulator import Emulator
+
+    with Emulator("dynamixel", five) as emu:
+        bus = make_bus("dynamixel", robot=five, port=emu.port, timeout_ms=50.0)
+        bus.open()
+        try:
+            found = {s.id: s.model for s in bus.scan(five.ids)}
+        finally:
+            bus.close()
+    assert found[five.joint("l_knee").servo_id] == 1020
+    assert found[five.joint("l_hip_roll").servo_id] == 1060
+    assert found[20] == 1060

@@ -1,12 +1,12 @@
 """Radians ↔ ticks per servo: the only place (with the buses) that knows a tick.
 
-ticks = zero_ticks + sign * q * resolution / (2 pi), rounded, inside the tick limits that
+ticks = zero_ticks + sign * q * ticks_per_rad, rounded (ticks_per_rad = resolution / span:
+resolution / (2 pi) for full-turn servos, 1024 / (300 deg) for the AX series), inside the tick limits that
 the joint limits imply.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from typing import NoReturn
 
@@ -28,7 +28,7 @@ class ServoMap:
         self.ids: tuple[int, ...] = robot.ids
         #: ticks per turn of each joint's servo (a robot may mix models)
         self.resolution = np.array([robot.servo(j).resolution for j in robot.joints])
-        self.ticks_per_rad = self.resolution / (2.0 * math.pi)
+        self.ticks_per_rad = np.array([robot.servo(j).ticks_per_rad for j in robot.joints])
         self.sign = np.array([j.sign for j in robot.joints], dtype=float)
         self.zero = np.array([j.zero_ticks for j in robot.joints], dtype=float)
         self.q_min = np.array([j.min_rad for j in robot.joints])

@@ -9,6 +9,9 @@ or 0). EEPROM is every address below ``EEPROM_END`` (saved over power-off), RAM 
 - Dynamixel X: ROBOTIS e-Manual, XL430-W250 control table
   (https://emanual.robotis.com/docs/en/dxl/x/xl430-w250/#control-table). The XL430 has no
   current sensing (no Current Limit / Goal Current / Present Current; Present Load(126)).
+- Dynamixel Protocol 1.0: ROBOTIS e-Manual, AX-12A control table
+  (https://emanual.robotis.com/docs/en/dxl/ax/ax-12a/#control-table); Baud Rate(4) is
+  2000000 / (value + 1) bps.
 - Feetech STS: Feetech "STS series memory table" (FT-SMS-STS-emanual, STS3215 column).
 """
 
@@ -100,6 +103,43 @@ DYNAMIXEL_X: dict[str, Entry] = {
     **_indirect(),
 }
 
+DYNAMIXEL_AX: dict[str, Entry] = {
+    # EEPROM (0-23)
+    "model_number": Entry(0, 2, "R", None),          # 12 on the AX-12A
+    "firmware_version": Entry(2, 1, "R", None),
+    "id": Entry(3, 1, "RW", 1),
+    "baud_rate": Entry(4, 1, "RW", 1),               # 1 = 1 Mbps
+    "return_delay_time": Entry(5, 1, "RW", 250),     # 2 us per step: 500 us
+    "cw_angle_limit": Entry(6, 2, "RW", 0),
+    "ccw_angle_limit": Entry(8, 2, "RW", 1023),
+    "temperature_limit": Entry(11, 1, "RW", 70),
+    "min_voltage_limit": Entry(12, 1, "RW", 60),
+    "max_voltage_limit": Entry(13, 1, "RW", 140),
+    "max_torque": Entry(14, 2, "RW", 1023),
+    "status_return_level": Entry(16, 1, "RW", 2),
+    "alarm_led": Entry(17, 1, "RW", 36),
+    "shutdown": Entry(18, 1, "RW", 36),
+    # RAM (24-49)
+    "torque_enable": Entry(24, 1, "RW", 0),
+    "led": Entry(25, 1, "RW", 0),
+    "cw_compliance_margin": Entry(26, 1, "RW", 1),
+    "ccw_compliance_margin": Entry(27, 1, "RW", 1),
+    "cw_compliance_slope": Entry(28, 1, "RW", 32),
+    "ccw_compliance_slope": Entry(29, 1, "RW", 32),
+    "goal_position": Entry(30, 2, "RW", None),
+    "moving_speed": Entry(32, 2, "RW", None),
+    "torque_limit": Entry(34, 2, "RW", None),        # loaded from Max Torque(14)
+    "present_position": Entry(36, 2, "R", None),
+    "present_speed": Entry(38, 2, "R", None),
+    "present_load": Entry(40, 2, "R", None),
+    "present_voltage": Entry(42, 1, "R", None),      # 0.1 V
+    "present_temperature": Entry(43, 1, "R", None),
+    "registered": Entry(44, 1, "R", 0),
+    "moving": Entry(46, 1, "R", 0),
+    "lock": Entry(47, 1, "RW", 0),
+    "punch": Entry(48, 2, "RW", 32),
+}
+
 FEETECH_STS: dict[str, Entry] = {
     # EEPROM (0-39): saved only while Lock(55) is 0.
     "firmware_major": Entry(0, 1, "R", None),
@@ -154,8 +194,10 @@ FEETECH_STS: dict[str, Entry] = {
     "present_current": Entry(69, 2, "R", None),
 }
 
-TABLES: dict[str, dict[str, Entry]] = {"dynamixel_x": DYNAMIXEL_X, "feetech_sts": FEETECH_STS}
-EEPROM_END: dict[str, int] = {"dynamixel_x": 64, "feetech_sts": 40}
+TABLES: dict[str, dict[str, Entry]] = {
+    "dynamixel_x": DYNAMIXEL_X, "dynamixel_p1": DYNAMIXEL_AX, "feetech_sts": FEETECH_STS,
+}
+EEPROM_END: dict[str, int] = {"dynamixel_x": 64, "dynamixel_p1": 24, "feetech_sts": 40}
 
 #: Registers the X manual gives in two's complement.
 DXL_SIGNED: frozenset[str] = frozenset({
@@ -175,6 +217,9 @@ BAUD_CODES: dict[str, dict[int, int]] = {
                     5: 3_000_000, 6: 4_000_000, 7: 4_500_000},
     "feetech_sts": {0: 1_000_000, 1: 500_000, 2: 250_000, 3: 128_000, 4: 115_200,
                     5: 76_800, 6: 57_600, 7: 38_400},
+    # AX-12A "Baud Rate(4)": 2000000 / (value + 1); the manual's table of usual values.
+    "dynamixel_p1": {1: 1_000_000, 3: 500_000, 4: 400_000, 7: 250_000, 9: 200_000,
+                     16: 115_200, 34: 57_600, 103: 19_200, 207: 9_600},
 }
 
 #: Profile Velocity(112) / Present Velocity(128) unit on X: 0.229 rev/min.

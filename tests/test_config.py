@@ -121,7 +121,7 @@ def test_bundled_robots_load() -> None:
      "bus.model: unknown servo model 'XL999'; valid: XL430-W250"),
     (sub('kind = "dynamixel"', 'kind = "feetech"'),
      "bus.model: XL430-W250 is not a feetech servo"),
-    (sub('kind = "dynamixel"', 'kind = "can"'), "bus.kind: expected one of dynamixel, feetech"),
+    (sub('kind = "dynamixel"', 'kind = "can"'), "bus.kind: expected one of dynamixel, dynamixel1, feetech"),
     (drop_joint("l_elbow"), "joints.l_elbow: missing (arms need all of"),
     (drop_joint("r_ankle_roll"), "joints.r_ankle_roll: missing (every leg joint is required; only hip yaw"),
     (sub("r_knee = 1.1", "r_knee = 2.9"), "rest.r_knee: 2.9 is outside the joint limits"),

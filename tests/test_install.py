@@ -149,7 +149,7 @@ def test_unknown_bus_lists_the_kinds() -> None:
     robot = load_robot()
     with pytest.raises(ConfigError) as e:
         make_bus("can", robot=robot)
-    assert "--bus: unknown bus 'can'; valid: sim, dynamixel, feetech" in str(e.value)
+    assert "--bus: unknown bus 'can'; valid: sim, dynamixel, dynamixel1, feetech" in str(e.value)
     assert ENTRY_POINT_GROUP in str(e.value)
 
 

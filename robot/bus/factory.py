@@ -1,6 +1,7 @@
 """One factory picks the bus backend (like pyserial's ``serial_for_url``).
 
-The hardware buses (``dynamixel``, ``feetech``) are built in. Other kinds are plugins: a
+The hardware buses (``dynamixel`` = Protocol 2.0, ``dynamixel1`` = Protocol 1.0,
+``feetech``) are built in. Other kinds are plugins: a
 distribution declares an entry point in the group ``biped.buses`` (biped's own
 pyproject.toml declares ``sim = "sim:open_bus"``), naming a callable
 ``(robot, *, port, baud, **options) -> Bus``; ``register_bus`` adds one at run time. So
@@ -18,7 +19,7 @@ from robot.errors import ConfigError
 
 #: Entry-point group where bus plugins are declared.
 ENTRY_POINT_GROUP = "biped.buses"
-HARDWARE = ("dynamixel", "feetech")
+HARDWARE = ("dynamixel", "dynamixel1", "feetech")
 
 BusFactory = Callable[..., Bus]   # (robot, *, port: str | None, baud: int | None, **options)
 
@@ -70,6 +71,10 @@ def make_bus(kind: str | None, *, robot: RobotConfig, port: str | None = None,
             from robot.bus.dynamixel import DynamixelBus
 
             return DynamixelBus(port, baud=baud, robot=robot, **options)  # type: ignore[arg-type]
+        if kind == "dynamixel1":
+            from robot.bus.dynamixel1 import Dynamixel1Bus
+
+            return Dynamixel1Bus(port, baud=baud, robot=robot, **options)  # type: ignore[arg-type]
         from robot.bus.feetech import FeetechBus
 
         return FeetechBus(port, baud=baud, robot=robot, **options)  # type: ignore[arg-type]

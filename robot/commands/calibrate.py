@@ -26,6 +26,7 @@ from robot.calibration import (
     zero_ticks,
 )
 from robot.commands.common import (
+    HARDWARE_BUSES,
     add_bus_args,
     add_robot_args,
     bus_from,
@@ -50,7 +51,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p = subparsers.add_parser("calibrate", help="measure zero, sign and limits by hand "
                               "(torque off) into a new robot TOML", description=__doc__)
     add_robot_args(p, gait=False)
-    add_bus_args(p, choices=("dynamixel", "feetech"))
+    add_bus_args(p, choices=HARDWARE_BUSES)
     p.add_argument("--out", required=True, type=output_file, metavar="NEW.toml",
                    help="robot TOML to write (a copy of --robot with the measured values)")
     p.add_argument("--overwrite", action="store_true", help="allow --out to be the --robot file")

@@ -124,7 +124,9 @@ seconds = bounded_float(0.0, 1e6, "s", what="a duration", lo_open=True)
 joint_speed = bounded_float(SPEED.lo, SPEED.hi, SPEED.unit, what="a joint speed")
 
 #: Every standard baud rate of the supported servo families [bit/s].
-BAUD_RATES: tuple[int, ...] = tuple(sorted({b for k in ("dynamixel", "feetech")
+#: The hardware bus kinds (robot.bus.factory.HARDWARE): Dynamixel 2.0, Dynamixel 1.0, Feetech.
+HARDWARE_BUSES: tuple[str, ...] = ("dynamixel", "dynamixel1", "feetech")
+BAUD_RATES: tuple[int, ...] = tuple(sorted({b for k in HARDWARE_BUSES
                                             for b in standard_bauds(k)}))
 
 
@@ -219,7 +221,7 @@ def add_robot_args(p: argparse.ArgumentParser, *, gait: bool = True) -> None:
 
 
 def add_bus_args(p: argparse.ArgumentParser, *, default: str | None = None,
-                 choices: tuple[str, ...] = ("sim", "dynamixel", "feetech")) -> None:
+                 choices: tuple[str, ...] = ("sim", *HARDWARE_BUSES)) -> None:
     p.add_argument("--bus", default=default, choices=choices,
                    help="servo bus backend" + (f" (default: {default})" if default else ""))
     p.add_argument("--port", default=None, metavar="DEV", help="serial device (default: config)")

@@ -18,6 +18,7 @@ from typing import Any
 
 from robot.bus.base import Bus
 from robot.commands.common import (
+    HARDWARE_BUSES,
     add_bus_args,
     add_robot_args,
     bounded_float,
@@ -40,7 +41,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p = subparsers.add_parser("monitor", help="torque off; live table of joint angles, "
                               "temperatures, loads and errors", description=__doc__)
     add_robot_args(p, gait=False)
-    add_bus_args(p, choices=("dynamixel", "feetech"))
+    add_bus_args(p, choices=HARDWARE_BUSES)
     p.add_argument("--rate", type=monitor_rate, default=5.0,
                    help="refreshes per second (default: %(default)s)")
     p.add_argument("--once", action="store_true", help="print one table and exit")

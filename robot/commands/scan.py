@@ -9,7 +9,7 @@ import logging
 from robot.bus import health
 from robot.bus.base import ServoInfo
 from robot.bus.sdk_bus import SdkBus
-from robot.commands.common import add_bus_args, bus_from, id_list, one_line_errors
+from robot.commands.common import HARDWARE_BUSES, add_bus_args, bus_from, id_list, one_line_errors
 from robot.config import DEFAULT_ROBOT, ROBOTS_DIR, RobotConfig, load_robot
 from robot.errors import BusError
 
@@ -19,7 +19,7 @@ log = logging.getLogger(__name__)
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = subparsers.add_parser("scan", help="list the servos on a Dynamixel or Feetech bus",
                               description=__doc__)
-    add_bus_args(p, choices=("dynamixel", "feetech"))
+    add_bus_args(p, choices=HARDWARE_BUSES)
     p.add_argument("--ids", type=id_list, default=None, metavar="RANGE",
                    help="ids to ping, e.g. 1-20 or 1,3,5-7 (default: 1-20 and the robot's ids)")
     p.add_argument("--robot", default=None, metavar="PATH",

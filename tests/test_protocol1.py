@@ -1,0 +1,45 @@
+"""Dynamixel Protocol 1.0 (AX-12A, AX-18A, MX-28): models, bus, emulator.
+
+Expected addresses and values are the ROBOTIS e-Manual's (AX-12A control table,
+https://emanual.robotis.com/docs/en/dxl/ax/ax-12a/), written here, not read from
+robot/bus/tables.py.
+"""
+
+from __future__ import annotations
+
+import math
+
+from robot.bus.tables import MODELS, TABLES
+
+# e-Manual AX-12A: (address, size)
+MANUAL = {"id": (3, 1), "baud_rate": (4, 1), "return_delay_time": (5, 1),
+          "cw_angle_limit": (6, 2), "ccw_angle_limit": (8, 2), "torque_enable": (24, 1),
+          "led": (25, 1), "goal_position": (30, 2), "moving_speed": (32, 2),
+          "present_position": (36, 2), "present_speed": (38, 2), "present_load": (40, 2),
+          "present_voltage": (42, 1), "present_temperature": (43, 1), "moving": (46, 1),
+          "lock": (47, 1)}
+
+
+def test_the_driver_table_is_the_manuals() -> None:
+    table = TABLES["dynamixel_p1"]
+    for name, (address, size) in MANUAL.items():
+        assert (table[name].address, table[name].size) == (address, size), name
+
+
+def test_ax_ticks_span_300_degrees() -> None:
+    ax = MODELS["AX-12A"]
+    assert (ax.number, ax.resolution, ax.family) == (12, 1024, "dynamixel_p1")
+    assert ax.ticks_per_rad * 2 * math.pi == 1228.8
+    assert ax.ticks_per_rad * math.radians(300) == 1024
+    assert MODELS["AX-18A"].number == 18
+    mx = MODELS["MX-28"]
+    assert (mx.number, mx.resolution) == (29, 4096)
+    assert mx.ticks_per_rad * 2 * math.pi == 4096
+
+
+def test_the_protocol1_bus_uses_packet_handler_1_0() -> None:
+    from robot.bus.dynamixel1 import Dynamixel1Bus
+
+    bus = Dynamixel1Bus("/dev/null", baud=1_000_000)
+    assert (bus.kind, bus.family) == ("dynamixel1", "dynamixel_p1")
+    assert bus._make_packet_handler().getProtocolVersion() == 1.0

@@ -23,7 +23,6 @@ range error until 0 (or a new setting) is written. Torque is left as it was.
 from __future__ import annotations
 
 import enum
-import math
 from dataclasses import dataclass
 
 from robot.bus.tables import COMM_WATCHDOG, ERROR_BITS, MODELS, RETURN_DELAY_UNIT_S
@@ -35,6 +34,8 @@ from sim.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, Entry
 UNPRINTED: dict[str, dict[str, int]] = {
     "dynamixel_x": {"firmware_version": 46, "present_input_voltage": 115,
                     "present_temperature": 35},
+    "dynamixel_p1": {"firmware_version": 24, "present_voltage": 120,
+                     "present_temperature": 35, "torque_limit": 1023, "moving_speed": 0},
     "feetech_sts": {"firmware_major": 3, "firmware_minor": 10, "max_voltage_limit": 140,
                     "p_coefficient": 32, "d_coefficient": 32, "present_voltage": 74,
                     "present_temperature": 35},
@@ -84,7 +85,8 @@ class EmulatedServo:
             self._owner[reg.address:reg.address + reg.size] = bytes([i + 1]) * reg.size
         self.conditions: set[str] = set()   # injected hardware faults (names of ERROR_BITS)
         self.stuck = False                  # injected jam: the horn does not move
-        self.speed_tps = self.model.no_load_speed * self.model.resolution / (2 * math.pi)
+        self.speed_tps = self.model.no_load_speed * self.model.ticks_per_rad
+        self._p1_errors = 0   # Protocol 1.0 has no error register: the status byte only
         codes = {b: c for c, b in BAUD_CODES[self.family].items()}
         if spec.baud not in codes:
             raise ValueError(f"servo {spec.servo_id}: baud {spec.baud} is not a "
@@ -96,6 +98,8 @@ class EmulatedServo:
                       present_position=spec.zero_ticks, goal_position=spec.zero_ticks)
         if self.family == "dynamixel_x":
             values.update(max_position_limit=spec.max_ticks, min_position_limit=spec.min_ticks)
+        elif self.family == "dynamixel_p1":
+            values.update(ccw_angle_limit=spec.max_ticks, cw_angle_limit=spec.min_ticks)
         else:
             values.update(max_angle_limit=spec.max_ticks, min_angle_limit=spec.min_ticks)
         for name, v in values.items():
@@ -108,8 +112,8 @@ class EmulatedServo:
         self._saved = bytes(self.mem[:self.eeprom_end])   # EEPROM as kept over power-off
         self._ram_at_power_on = bytes(self.mem[self.eeprom_end:])
         self.pending: tuple[int, bytes] | None = None     # a Reg Write waiting for Action
-        self._registered = ("registered_instruction" if self.family == "dynamixel_x"
-                            else "async_write_flag")
+        self._registered = {"dynamixel_x": "registered_instruction",
+                            "dynamixel_p1": "registered"}.get(self.family, "async_write_flag")
         # Indirect Data address -> name of the Indirect Address register pointing it (X).
         self._indirect = {e.address: name.replace("data", "address")
                           for name, e in self.table.items() if name.startswith("indirect_data")}
@@ -206,10 +210,15 @@ class EmulatedServo:
             value |= self.get("hardware_error_status")
             if value:
                 self.set("torque_enable", 0)
+        if self.family == "dynamixel_p1":
+            self._p1_errors = value
+            return
         self.set(self.error_register, value)
 
     @property
     def error_bits(self) -> int:
+        if self.family == "dynamixel_p1":
+            return self._p1_errors
         return self.get(self.error_register)
 
     def read(self, address: int, length: int) -> bytes | None:

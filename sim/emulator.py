@@ -69,25 +69,27 @@ log = logging.getLogger(__name__)
 
 ROOT = Path(__file__).resolve().parent.parent   # puts `sim` and `robot` on the child's path
 
-DEFAULT_MODEL = {"dynamixel": "XL430-W250", "feetech": "STS3215"}
+DEFAULT_MODEL = {"dynamixel": "XL430-W250", "dynamixel1": "AX-12A", "feetech": "STS3215"}
 DEFAULT_BAUD = 1_000_000
 # As shipped: ROBOTIS e-Manual XL430-W250 (Baud Rate(8) initial 1 = 57600, Return Delay
 # Time(9) initial 250 = 500 us, ID(7) initial 1); Feetech STS memory table (ID(5) 1, Baud
-# Rate(6) 0 = 1 Mbps, Return Delay Time(7) 0).
-FACTORY_BAUD = {"dynamixel": 57_600, "feetech": 1_000_000}
-FACTORY_RETURN_DELAY = {"dynamixel": 250, "feetech": 0}
+# Rate(6) 0 = 1 Mbps, Return Delay Time(7) 0); e-Manual AX-12A (ID(3) 1, Baud Rate(4) 1 =
+# 1 Mbps, Return Delay Time(5) 250 = 500 us).
+FACTORY_BAUD = {"dynamixel": 57_600, "dynamixel1": 1_000_000, "feetech": 1_000_000}
+FACTORY_RETURN_DELAY = {"dynamixel": 250, "dynamixel1": 250, "feetech": 0}
 FACTORY_ID = 1
-CENTER_TICKS = 2048
 REPLY_TIMEOUT_S = 5.0        # control-channel answer [s]
 START_TIMEOUT_S = 20.0       # child start-up [s]
 
 
-def _limits(robot: RobotConfig | None, servo_id: int, resolution: int) -> tuple[int, int, int]:
-    """(zero, min, max) [ticks] for ``servo_id`` from the robot's joint, else the full turn."""
+def _limits(robot: RobotConfig | None, servo_id: int, model: str) -> tuple[int, int, int]:
+    """(zero, min, max) [ticks] for ``servo_id`` from the robot's joint, else the full range
+    with the horn at its middle (2048 of 4096; 512 of the AX's 1024)."""
+    resolution = MODELS[model].resolution
     joint = robot.joint_by_id(servo_id) if robot is not None else None
     if joint is None:
-        return CENTER_TICKS, 0, resolution - 1
-    per_rad = resolution / (2 * math.pi)
+        return resolution // 2, 0, resolution - 1
+    per_rad = MODELS[model].ticks_per_rad
     ends = [joint.zero_ticks + joint.sign * q * per_rad for q in (joint.min_rad, joint.max_rad)]
     lo = max(0, math.floor(min(ends)))
     hi = min(resolution - 1, math.ceil(max(ends)))
@@ -124,7 +126,7 @@ class Emulator:
         for sid in ids:
             joint = robot.joint_by_id(sid) if robot is not None and same_kind else None
             own = joint.model if joint is not None and joint.model else model  # mixed models
-            zero, lo, hi = _limits(robot, sid, MODELS[own].resolution)
+            zero, lo, hi = _limits(robot, sid, own)
             specs.append(ServoSpec(sid, own, zero, lo, hi, baud))
         self.model = model
         self.baud = baud

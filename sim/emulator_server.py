@@ -23,7 +23,7 @@ from types import ModuleType
 from typing import Any
 
 from robot.errors import BipedError
-from sim import dxl_protocol, sts_protocol
+from sim import dxl1_protocol, dxl_protocol, sts_protocol
 from sim.emulated_servo import EmulatedServo, ServoSpec
 
 LOG_MAX = 200_000            # packets kept in the child
@@ -57,6 +57,11 @@ class Packet:
     length: int | None = None
 
 
+#: Wire protocol codec per bus kind.
+CODECS: dict[str, ModuleType] = {"dynamixel": dxl_protocol, "dynamixel1": dxl1_protocol,
+                                 "feetech": sts_protocol}
+
+
 @dataclass(frozen=True)
 class ChainSpec:
     """The chain to serve; ``plugged``: indices into ``servos`` on the bus (None: all)."""
@@ -72,7 +77,7 @@ class _ChainServer:
 
     def __init__(self, spec: ChainSpec, conn: Connection) -> None:
         self.conn = conn
-        self.codec: ModuleType = dxl_protocol if spec.protocol == "dynamixel" else sts_protocol
+        self.codec: ModuleType = CODECS[spec.protocol]
         self.parser = self.codec.Parser()
         now = time.monotonic()
         self.servos = [EmulatedServo(s, now) for s in spec.servos]

@@ -10,6 +10,7 @@ Position, Moving, Present Velocity (X, signed, 0.229 rev/min) / Present Speed (S
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 from sim.control_tables import DXL_VELOCITY_UNIT_RPM, STS_SPEED_UNIT_TICKS_S
@@ -18,6 +19,11 @@ if TYPE_CHECKING:
     from sim.emulated_servo import EmulatedServo
 
 STS_DIRECTION_BIT = 0x8000
+#: AX-12A Moving Speed(32) / Present Speed(38): 0.111 rev/min per unit, bits 0-9; bit 10
+#: is the direction (CW) in Present Speed.
+P1_SPEED_UNIT_RPM = 0.111
+P1_SPEED_MASK = 0x3FF
+P1_DIRECTION_BIT = 0x400
 MOVING_IN_POSITION = 0x01
 MOVING_PROFILE_ONGOING = 0x02
 
@@ -35,6 +41,10 @@ def speed_ticks_s(servo: EmulatedServo) -> float:
         if pv > 0:
             return min(top, pv * dxl_velocity_unit_ticks_s(servo.model.resolution))
         return top
+    if servo.family == "dynamixel_p1":
+        ms = servo.get("moving_speed") & P1_SPEED_MASK    # 0: as fast as it can
+        per_rpm = servo.model.ticks_per_rad * 2 * math.pi / 60.0
+        return min(top, ms * P1_SPEED_UNIT_RPM * per_rpm) if ms > 0 else top
     gs = servo.get("goal_speed") & ~STS_DIRECTION_BIT
     return min(top, gs * STS_SPEED_UNIT_TICKS_S) if gs > 0 else top
 
@@ -59,6 +69,10 @@ def advance(servo: EmulatedServo, pos: float, dt: float) -> float:
                   round(velocity / dxl_velocity_unit_ticks_s(servo.model.resolution)))
         servo.set("moving_status", 0 if not torque else (
             MOVING_PROFILE_ONGOING if moving else MOVING_IN_POSITION))
+    elif servo.family == "dynamixel_p1":
+        per_unit = P1_SPEED_UNIT_RPM * servo.model.ticks_per_rad * 2 * math.pi / 60.0
+        magnitude = min(round(abs(velocity) / per_unit), P1_SPEED_MASK)
+        servo.set("present_speed", magnitude | (P1_DIRECTION_BIT if velocity < 0 else 0))
     else:
         magnitude = min(round(abs(velocity)), STS_DIRECTION_BIT - 1)
         servo.set("present_speed", magnitude | (STS_DIRECTION_BIT if velocity < 0 else 0))

@@ -19,7 +19,7 @@ if TYPE_CHECKING:
     from sim.emulated_servo import EmulatedServo, WriteError
 
 READ_ONLY: dict[str, frozenset[str]] = {
-    fam: read_only(fam) for fam in ("dynamixel_x", "feetech_sts")}
+    fam: read_only(fam) for fam in ("dynamixel_x", "dynamixel_p1", "feetech_sts")}
 #: Allowed raw values of a few registers [inclusive range]; others accept any value.
 VALID_RANGE: dict[str, tuple[int, int]] = {
     "torque_enable": (0, 1),
@@ -62,7 +62,7 @@ def plan(servo: EmulatedServo, address: int, data: bytes) -> tuple[WriteError, d
         err = check(servo, name, values[name])
         if err is not WriteError.NONE:
             return err, {}
-        if name == "goal_position" and not dxl:
+        if name == "goal_position" and servo.family == "feetech_sts":
             values[name] = min(max(values[name], servo.get("min_angle_limit")),
                                servo.get("max_angle_limit"))
     return WriteError.NONE, values
@@ -88,6 +88,9 @@ def check(servo: EmulatedServo, name: str, value: int) -> WriteError:
             and servo.get("operating_mode") == POSITION_MODE["dynamixel_x"]
             and not servo.get("min_position_limit") <= value <= servo.get("max_position_limit")):
         return WriteError.LIMIT
+    if (name == "goal_position" and servo.family == "dynamixel_p1"
+            and not servo.get("cw_angle_limit") <= value <= servo.get("ccw_angle_limit")):
+        return WriteError.LIMIT     # AX: Angle Limit Error, the goal is not taken
     return WriteError.NONE
 
 

@@ -43,3 +43,30 @@ def test_the_protocol1_bus_uses_packet_handler_1_0() -> None:
     bus = Dynamixel1Bus("/dev/null", baud=1_000_000)
     assert (bus.kind, bus.family) == ("dynamixel1", "dynamixel_p1")
     assert bus._make_packet_handler().getProtocolVersion() == 1.0
+
+
+# ---------------------------------------------------------------------- the emulator
+def test_the_emulator_answers_the_sdk_in_protocol_1() -> None:
+    import dynamixel_sdk as sdk
+
+    from sim.emulator import Emulator
+
+    with Emulator("dynamixel1", ids=[1, 2]) as emu:
+        port = sdk.PortHandler(emu.port)
+        ph = sdk.PacketHandler(1.0)
+        assert port.openPort() and port.setBaudRate(1_000_000)
+        try:
+            assert ph.ping(port, 1) == (12, sdk.COMM_SUCCESS, 0)       # AX-12A model 12
+            assert ph.ping(port, 7)[1] == sdk.COMM_RX_TIMEOUT
+            assert ph.read2ByteTxRx(port, 2, 36)[0] == 512              # Present Position
+            assert ph.read2ByteTxRx(port, 2, 8)[0] == 1023              # CCW Angle Limit
+            assert ph.write1ByteTxRx(port, 1, 24, 1) == (sdk.COMM_SUCCESS, 0)
+            # Goal Position(30) above CCW Angle Limit: Angle Limit Error (bit 1)
+            assert ph.write2ByteTxRx(port, 1, 30, 1024)[1] == 1 << 1
+            # Present Position is read-only: Range Error (bit 3)
+            assert ph.write2ByteTxRx(port, 1, 36, 100)[1] == 1 << 3
+        finally:
+            port.closePort()
+        writes = [p for p in emu.log() if p.instruction == "write"]
+        assert [(p.address, p.values) for p in writes][0] == (24, {1: 1})
+        assert emu.registers(1)["torque_enable"] == 1

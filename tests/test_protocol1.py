@@ -7,7 +7,10 @@ robot/bus/tables.py.
 
 from __future__ import annotations
 
+import json
 import math
+
+import pytest
 
 from robot.bus.tables import MODELS, TABLES
 
@@ -70,3 +73,26 @@ def test_the_emulator_answers_the_sdk_in_protocol_1() -> None:
         writes = [p for p in emu.log() if p.instruction == "write"]
         assert [(p.address, p.values) for p in writes][0] == (24, {1: 1})
         assert emu.registers(1)["torque_enable"] == 1
+
+
+# ---------------------------------------------------------------------- the kit's robot
+def test_the_ax12_humanoid_loads_inside_the_ax_range() -> None:
+    from robot.config import ROBOTS_DIR, load_robot
+    from robot.servo_map import ServoMap
+
+    robot = load_robot(ROBOTS_DIR / "biped18-ax12.toml")
+    assert (robot.bus.kind, robot.bus.model, robot.bus.baud) == ("dynamixel1", "AX-12A",
+                                                                  1_000_000)
+    assert len(robot.joints) == 18
+    sm = ServoMap(robot)
+    assert sm.tick_min.min() >= 0 and sm.tick_max.max() <= 1023
+    # 1 rad is 1024 / (300 deg in rad) = 195.6 ticks from the centre 512
+    assert sm.goals(sm.vector({"r_knee": 1.0}).tolist())[4] == round(512 + 1024 / math.radians(300))
+
+
+def test_the_ax12_humanoid_walks_10s_in_mujoco(capsys: pytest.CaptureFixture[str]) -> None:
+    from robot.cli import main
+
+    assert main(["walk", "--json", "--robot", "biped18-ax12", "--seconds", "10"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["fell"] is False and r["distance_m"] > 0.3

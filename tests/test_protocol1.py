@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Iterator
 
 import pytest
 
 from robot.bus.tables import MODELS, TABLES
+from sim.emulator import Emulator
 
 # e-Manual AX-12A: (address, size)
 MANUAL = {"id": (3, 1), "baud_rate": (4, 1), "return_delay_time": (5, 1),
@@ -96,3 +98,83 @@ def test_the_ax12_humanoid_walks_10s_in_mujoco(capsys: pytest.CaptureFixture[str
     assert main(["walk", "--json", "--robot", "biped18-ax12", "--seconds", "10"]) == 0
     r = json.loads(capsys.readouterr().out)
     assert r["fell"] is False and r["distance_m"] > 0.3
+
+
+# ---------------------------------------------------------------------- CLI on the wire
+AX_TOML = "biped18-ax12"
+TORQUE_ENABLE, GOAL_POSITION = 24, 30      # e-Manual AX-12A addresses
+
+
+@pytest.fixture
+def ax_emu() -> Iterator[Emulator]:
+    from robot.config import ROBOTS_DIR, load_robot
+
+    with Emulator("dynamixel1", load_robot(ROBOTS_DIR / f"{AX_TOML}.toml")) as emu:
+        yield emu
+
+
+def _bus(emu: Emulator) -> list[str]:
+    return ["--bus", "dynamixel1", "--port", emu.port, "--robot", AX_TOML]
+
+
+def test_scan_finds_18_ax12(ax_emu: Emulator, capsys: pytest.CaptureFixture[str]) -> None:
+    from robot.cli import main
+
+    assert main(["scan", *_bus(ax_emu), "--ids", "1-20", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [r["id"] for r in rows] == list(range(1, 19))
+    assert {r["model"] for r in rows} == {12}                   # AX-12A
+    assert rows[6]["joint"] == "l_hip_yaw"
+    assert {p.instruction for p in ax_emu.log()} <= {"ping", "read", "write", "sync_write"}
+
+
+def test_torque_on_then_off_at_address_24(ax_emu: Emulator) -> None:
+    from robot.cli import main
+
+    ax_emu.log(clear=True)
+    assert main(["torque", "on", *_bus(ax_emu)]) == 0
+    assert {ax_emu.registers(i)["torque_enable"] for i in range(1, 19)} == {1}
+    on = [p for p in ax_emu.log() if p.address == TORQUE_ENABLE and p.instruction == "write"]
+    assert sorted(i for p in on for i in p.ids) == list(range(1, 19))
+    assert main(["torque", "off", *_bus(ax_emu)]) == 0
+    assert {ax_emu.registers(i)["torque_enable"] for i in range(1, 19)} == {0}
+
+
+def test_pose_rest_sync_writes_goals_inside_0_1023(ax_emu: Emulator) -> None:
+    from robot.cli import main
+
+    ax_emu.log(clear=True)
+    assert main(["pose", "rest", *_bus(ax_emu), "--speed", "5"]) == 0
+    goals = [p for p in ax_emu.log() if p.instruction == "sync_write"
+             and p.address == GOAL_POSITION]
+    assert goals and all(p.length == 2 for p in goals)
+    last = goals[-1].values
+    assert all(0 <= v <= 1023 for v in last.values())
+    # rest knee 1.1 rad: 512 + 1.1 * 1024 / (300 deg) ticks on ids 4 and 10 (sign +1)
+    knee = round(512 + 1.1 * 1024 / math.radians(300))
+    assert last[4] == knee and last[10] == knee
+    # no sync read on the AX: state is read servo by servo
+    assert not any(p.instruction.endswith("sync_read") for p in ax_emu.log())
+
+
+def test_a_short_walk_on_the_emulated_chain(ax_emu: Emulator,
+                                            capsys: pytest.CaptureFixture[str]) -> None:
+    from robot.cli import main
+
+    ax_emu.log(clear=True)
+    code = main(["walk", *_bus(ax_emu), "--seconds", "1", "--rate", "50", "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0 and out["bus_errors"] == 0, out
+    writes = [p for p in ax_emu.log() if p.instruction == "sync_write"
+              and p.address == GOAL_POSITION]
+    assert len(writes) >= 40 and all(len(p.ids) == 18 for p in writes)
+
+
+def test_a_missing_servo_is_one_line_naming_its_joint(
+        ax_emu: Emulator, capsys: pytest.CaptureFixture[str]) -> None:
+    from robot.cli import main
+
+    ax_emu.set_faults(missing_ids=[10])
+    assert main(["torque", "on", *_bus(ax_emu)]) != 0
+    err = capsys.readouterr().err.strip()
+    assert "id 10 (l_knee)" in err and len(err.splitlines()) == 1, err

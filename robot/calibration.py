@@ -78,11 +78,13 @@ class SignReading:
 
 
 def detect_sign(before: int, after: int, *, direction: int, resolution: int,
-                threshold_rad: float = MOVE_THRESHOLD_RAD) -> SignReading:
+                threshold_rad: float = MOVE_THRESHOLD_RAD,
+                ticks_per_rad: float | None = None) -> SignReading:
     """The sign that makes a move of the joint in ``direction`` (+1/-1) a tick change of
-    ``after - before``."""
+    ``after - before``. ``ticks_per_rad``: default resolution / (2 pi) (a full-turn servo;
+    pass ``ServoModel.ticks_per_rad`` for the AX's 1024 ticks over 300 deg)."""
     delta = wrapped_delta(before, after, resolution)
-    if abs(delta) < threshold_rad * resolution / (2 * math.pi):
+    if abs(delta) < threshold_rad * (ticks_per_rad or resolution / (2 * math.pi)):
         return SignReading(None, delta)
     return SignReading(1 if (delta > 0) == (direction > 0) else -1, delta)
 
@@ -94,24 +96,26 @@ def zero_ticks(positions: Mapping[int, int], robot: RobotConfig) -> dict[str, in
 
 
 def hardware_range(zero: int, sign: int, resolution: int,
-                   servo_limits: tuple[int, int] | None = None) -> tuple[float, float]:
+                   servo_limits: tuple[int, int] | None = None,
+                   ticks_per_rad: float | None = None) -> tuple[float, float]:
     """The joint range [rad] the servo can reach: its tick range (its own position limit
     registers if given, else 0..resolution-1) seen from ``zero``/``sign``, inside [-pi, pi]."""
     lo_t, hi_t = servo_limits if servo_limits is not None else (0, resolution - 1)
-    per_rad = resolution / (2 * math.pi)
+    per_rad = ticks_per_rad or resolution / (2 * math.pi)
     ends = sorted(((lo_t - zero) * sign / per_rad, (hi_t - zero) * sign / per_rad))
     return max(ends[0], ANGLE.lo), min(ends[1], ANGLE.hi)
 
 
 def limits_from_ends(a: int, b: int, *, zero: int, sign: int, resolution: int,
-                     servo_limits: tuple[int, int] | None = None) -> tuple[float, float]:
+                     servo_limits: tuple[int, int] | None = None,
+                     ticks_per_rad: float | None = None) -> tuple[float, float]:
     """(min_rad, max_rad) from the ticks read at the two ends of a joint's free range:
     pulled in by LIMIT_MARGIN_RAD, kept inside ``hardware_range``, rounded inward."""
-    per_rad = resolution / (2 * math.pi)
+    per_rad = ticks_per_rad or resolution / (2 * math.pi)
     qa = wrapped_delta(zero, a, resolution) * sign / per_rad
     qb = wrapped_delta(zero, b, resolution) * sign / per_rad
     lo, hi = sorted((qa, qb))
-    hw_lo, hw_hi = hardware_range(zero, sign, resolution, servo_limits)
+    hw_lo, hw_hi = hardware_range(zero, sign, resolution, servo_limits, per_rad)
     lo, hi = max(lo + LIMIT_MARGIN_RAD, hw_lo), min(hi - LIMIT_MARGIN_RAD, hw_hi)
     k = 10 ** LIMIT_DIGITS
     return math.ceil(lo * k) / k, math.floor(hi * k) / k

@@ -28,7 +28,8 @@ log = logging.getLogger(__name__)
 FACTORY_ID = 1
 #: Baud rate [bit/s] as shipped: ROBOTIS X series 57600 (Baud Rate(8) = 1), Feetech STS
 #: 1 Mbps (Baud Rate(6) = 0).
-FACTORY_BAUD = {"dynamixel_x": 57_600, "feetech_sts": 1_000_000}
+# AX-12A / MX-28 (Protocol 1.0) ship at 1 Mbps (e-Manual AX-12A, Baud Rate(4) initial 1).
+FACTORY_BAUD = {"dynamixel_x": 57_600, "dynamixel_p1": 1_000_000, "feetech_sts": 1_000_000}
 ALL_IDS = range(int(SERVO_ID.lo), int(SERVO_ID.hi) + 1)
 
 
@@ -170,8 +171,10 @@ def assign(bus: SdkBus, found: Found, joint: JointConfig, robot: RobotConfig) ->
     bus.set_baud(found.baud)
     sid = found.id
     bus.set_torque([sid], enabled=False)
-    lock = "lock" in bus.table
-    if lock:   # Feetech: unlock the EEPROM so the writes survive a power cycle
+    # Feetech: unlock the EEPROM so the writes survive a power cycle. (The AX's Lock(47)
+    # means the opposite: 1 locks the EEPROM until power-off, so it is never written.)
+    lock = "lock" in bus.table and family == "feetech_sts"
+    if lock:
         bus.write_register(sid, "lock", 0)
     changes: list[str] = []
     delay = bus.read_register(sid, "return_delay_time")

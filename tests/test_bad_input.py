@@ -438,9 +438,9 @@ def test_bad_robot_file_fails_before_the_port_is_used(chain: Emulator, command: 
 
 @pytest.mark.parametrize("command", ["torque on", "scan"])
 @pytest.mark.parametrize("extra, needle", [
-    (["--baud", "12345"], "argument --baud: expected a standard servo baud rate (9600, 38400, "
-                          "57600, 76800, 115200, 128000, 250000, 500000, 1000000, 2000000, "
-                          "3000000, 4000000), got '12345'"),
+    (["--baud", "12345"], "argument --baud: expected a standard servo baud rate (9600, 19200, "
+                          "38400, 57600, 76800, 115200, 128000, 200000, 250000, 400000, "
+                          "500000, 1000000, 2000000, 3000000, 4000000), got '12345'"),
     (["--baud", BIG], "argument --baud: expected a standard servo baud rate"),
 ])
 def test_non_standard_baud_option(chain: Emulator, command: str, extra: list[str], needle: str,

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
@@ -178,3 +179,36 @@ def test_a_missing_servo_is_one_line_naming_its_joint(
     assert main(["torque", "on", *_bus(ax_emu)]) != 0
     err = capsys.readouterr().err.strip()
     assert "id 10 (l_knee)" in err and len(err.splitlines()) == 1, err
+
+
+def test_setup_motors_gives_a_factory_new_ax12_its_joint_id(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    from robot.cli import main
+
+    with Emulator.factory_new("dynamixel1", 1) as emu:
+        emu.plug(0)
+        assert emu.registers_of(0)["return_delay_time"] == 250      # e-Manual: 500 us
+        assert main(["setup-motors", "--robot", AX_TOML, "--bus", "dynamixel1", "--port",
+                     emu.port, "--joint", "r_knee", "--yes"]) == 0
+        assert "r_knee: id 4 at 1000000 baud" in capsys.readouterr().out
+        regs = emu.registers_of(0)
+        assert (regs["id"], regs["baud_rate"], regs["return_delay_time"]) == (4, 1, 0)
+        assert regs["lock"] == 0      # AX Lock(47) = 1 would lock the EEPROM: never written
+
+
+def test_calibrate_zero_on_the_ax12_writes_no_goal(ax_emu: Emulator, tmp_path: Path,
+                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    from robot.cli import main
+    from robot.config import load_robot
+
+    for sid in range(1, 19):        # the user holds the robot in its zero pose
+        ax_emu.set_register(sid, "goal_position", 500 + sid)
+        ax_emu.set_register(sid, "present_position", 500 + sid)
+    ax_emu.log(clear=True)
+    out = tmp_path / "ax.toml"
+    assert main(["calibrate", *_bus(ax_emu), "--out", str(out), "--zero", "--yes"]) == 0
+    assert f"wrote {out}" in capsys.readouterr().out
+    new = load_robot(out)
+    assert new.joint("r_knee").zero_ticks == 504 and new.joint("l_elbow").zero_ticks == 518
+    assert not [p for p in ax_emu.log() if p.address == GOAL_POSITION]
+    assert {ax_emu.registers(i)["torque_enable"] for i in range(1, 19)} == {0}

@@ -44,6 +44,7 @@ Ask = Callable[[str], str]
 SIGN_TRIES = 3
 #: The servo's own position-limit registers, per bus kind.
 LIMIT_REGISTERS = {"dynamixel": ("min_position_limit", "max_position_limit"),
+                   "dynamixel1": ("cw_angle_limit", "ccw_angle_limit"),
                    "feetech": ("min_angle_limit", "max_angle_limit")}
 
 
@@ -68,7 +69,7 @@ def _position(bus: Bus, joint: JointConfig) -> int:
 
 def _signs(bus: Bus, robot: RobotConfig, ask: Ask) -> dict[str, int]:
     """Step 2: ``{joint: sign}`` from one hand move per joint."""
-    res = robot.bus.servo.resolution
+    res, per_rad = robot.bus.servo.resolution, robot.bus.servo.ticks_per_rad
     out: dict[str, int] = {}
     print(f"step 2: move each joint by hand, about 20-30 degrees, the way it says "
           f"(a move under {MOVE_THRESHOLD_RAD} rad does not count)")
@@ -79,7 +80,7 @@ def _signs(bus: Bus, robot: RobotConfig, ask: Ask) -> dict[str, int]:
             ask(f"{j.name} (id {j.servo_id}): move it so that {direction_words(j.name, direction)}"
                 f" ({'+' if direction > 0 else '-'} direction), hold it and press Enter ")
             reading = detect_sign(before, _position(bus, j), direction=direction,
-                                  resolution=res)
+                                  resolution=res, ticks_per_rad=per_rad)
             if reading.sign is not None:
                 out[j.name] = reading.sign
                 flip = " (flipped)" if reading.sign != j.sign else ""
@@ -96,7 +97,7 @@ def _signs(bus: Bus, robot: RobotConfig, ask: Ask) -> dict[str, int]:
 def _limits(bus: Bus, robot: RobotConfig, zeros: dict[str, int], signs: dict[str, int],
             kind: str, ask: Ask) -> dict[str, tuple[float, float]]:
     """Step 3: ``{joint: (min_rad, max_rad)}`` from the two ends of each joint's free range."""
-    res = robot.bus.servo.resolution
+    res, per_rad = robot.bus.servo.resolution, robot.bus.servo.ticks_per_rad
     read = getattr(bus, "read_register", None)
     out: dict[str, tuple[float, float]] = {}
     print("step 3: move each joint by hand to both ends of its free range (where it touches "
@@ -112,7 +113,8 @@ def _limits(bus: Bus, robot: RobotConfig, zeros: dict[str, int], signs: dict[str
             lo, hi = (int(read(j.servo_id, r)) for r in LIMIT_REGISTERS[kind])
             servo_limits = (lo, hi) if lo < hi else None
         out[j.name] = limits_from_ends(*ends, zero=zeros[j.name], sign=signs[j.name],
-                                       resolution=res, servo_limits=servo_limits)
+                                       resolution=res, servo_limits=servo_limits,
+                                       ticks_per_rad=per_rad)
         print(f"  {j.name}: [{out[j.name][0]:+.3f}, {out[j.name][1]:+.3f}] rad")
         ask(f"put {j.name} back to its zero pose and press Enter ")
     return out

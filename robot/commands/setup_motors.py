@@ -13,10 +13,11 @@ import argparse
 from collections.abc import Callable
 
 from robot.bus.dynamixel import DynamixelBus
+from robot.bus.dynamixel1 import Dynamixel1Bus
 from robot.bus.feetech import FeetechBus
 from robot.bus.sdk_bus import SdkBus
 from robot.bus.tables import BUS_FAMILIES
-from robot.commands.common import add_robot_args, one_line_errors, robot_from
+from robot.commands.common import HARDWARE_BUSES, add_robot_args, one_line_errors, robot_from
 from robot.config import RobotConfig
 from robot.errors import ConfigError
 from robot.motor_setup import (
@@ -35,7 +36,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p = subparsers.add_parser("setup-motors", help="give new servos their joint ids and baud",
                               description=__doc__)
     add_robot_args(p, gait=False)
-    p.add_argument("--bus", choices=("dynamixel", "feetech"), default=None,
+    p.add_argument("--bus", choices=HARDWARE_BUSES, default=None,
                    help="servo bus (default: the robot's)")
     p.add_argument("--port", default=None, metavar="DEV", help="serial device (default: config)")
     p.add_argument("--joint", default=None, metavar="NAME",
@@ -50,7 +51,8 @@ def _bus(args: argparse.Namespace, robot: RobotConfig) -> SdkBus:
     if kind != robot.bus.kind:
         raise ConfigError(f"--bus {kind}: robot {robot.name} ({robot.source}) has "
                           f"{robot.bus.kind} servos; use --bus {robot.bus.kind}")
-    cls = DynamixelBus if kind == "dynamixel" else FeetechBus
+    cls: type[SdkBus] = {"dynamixel": DynamixelBus, "dynamixel1": Dynamixel1Bus}.get(
+        kind, FeetechBus)
     # No robot on the bus: a servo at id 1 is a new servo, not joint 1 (and no health check).
     return cls(args.port or robot.bus.port, baud=FACTORY_BAUD[BUS_FAMILIES[kind]],
                retries=robot.bus.retries, timeout_ms=robot.bus.timeout_ms, check_health=False)

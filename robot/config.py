@@ -26,6 +26,7 @@ from robot.bundled import (  # noqa: F401  (re-exported: where configs come from
 from robot.bus.tables import MODELS, ServoModel
 from robot.config_checks import check_bus, check_joint_extras, check_joint_set, check_ticks
 from robot.errors import ConfigError
+from robot.imu.config import ImuConfig, parse_imu
 from robot.joint_names import (  # noqa: F401 (re-exported)
     ARM_JOINTS,
     ARM_NAMES,
@@ -156,6 +157,8 @@ class RobotConfig:
     joints: tuple[JointConfig, ...]
     rest: Mapping[str, float] = field(default_factory=dict)
     source: str = "<memory>"
+    #: The ``[imu]`` section (optional; robot.imu.config): None when the robot has no IMU.
+    imu: ImuConfig | None = None
 
     def joint(self, name: str) -> JointConfig:
         for j in self.joints:
@@ -225,7 +228,7 @@ def load_robot(name_or_path: str | Path | None = None) -> RobotConfig:
 
 def parse_robot(data: Mapping[str, Any], *, source: str = "<memory>") -> RobotConfig:
     src = source
-    allowed = {"name", "bus", "geometry", "mass", "joints", "rest"}
+    allowed = {"name", "bus", "geometry", "mass", "joints", "rest", "imu"}
     unknown = sorted(set(data) - allowed)
     if unknown:
         raise ConfigError(f"{src}: {unknown[0]}: unknown key; valid: {', '.join(sorted(allowed))}")
@@ -281,8 +284,9 @@ def parse_robot(data: Mapping[str, Any], *, source: str = "<memory>") -> RobotCo
             raise ConfigError(f"{src}: rest.{jn}: {q} is outside the joint limits "
                               f"[{names[jn].min_rad}, {names[jn].max_rad}]")
         rest[jn] = q
+    imu = parse_imu(src, data["imu"]) if "imu" in data else None
     robot = RobotConfig(name=name, bus=bus, geometry=geometry, mass=mass, joints=tuple(joints),
-                        rest=rest, source=src)
+                        rest=rest, source=src, imu=imu)
     check_ticks(robot)
     return robot
 

@@ -1,0 +1,57 @@
+"""One factory picks the IMU backend by ``ImuConfig.kind`` (like ``robot.bus.factory``).
+
+``bno055`` (robot.imu.bno055, BNO055 over UART) is built in. Other kinds are plugins: a
+distribution declares an entry point in the group ``biped.imus`` (biped's own
+pyproject.toml declares ``sim = "sim.imu:open_sim_imu"``), naming a callable
+``(config: ImuConfig, *, bus: Bus | None) -> Imu``; ``register_imu`` adds one at run time.
+So ``robot/`` never imports ``sim/``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+from robot.errors import ConfigError
+from robot.imu.base import Imu
+from robot.imu.registry import Registry
+
+if TYPE_CHECKING:
+    from robot.bus.base import Bus
+    from robot.imu.config import ImuConfig
+
+#: Entry-point group where IMU plugins are declared.
+ENTRY_POINT_GROUP = "biped.imus"
+BUILTIN = ("bno055",)
+
+ImuFactory = Callable[..., Imu]   # (config: ImuConfig, *, bus: Bus | None) -> Imu
+
+_plugins: Registry[ImuFactory] = Registry(ENTRY_POINT_GROUP, BUILTIN, "imu.kind")
+
+
+def register_imu(kind: str, factory: ImuFactory) -> None:
+    """Make ``open_imu`` build IMUs of ``kind`` with ``factory(config, bus=...)``."""
+    _plugins.register(kind, factory)
+
+
+def imu_kinds() -> tuple[str, ...]:
+    """Every IMU kind ``open_imu`` accepts: plugins (registered or declared), then built-in."""
+    return _plugins.kinds()
+
+
+def open_imu(config: ImuConfig, *, bus: Bus | None = None) -> Imu:
+    """The IMU backend for ``config`` (not yet opened: use ``with open_imu(...) as imu:``).
+
+    bus: the servo bus the robot runs on; the ``sim`` IMU reads the MuJoCo state of a
+    ``sim`` bus (open it first), real IMUs ignore it.
+    """
+    if config.kind == "bno055":
+        from robot.imu.bno055 import Bno055Imu
+
+        return Bno055Imu(config)
+    factory = _plugins.plugin(config.kind)
+    if factory is None:
+        raise ConfigError(f"imu.kind: unknown IMU {config.kind!r}; valid: "
+                          f"{', '.join(imu_kinds())} (plugins are entry points in group "
+                          f"{ENTRY_POINT_GROUP}; reinstall biped if 'sim' is missing)")
+    return factory(config, bus=bus)

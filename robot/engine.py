@@ -79,6 +79,11 @@ class GaitEngine:
         self._ramp = 0.0          # linear ramp variable in [0, 1]
         self._running = False
         self.unreachable_ticks = 0
+        #: Added to ``turn`` [rad/step] by a feedback loop (robot.balance's heading loop);
+        #: the sum is kept inside turn's range.
+        self.turn_trim = 0.0
+        #: Extra pelvis (roll, pitch) [rad] relative to the feet, set by a feedback loop.
+        self.lean: tuple[float, float] = (0.0, 0.0)
         self._lo = [j.min_rad for j in robot.joints]
         self._hi = [j.max_rad for j in robot.joints]
 
@@ -144,9 +149,12 @@ class GaitEngine:
         """Joint angles [rad] at the current phase (default: the current envelope)."""
         a = self.amplitude if amplitude is None else amplitude
         p = self._live
+        if self.turn_trim:
+            spec = SPECS["turn"]
+            p = dataclasses.replace(p, turn=min(max(p.turn + self.turn_trim, spec.lo), spec.hi))
         ch = gait.channels(self.phase, p, amplitude=a)
         q, ok = solve(body_targets(ch, p, self.robot.geometry, amplitude=a,
-                                   leg_yaw=self._leg_yaw), self.robot)
+                                   leg_yaw=self._leg_yaw, lean=self.lean), self.robot)
         if not ok:
             self.unreachable_ticks += 1
             if self.unreachable_ticks in (1, 10, 100) or self.unreachable_ticks % 1000 == 0:

@@ -42,6 +42,7 @@ LEGS = "legs and feet"
 ARMS = "shoulders and arms"
 STEER = "steering"
 ROBOT = "robot mapping"
+BALANCE = "balance feedback"
 
 SPECS: dict[str, ParamSpec] = {
     # --- timing ---------------------------------------------------------------------
@@ -95,6 +96,23 @@ SPECS: dict[str, ParamSpec] = {
     "arm_scale": ParamSpec(1.0, 0.0, 3.0, "-", ROBOT, "scale of arm channels to the arm length", False),
     "ramp_cycles": ParamSpec(1.0, 0.1, 10.0, "cycle", ROBOT, "gait cycles to ramp amplitudes "
                              "in and out", False),
+    # --- balance feedback (robot/balance.py; used only with an IMU and balance on) --------
+    "bal_ankle_pd": ParamSpec(0.05, 0.0, 1.0, "s", BALANCE, "ankle pitch/roll per torso "
+                              "tilt rate [rad per rad/s] (gyro damping)", False),
+    "bal_hip_pd": ParamSpec(0.0, 0.0, 1.0, "s", BALANCE, "hip pitch/roll per torso tilt "
+                            "rate [rad per rad/s] (gyro damping)", False),
+    "bal_ankle_pp": ParamSpec(0.0, 0.0, 3.0, "-", BALANCE, "ankle pitch/roll per rad of "
+                              "torso tilt from upright", False),
+    "bal_lean_i": ParamSpec(1.0, 0.0, 5.0, "1/s", BALANCE, "rate at which the pelvis learns "
+                            "the lean a slope needs [rad/s per rad of tilt]", False),
+    "bal_lean_max": ParamSpec(0.15, 0.0, 0.4, "rad", BALANCE, "largest learned lean (pelvis "
+                              "roll/pitch relative to the feet)", False),
+    "bal_heading_p": ParamSpec(0.5, 0.0, 2.0, "1/step", BALANCE, "turn trim per rad of "
+                               "heading error [rad/step per rad]", False),
+    "bal_heading_i": ParamSpec(0.2, 0.0, 2.0, "1/(step s)", BALANCE, "turn trim per rad*s "
+                               "of heading error", False),
+    "bal_turn_max": ParamSpec(0.2, 0.0, 0.5, "rad/step", BALANCE, "largest turn trim the "
+                              "heading loop may add", False),
 }
 
 ALIASES: dict[str, str] = {
@@ -106,7 +124,7 @@ ALIASES: dict[str, str] = {
     "Wosc_L": "Aosc_L",
 }
 
-GROUPS: tuple[str, ...] = (PELVIS, LEGS, ARMS, STEER, ROBOT)
+GROUPS: tuple[str, ...] = (PELVIS, LEGS, ARMS, STEER, ROBOT, BALANCE)
 
 
 @dataclass(frozen=True)
@@ -155,6 +173,14 @@ class GaitParams:
     toe_gain: float = SPECS["toe_gain"].default
     arm_scale: float = SPECS["arm_scale"].default
     ramp_cycles: float = SPECS["ramp_cycles"].default
+    bal_ankle_pd: float = SPECS["bal_ankle_pd"].default
+    bal_hip_pd: float = SPECS["bal_hip_pd"].default
+    bal_ankle_pp: float = SPECS["bal_ankle_pp"].default
+    bal_lean_i: float = SPECS["bal_lean_i"].default
+    bal_lean_max: float = SPECS["bal_lean_max"].default
+    bal_heading_p: float = SPECS["bal_heading_p"].default
+    bal_heading_i: float = SPECS["bal_heading_i"].default
+    bal_turn_max: float = SPECS["bal_turn_max"].default
 
     def replace(self, changes: Mapping[str, Any], *, where: str = "parameter") -> GaitParams:
         """A copy with ``changes`` applied after validating every one of them.

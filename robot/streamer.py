@@ -26,7 +26,7 @@ import logging
 import threading
 import time
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -42,7 +42,17 @@ from robot.start_check import check_inside_limits
 from robot.telemetry import LoopStats, Telemetry, TickObserver
 from robot.watchdog import FAILSAFE_MARGIN, Watchdog, WatchdogConfig
 
-__all__ = ["LoopStats", "Streamer", "Telemetry", "TickObserver", "check_inside_limits"]
+__all__ = ["Feedback", "LoopStats", "Streamer", "Telemetry", "TickObserver",
+           "check_inside_limits"]
+
+
+class Feedback(Protocol):
+    """A stage between the engine and safety (robot.balance.Balance): ``start`` when the
+    gait starts, then called every tick with the joints [rad] and the tick [s]."""
+
+    def start(self) -> None: ...
+    def stop(self) -> None: ...
+    def __call__(self, q: np.ndarray, dt: float) -> np.ndarray: ...
 
 log = logging.getLogger(__name__)
 
@@ -53,7 +63,8 @@ class Streamer:
     def __init__(self, robot_map: ServoMap, bus: Bus, engine: GaitEngine, *,
                  rate_hz: float = 200.0, read_every: int = 10, clock: Clock | None = None,
                  hold_at_end: bool = False, watchdog: WatchdogConfig | None = None,
-                 observer: TickObserver | None = None) -> None:
+                 observer: TickObserver | None = None,
+                 feedback: Feedback | None = None) -> None:
         self.map = robot_map
         self.bus = bus
         self.engine = engine
@@ -66,6 +77,8 @@ class Streamer:
         self.watchdog_config = watchdog or WatchdogConfig()
         self.watchdog = Watchdog(self.watchdog_config, robot_map, robot=engine.robot)
         self.observer = observer
+        self.feedback = feedback
+        self._feedback_on = False
         self.telemetry = Telemetry()
         self._lock = threading.Lock()
         self._pending: dict[str, float] = {}
@@ -153,6 +166,9 @@ class Streamer:
         self._ramp_to(self.engine.start_pose(), state="ramp_in", interruptible=True)
         if not self._stop.is_set():
             self.engine.start()
+            if self.feedback is not None:
+                self.feedback.start()
+                self._feedback_on = True
             t_gait = self.clock.now()
             while not self._estop.is_set():
                 if self._stop.is_set() or (seconds is not None
@@ -171,6 +187,7 @@ class Streamer:
                            else "ramp_out")
         if not self._estop.is_set():
             self._ramp_to(self.map.vector(self.engine.robot.rest), state="rest")
+        self._feedback_on = False
 
     def _set_fault(self, reason: str) -> None:
         """Record the first fault and request a stop (its ramp-out, if any, follows)."""
@@ -230,7 +247,10 @@ class Streamer:
 
     # -- the one loop --------------------------------------------------------------------
     def _send(self, q: np.ndarray, *, state: str) -> None:
-        """Clamp, slew-limit, wait for the deadline, write; read back every Nth tick."""
+        """(Feedback,) clamp, slew-limit, wait for the deadline, write; read back every Nth
+        tick."""
+        if self._feedback_on:
+            q = self._feed_back(q)
         q = np.clip(self.map.clamp(q), self._q_last - self._step, self._q_last + self._step)
         q_list = q.tolist()
         self._wait_deadline()
@@ -259,6 +279,19 @@ class Streamer:
                 self._bus_errors += 1
                 self.watchdog.bus_failed("read", e)
         self._notify()
+
+    def _feed_back(self, q: np.ndarray) -> np.ndarray:
+        """``q`` corrected by the feedback stage; if it fails, the walk ends as a fault
+        and goes on open loop (the servos are fine; only the sensor is not)."""
+        assert self.feedback is not None
+        try:
+            return self.feedback(q, self.dt)
+        except Exception as e:
+            self._feedback_on = False
+            self.feedback.stop()
+            log.exception("the balance feedback failed; open loop from here")
+            self._set_fault(f"exception in the balance feedback: {type(e).__name__}: {e}")
+            return q
 
     def _wait_deadline(self) -> None:
         self._next += self.dt

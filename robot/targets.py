@@ -63,11 +63,14 @@ def scale(g: Geometry, p: GaitParams) -> float:
 
 
 def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
-                 amplitude: float = 1.0, leg_yaw: bool = True) -> BodyTargets:
+                 amplitude: float = 1.0, leg_yaw: bool = True,
+                 lean: tuple[float, float] = (0.0, 0.0)) -> BodyTargets:
     """Map the paper's channels (robot.gait.channels at ``amplitude``) to body targets.
 
     leg_yaw: False for 5-DoF legs (no hip yaw): no foot yaws relative to the pelvis, so
     ``turn`` and the pelvis yaw of eq 14/15 are left out and the IK's hip yaw is 0.
+    lean: extra (roll, pitch) [rad] of the pelvis relative to the feet's plane (robot.
+    balance: on a slope the feet follow the ground while the body stays upright).
     """
     s = scale(g, p)
     a_delta = amplitude * p.delta_f
@@ -78,8 +81,10 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
     px = s * 0.5 * (ch["RightUpLeg_tZ"] + ch["LeftUpLeg_tZ"])
     yaw = s * (ch["RightUpLeg_tZ"] - ch["LeftUpLeg_tZ"]) / g.hip_width if leg_yaw else 0.0
     py = p.sway * (sin_t * xm.cos(p.sway_phase) - tz * xm.sin(p.sway_phase))
-    pitch = p.torso_lean + p.spine_gain * (ch["StZ_ik"] - ch["CtZ"])
+    pitch = p.torso_lean + lean[1] + p.spine_gain * (ch["StZ_ik"] - ch["CtZ"])
     pelvis_rot = xm.rz_ry(yaw, pitch)
+    if lean[0] != 0.0:
+        pelvis_rot = xm.post_rx(pelvis_rot, lean[0])
 
     # Feet in the level frame under the pelvis origin.
     ty_l = 2.0 * a_delta - ty           # eq 8 in anti-phase

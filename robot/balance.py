@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from robot.params import SPECS, GaitParams
+from robot.targets import NO_TRIM, BodyTrim
 
 if TYPE_CHECKING:
     from robot.engine import GaitEngine
@@ -63,12 +64,14 @@ class BalanceState(NamedTuple):
     heading_ref: float = 0.0
     heading_i: float = 0.0
     turn: float = 0.0
+    feet: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
     started: bool = False
 
 
 class Correction(NamedTuple):
     """Added to both legs [rad]: ankle/hip pitch and roll; turn trim [rad/step]; the
-    pelvis's extra roll and pitch relative to the feet [rad] (the learned lean)."""
+    pelvis's extra roll and pitch relative to the feet [rad] (the learned lean); both feet
+    moved forward / left under the pelvis [m] (the step toward the fall)."""
 
     ankle_pitch: float = 0.0
     ankle_roll: float = 0.0
@@ -77,6 +80,7 @@ class Correction(NamedTuple):
     turn: float = 0.0
     pelvis_roll: float = 0.0
     pelvis_pitch: float = 0.0
+    feet: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
 
 
 def wrap(angle: float) -> float:
@@ -97,7 +101,8 @@ def commanded_yaw_rate(p: GaitParams, amplitude: float) -> float:
 
 
 def balance_step(state: BalanceState, tilt: Tilt, p: GaitParams, dt: float, *,
-                 amplitude: float = 1.0) -> tuple[BalanceState, Correction]:
+                 amplitude: float = 1.0,
+                 swinging: tuple[bool, bool] = (False, False)) -> tuple[BalanceState, Correction]:
     """One tick of the balance loop: the new state and the correction. dt: tick [s];
     amplitude: the gait envelope (the heading reference follows the commanded turn
     scaled by it)."""
@@ -122,13 +127,24 @@ def balance_step(state: BalanceState, tilt: Tilt, p: GaitParams, dt: float, *,
     want = _clip(p.bal_heading_p * error + p.bal_heading_i * heading_i, p.bal_turn_max)
     step_s = 0.5 * p.cycle_s if math.isfinite(p.cycle_s) else 0.0
     turn = want if step_s <= dt else state.turn + (want - state.turn) * dt / step_s
+    # Stepping: a swinging foot moves (time constant: a quarter step) toward where the
+    # body is falling; a standing foot stays put (moving it would push the body).
+    want_x = _clip(p.bal_step_pd * tilt.pitch_rate, p.bal_step_max)
+    want_y = _clip(-p.bal_step_pd * tilt.roll_rate, p.bal_step_max)
+    a = min(1.0, dt / (0.125 * p.cycle_s)) if math.isfinite(p.cycle_s) else 1.0
+    rx, ry, lx, ly = state.feet
+    if swinging[0]:
+        rx, ry = rx + a * (want_x - rx), ry + a * (want_y - ry)
+    if swinging[1]:
+        lx, ly = lx + a * (want_x - lx), ly + a * (want_y - ly)
+    feet = (rx, ry, lx, ly)
     corr = Correction(
         ankle_pitch=p.bal_ankle_pd * tilt.pitch_rate + p.bal_ankle_pp * e_pitch,
         ankle_roll=p.bal_ankle_pd * tilt.roll_rate + p.bal_ankle_pp * e_roll,
         hip_pitch=p.bal_hip_pd * tilt.pitch_rate,
         hip_roll=p.bal_hip_pd * tilt.roll_rate,
-        turn=amplitude * turn, pelvis_roll=lean_roll, pelvis_pitch=lean_pitch)
-    return BalanceState(lean_pitch, lean_roll, heading, heading_ref, heading_i, turn,
+        turn=amplitude * turn, pelvis_roll=lean_roll, pelvis_pitch=lean_pitch, feet=feet)
+    return BalanceState(lean_pitch, lean_roll, heading, heading_ref, heading_i, turn, feet,
                         True), corr
 
 
@@ -188,13 +204,15 @@ class Balance:
 
     def stop(self) -> None:
         self.engine.turn_trim = 0.0
-        self.engine.lean = (0.0, 0.0)
+        self.engine.trim = NO_TRIM
 
     def __call__(self, q: np.ndarray, dt: float) -> np.ndarray:
         tilt = self._read_tilt()
+        lift = self.engine.lift
         self.state, corr = balance_step(self.state, tilt, self.engine.live_params, dt,
-                                        amplitude=self.engine.amplitude)
+                                        amplitude=self.engine.amplitude,
+                                        swinging=(lift[0] > 0.0, lift[1] > 0.0))
         self.engine.turn_trim = corr.turn if self._yaw else 0.0
-        self.engine.lean = (corr.pelvis_roll, corr.pelvis_pitch)
+        self.engine.trim = BodyTrim(corr.pelvis_roll, corr.pelvis_pitch, *corr.feet)
         self.last = corr
         return apply(q, corr, self.slots)

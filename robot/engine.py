@@ -20,7 +20,7 @@ from robot import gait
 from robot.config import JOINT_NAMES, RobotConfig
 from robot.ik import arm_ik, leg_ik
 from robot.params import SPECS, GaitParams
-from robot.targets import BodyTargets, body_targets
+from robot.targets import NO_TRIM, BodyTargets, body_targets
 from robot.xmath import Num
 
 log = logging.getLogger(__name__)
@@ -82,8 +82,10 @@ class GaitEngine:
         #: Added to ``turn`` [rad/step] by a feedback loop (robot.balance's heading loop);
         #: the sum is kept inside turn's range.
         self.turn_trim = 0.0
-        #: Extra pelvis (roll, pitch) [rad] relative to the feet, set by a feedback loop.
-        self.lean: tuple[float, float] = (0.0, 0.0)
+        #: Posture change relative to the feet, set by a feedback loop (robot.balance).
+        self.trim = NO_TRIM
+        #: Lift of the right and left foot [m] at the last ``pose`` (> 0: swinging).
+        self.lift = (0.0, 0.0)
         self._lo = [j.min_rad for j in robot.joints]
         self._hi = [j.max_rad for j in robot.joints]
 
@@ -153,8 +155,10 @@ class GaitEngine:
             spec = SPECS["turn"]
             p = dataclasses.replace(p, turn=min(max(p.turn + self.turn_trim, spec.lo), spec.hi))
         ch = gait.channels(self.phase, p, amplitude=a)
-        q, ok = solve(body_targets(ch, p, self.robot.geometry, amplitude=a,
-                                   leg_yaw=self._leg_yaw, lean=self.lean), self.robot)
+        targets = body_targets(ch, p, self.robot.geometry, amplitude=a,
+                               leg_yaw=self._leg_yaw, trim=self.trim)
+        self.lift = (float(targets.lift_r), float(targets.lift_l))
+        q, ok = solve(targets, self.robot)
         if not ok:
             self.unreachable_ticks += 1
             if self.unreachable_ticks in (1, 10, 100) or self.unreachable_ticks % 1000 == 0:

@@ -107,6 +107,10 @@ SPECS: dict[str, ParamSpec] = {
                             "the lean a slope needs [rad/s per rad of tilt]", False),
     "bal_lean_max": ParamSpec(0.15, 0.0, 0.4, "rad", BALANCE, "largest learned lean (pelvis "
                               "roll/pitch relative to the feet)", False),
+    "bal_step_pd": ParamSpec(0.0, 0.0, 0.2, "m s", BALANCE, "feet moved toward the fall "
+                             "per torso tilt rate [m per rad/s] (stepping)", False),
+    "bal_step_max": ParamSpec(0.02, 0.0, 0.06, "m", BALANCE, "largest step toward the fall",
+                              False),
     "bal_heading_p": ParamSpec(0.5, 0.0, 2.0, "1/step", BALANCE, "turn trim per rad of "
                                "heading error [rad/step per rad]", False),
     "bal_heading_i": ParamSpec(0.2, 0.0, 2.0, "1/(step s)", BALANCE, "turn trim per rad*s "
@@ -178,6 +182,8 @@ class GaitParams:
     bal_ankle_pp: float = SPECS["bal_ankle_pp"].default
     bal_lean_i: float = SPECS["bal_lean_i"].default
     bal_lean_max: float = SPECS["bal_lean_max"].default
+    bal_step_pd: float = SPECS["bal_step_pd"].default
+    bal_step_max: float = SPECS["bal_step_max"].default
     bal_heading_p: float = SPECS["bal_heading_p"].default
     bal_heading_i: float = SPECS["bal_heading_i"].default
     bal_turn_max: float = SPECS["bal_turn_max"].default

@@ -57,6 +57,26 @@ def _yawed(v: tuple[Num, Num, Num], yaw: Num) -> tuple[Num, Num, Num]:
     return (c * v[0] - s * v[1], s * v[0] + c * v[1], v[2])
 
 
+class BodyTrim(NamedTuple):
+    """A feedback loop's change of the posture (robot.balance), relative to the feet.
+
+    roll, pitch: extra pelvis rotation [rad] (on a slope the feet follow the ground while
+    the body stays upright); r_dx, r_dy, l_dx, l_dy: each foot moved forward / left [m]
+    under the pelvis (a feedback loop moves a foot only while it swings, so it lands
+    where the body is falling, and keeps it there while it stands).
+    """
+
+    roll: float = 0.0
+    pitch: float = 0.0
+    r_dx: float = 0.0
+    r_dy: float = 0.0
+    l_dx: float = 0.0
+    l_dy: float = 0.0
+
+
+NO_TRIM = BodyTrim()
+
+
 def scale(g: Geometry, p: GaitParams) -> float:
     """Metres per rig unit."""
     return g.leg_length / p.rig_leg
@@ -64,13 +84,12 @@ def scale(g: Geometry, p: GaitParams) -> float:
 
 def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
                  amplitude: float = 1.0, leg_yaw: bool = True,
-                 lean: tuple[float, float] = (0.0, 0.0)) -> BodyTargets:
+                 trim: BodyTrim = NO_TRIM) -> BodyTargets:
     """Map the paper's channels (robot.gait.channels at ``amplitude``) to body targets.
 
     leg_yaw: False for 5-DoF legs (no hip yaw): no foot yaws relative to the pelvis, so
     ``turn`` and the pelvis yaw of eq 14/15 are left out and the IK's hip yaw is 0.
-    lean: extra (roll, pitch) [rad] of the pelvis relative to the feet's plane (robot.
-    balance: on a slope the feet follow the ground while the body stays upright).
+    trim: a feedback loop's change of posture (robot.balance), see ``BodyTrim``.
     """
     s = scale(g, p)
     a_delta = amplitude * p.delta_f
@@ -81,10 +100,10 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
     px = s * 0.5 * (ch["RightUpLeg_tZ"] + ch["LeftUpLeg_tZ"])
     yaw = s * (ch["RightUpLeg_tZ"] - ch["LeftUpLeg_tZ"]) / g.hip_width if leg_yaw else 0.0
     py = p.sway * (sin_t * xm.cos(p.sway_phase) - tz * xm.sin(p.sway_phase))
-    pitch = p.torso_lean + lean[1] + p.spine_gain * (ch["StZ_ik"] - ch["CtZ"])
+    pitch = p.torso_lean + trim.pitch + p.spine_gain * (ch["StZ_ik"] - ch["CtZ"])
     pelvis_rot = xm.rz_ry(yaw, pitch)
-    if lean[0] != 0.0:
-        pelvis_rot = xm.post_rx(pelvis_rot, lean[0])
+    if trim.roll != 0.0:
+        pelvis_rot = xm.post_rx(pelvis_rot, trim.roll)
 
     # Feet in the level frame under the pelvis origin.
     ty_l = 2.0 * a_delta - ty           # eq 8 in anti-phase
@@ -112,8 +131,10 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
         r_pos = _yawed(r_pos, yaw_r)
         l_pos = _yawed(l_pos, yaw_l)
 
-    r_sole = xm.apply_t(pelvis_rot, (r_pos[0] - px, r_pos[1] - py, r_pos[2]))
-    l_sole = xm.apply_t(pelvis_rot, (l_pos[0] - px, l_pos[1] - py, l_pos[2]))
+    r_sole = xm.apply_t(pelvis_rot, (r_pos[0] - px + trim.r_dx, r_pos[1] - py + trim.r_dy,
+                                     r_pos[2]))
+    l_sole = xm.apply_t(pelvis_rot, (l_pos[0] - px + trim.l_dx, l_pos[1] - py + trim.l_dy,
+                                     l_pos[2]))
     r_foot = xm.matmul(xm.transpose(pelvis_rot), r_rot)
     l_foot = xm.matmul(xm.transpose(pelvis_rot), l_rot)
 

@@ -23,6 +23,7 @@ from robot.config import load_gait, load_robot
 from robot.engine import GaitEngine
 from robot.ik import leg_fk_full
 from robot.params import BALANCE, SPECS, GaitParams
+from robot.targets import BodyTrim
 
 DT = 0.005
 LEVEL = Tilt(roll=0.0, pitch=0.0, roll_rate=0.0, pitch_rate=0.0, yaw_rate=0.0, heading=0.0)
@@ -159,7 +160,7 @@ def test_the_stage_trims_the_engine_and_start_forgets() -> None:
     engine.start()
     for _ in range(401):
         stage(engine.tick(DT), DT)
-    assert engine.turn_trim > 0.0 and engine.lean[1] > 0.0
+    assert engine.turn_trim > 0.0 and engine.trim.pitch > 0.0
     stage.start()
-    assert engine.turn_trim == 0.0 and engine.lean == (0.0, 0.0)
+    assert engine.turn_trim == 0.0 and engine.trim == BodyTrim()
     assert stage.state == BalanceState()

@@ -212,7 +212,8 @@ class FakeBno055:
         addrs = range(reg, reg + len(data))
         if page == 0 and any(a in r for a in addrs for r in P0_READ_ONLY):
             return bytes([STATUS, REGMAP_WRITE_DISABLED])
-        if page == 1 and (p0[P0["OPR_MODE"]] & 0x0F) != CONFIGMODE:
+        if page == 1 and addrs != range(P0["PAGE_ID"], P0["PAGE_ID"] + 1) \
+                and (p0[P0["OPR_MODE"]] & 0x0F) != CONFIGMODE:
             return bytes([STATUS, WRITE_FAIL])   # configuration only in CONFIGMODE
         self._page[page][reg:reg + len(data)] = data
         if P0["PAGE_ID"] in addrs:   # PAGE_ID is 0x07 on both pages (section 4.2)

@@ -11,8 +11,8 @@ Measurement model, per axis, in the IMU (device) frame (the torso frame rotated 
     quat  = true ⊗ exp(n_q / 2),  n_q ~ N(0, (noise * QUAT_NOISE)^2) per axis   (fusion)
 
 The densities and offsets are the BNO055 datasheet's typical values (BST-BNO055-DS000
-rev 1.4, section 1.2 / Table 0-1 "Electrical parameter specification"), the bandwidths the
-chip's filters in fusion mode (Table 3-7, default sensor configuration). All randomness
+rev 1.4, section 1 "Specification", Tables 0-1/0-2), the bandwidths the chip's filters in
+fusion mode (Table 3-7, default sensor configuration). All randomness
 comes from ``numpy.random.default_rng(seed)``: the same seed and the same reads give the
 same samples.
 

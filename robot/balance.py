@@ -29,6 +29,8 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
+from robot.imu.base import Imu
+from robot.imu.tilt import TiltEstimator, tilt_from_quat
 from robot.params import SPECS, GaitParams
 from robot.targets import NO_TRIM, BodyTrim
 
@@ -36,7 +38,7 @@ if TYPE_CHECKING:
     from robot.engine import GaitEngine
 
 
-class Tilt(NamedTuple):
+class Attitude(NamedTuple):
     """What the balance loop needs from an IMU, in the torso frame.
 
     roll, pitch: tilt from upright [rad] (+pitch = nose down, +roll = right side down);
@@ -100,7 +102,7 @@ def commanded_yaw_rate(p: GaitParams, amplitude: float) -> float:
     return amplitude * p.turn * 2.0 / cycle
 
 
-def balance_step(state: BalanceState, tilt: Tilt, p: GaitParams, dt: float, *,
+def balance_step(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float, *,
                  amplitude: float = 1.0,
                  swinging: tuple[bool, bool] = (False, False)) -> tuple[BalanceState, Correction]:
     """One tick of the balance loop: the new state and the correction. dt: tick [s];
@@ -184,11 +186,11 @@ class Balance:
     """The streamer's feedback stage: per tick, read the tilt, step the loop, trim the
     engine's turn and return the corrected joints.
 
-    read_tilt: returns the current ``Tilt`` (from an IMU; robot.imu); it may raise, and the
+    read_tilt: returns the current ``Attitude`` (from an IMU; robot.imu); it may raise, and the
     streamer then ends the walk as a fault and drops the feedback.
     """
 
-    def __init__(self, engine: GaitEngine, read_tilt: Callable[[], Tilt]) -> None:
+    def __init__(self, engine: GaitEngine, read_tilt: Callable[[], Attitude]) -> None:
         self.engine = engine
         self._read_tilt = read_tilt
         self.slots = JointSlots.of(engine.robot.joint_names)
@@ -216,3 +218,26 @@ class Balance:
         self.engine.trim = BodyTrim(corr.pelvis_roll, corr.pelvis_pitch, *corr.feet)
         self.last = corr
         return apply(q, corr, self.slots)
+
+
+def attitude_reader(imu: Imu, *, tau_s: float | None = None) -> Callable[[], Attitude]:
+    """A function that reads ``imu`` and returns the torso's ``Attitude``: tilt and
+    heading from the device's fused quaternion when it has one, else tilt from a
+    complementary filter (robot.imu.tilt, time constant ``tau_s`` [s]) and no heading (the
+    loop then integrates the yaw rate). Rates are the gyro's, torso frame."""
+    estimator = TiltEstimator() if tau_s is None else TiltEstimator(tau_s=tau_s)
+
+    def read() -> Attitude:
+        s = imu.read()
+        gx, gy, gz = s.gyro
+        if s.quat is not None:
+            roll, pitch = tilt_from_quat(s.quat)
+            w, x, y, z = s.quat
+            heading: float | None = math.atan2(2.0 * (w * z + x * y),
+                                               1.0 - 2.0 * (y * y + z * z))
+        else:
+            roll, pitch = estimator.update(s)
+            heading = None
+        return Attitude(roll=roll, pitch=pitch, roll_rate=gx, pitch_rate=gy, yaw_rate=gz,
+                        heading=heading)
+    return read

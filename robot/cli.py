@@ -33,6 +33,7 @@ COMMANDS: tuple[str, ...] = (
     "calibrate",
     "find_port",
     "monitor",
+    "robustness",
 )
 
 

@@ -14,7 +14,7 @@ from robot.balance import (
     BalanceState,
     Correction,
     JointSlots,
-    Tilt,
+    Attitude,
     apply,
     balance_step,
     wrap,
@@ -26,7 +26,7 @@ from robot.params import BALANCE, SPECS, GaitParams
 from robot.targets import BodyTrim
 
 DT = 0.005
-LEVEL = Tilt(roll=0.0, pitch=0.0, roll_rate=0.0, pitch_rate=0.0, yaw_rate=0.0, heading=0.0)
+LEVEL = Attitude(roll=0.0, pitch=0.0, roll_rate=0.0, pitch_rate=0.0, yaw_rate=0.0, heading=0.0)
 GAINS = GaitParams().replace({"bal_ankle_pd": 0.05, "bal_hip_pd": 0.02, "bal_ankle_pp": 0.1,
                               "bal_lean_i": 1.0, "bal_lean_max": 0.1, "bal_heading_p": 0.5,
                               "bal_heading_i": 0.2, "bal_turn_max": 0.2})
@@ -43,7 +43,7 @@ def torso_tilt_over_flat_foot(robot_geometry, side: str, q_leg) -> tuple[float, 
 
 
 def test_zero_gains_change_nothing() -> None:
-    tilt = Tilt(roll=0.1, pitch=-0.2, roll_rate=1.0, pitch_rate=-2.0, yaw_rate=0.5, heading=0.3)
+    tilt = Attitude(roll=0.1, pitch=-0.2, roll_rate=1.0, pitch_rate=-2.0, yaw_rate=0.5, heading=0.3)
     zero = GaitParams().replace({n: 0.0 for n, spec in SPECS.items() if spec.group == BALANCE})
     _, corr = balance_step(BalanceState(), tilt, zero, DT)
     assert corr == Correction()

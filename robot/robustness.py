@@ -1,0 +1,154 @@
+"""The robustness suite: simulated walks under perturbations, with and without balance.
+
+Each condition is one ``biped walk --json`` run in its own process (the same code path a
+user runs, so the suite measures the product, not a copy of it), several at once across
+the cores. A condition survives when the walk does not fall (sim.metrics: torso low or
+tilted past the fall threshold) in ``seconds`` of gait.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any
+
+from robot.params import GaitParams
+
+#: Push impulse of the full suite [N*s] (issue 10's goal) and the gait time of the first
+#: push [s]: well after the ramp-in.
+PUSH_NS = 1.0
+PUSH_AT_S = 8.0
+#: Phases of the step at which pushes land (fractions of a gait cycle).
+PUSH_PHASES = (0.0, 0.25, 0.5, 0.75)
+#: Parameters the +/-20 % conditions change: every non-zero parameter of the preset that
+#: shapes the motion (steering and balance gains are covered by their own conditions).
+PARAM_SCALE = 0.2
+SKIP_PARAMS = frozenset({"speed", "turn", "side_step", "ramp_cycles", "rig_leg", "fps"})
+
+
+@dataclass(frozen=True)
+class Condition:
+    """One perturbation: a name, a group (one bar of the picture) and walk options."""
+
+    group: str
+    name: str
+    args: tuple[str, ...] = ()
+
+
+@dataclass
+class Outcome:
+    """The result of one condition with balance on or off."""
+
+    condition: Condition
+    balance: bool
+    fell: bool | None                      # None: the run failed (error set)
+    fell_at_s: float | None = None
+    distance_m: float = 0.0
+    heading_deg: float = 0.0
+    wall_s: float = 0.0
+    error: str = ""
+    summary: dict[str, Any] = field(default_factory=dict)
+
+
+def conditions(params: GaitParams, *, quick: bool = False) -> list[Condition]:
+    """The suite for a preset with ``params`` (``quick``: a few cases for CI)."""
+    cycle = params.cycle_s
+    out = [Condition("flat", "flat")]
+    slopes = (5.0, -5.0) if quick else (2.0, 5.0, -2.0, -5.0)
+    out += [Condition("slope", f"slope {s:+g} deg", ("--slope", f"{s:g}")) for s in slopes]
+    crosses = (4.0,) if quick else (4.0, -4.0)
+    out += [Condition("cross slope", f"cross slope {s:+g} deg", ("--cross-slope", f"{s:g}"))
+            for s in crosses]
+    heights, seeds = ((5.0,), (0,)) if quick else ((1.0, 3.0, 5.0), (0, 1, 2))
+    out += [Condition("bumps", f"bumps {h:g} mm seed {s}",
+                      ("--bumps", f"{h:g}", "--terrain-seed", str(s)))
+            for h in heights for s in seeds]
+    phases = (0.0,) if quick else PUSH_PHASES
+    pushes = {"forward": (1, 0), "backward": (-1, 0), "left": (0, 1), "right": (0, -1)}
+    for direction, (ux, uy) in pushes.items():
+        for ph in phases:
+            t = PUSH_AT_S + ph * cycle
+            out.append(Condition(f"push {direction}",
+                                 f"push {PUSH_NS:g} N*s {direction} at phase {ph:g}",
+                                 ("--push", f"{t:.3f}:{ux * PUSH_NS:g},{uy * PUSH_NS:g}")))
+    if not quick:
+        values = params.as_dict()
+        for name, v in values.items():
+            if name in SKIP_PARAMS or name.startswith("bal_") or v == 0.0:
+                continue
+            for sign in (1, -1):
+                out.append(Condition("params +/-20 %", f"{name} {sign * 20:+d} %",
+                                     ("--set", f"{name}={v * (1 + sign * PARAM_SCALE)!r}")))
+    for ms in ((20.0,) if quick else (10.0, 20.0)):
+        out.append(Condition("latency", f"latency {ms:g} ms", ("--latency", f"{ms:g}")))
+    if not quick:
+        out += [Condition("friction", f"friction x{f:g}", ("--friction", f"{f:g}"))
+                for f in (0.5, 2.0)]
+        out += [Condition("mass", f"mass x{m:g}", ("--mass-scale", f"{m:g}"))
+                for m in (0.8, 1.2)]
+    return out
+
+
+def walk_command(robot: str, gait: str, seconds: float, condition: Condition, *,
+                 balance: bool, base_args: Sequence[str] = ()) -> list[str]:
+    """The ``biped walk`` command line of one run (``base_args``: e.g. ``--set`` items,
+    before the condition's own, which win)."""
+    cmd = [sys.executable, "-m", "robot.cli", "walk", "--json", "--robot", robot,
+           "--gait", gait, "--seconds", f"{seconds:g}", *base_args, *condition.args]
+    return cmd if balance else [*cmd, "--no-balance"]
+
+
+def run_one(cmd: Sequence[str], condition: Condition, *, balance: bool,
+            timeout_s: float) -> Outcome:
+    """Run one walk in a subprocess and read its JSON summary."""
+    env = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+    try:
+        proc = subprocess.run(list(cmd), capture_output=True, text=True, timeout=timeout_s,
+                              env=env, check=False)
+    except subprocess.TimeoutExpired:
+        return Outcome(condition, balance, None, error=f"timed out after {timeout_s:g} s")
+    line = proc.stdout.strip().splitlines()[-1] if proc.stdout.strip() else ""
+    try:
+        r = json.loads(line)
+    except json.JSONDecodeError:
+        err = proc.stderr.strip().splitlines()
+        return Outcome(condition, balance, None,
+                       error=err[-1] if err else f"exit {proc.returncode}, no summary")
+    return Outcome(condition, balance, bool(r.get("fell")), r.get("fell_at_s"),
+                   float(r.get("distance_m", 0.0)), float(r.get("heading_change_deg", 0.0)),
+                   float(r.get("wall_s", 0.0)), summary=r)
+
+
+def run_suite(robot: str, gait: str, conds: Iterable[Condition], *, seconds: float,
+              balance_modes: Sequence[bool] = (True, False), jobs: int | None = None,
+              progress: Callable[[Outcome], None] | None = None,
+              base_args: Sequence[str] = ()) -> list[Outcome]:
+    """Every condition in every balance mode, ``jobs`` at a time (default: the cores)."""
+    work = [(c, b) for c in conds for b in balance_modes]
+    jobs = jobs or os.cpu_count() or 1
+    timeout = 60.0 + 10.0 * seconds
+
+    def one(item: tuple[Condition, bool]) -> Outcome:
+        c, b = item
+        out = run_one(walk_command(robot, gait, seconds, c, balance=b, base_args=base_args),
+                      c, balance=b, timeout_s=timeout)
+        if progress is not None:
+            progress(out)
+        return out
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        return list(pool.map(one, work))
+
+
+def survival_table(outcomes: Sequence[Outcome]) -> list[tuple[str, dict[bool, tuple[int, int]]]]:
+    """Per group, in suite order: {balance: (survived, runs)} (failed runs count as falls)."""
+    table: dict[str, dict[bool, tuple[int, int]]] = {}
+    for o in outcomes:
+        row = table.setdefault(o.condition.group, {})
+        ok, n = row.get(o.balance, (0, 0))
+        row[o.balance] = (ok + (o.fell is False), n + 1)
+    return list(table.items())

@@ -29,6 +29,10 @@ log = logging.getLogger(__name__)
 #: Phase rates are integrated, but amplitudes (stride, foot height, ...) would otherwise
 #: step the targets within one tick.
 PARAM_TAU_S = 0.1
+#: Steering parameters follow a live change at most this fast [unit/s]: a reversal or a
+#: sudden side step or turn would otherwise change the step under a foot that stands.
+#: (speed: stride multiplier per s; turn: rad/step per s; side_step: m/step per s)
+STEER_RATE: dict[str, float] = {"speed": 0.5, "turn": 0.25, "side_step": 0.02}
 
 
 def solve(t: BodyTargets, robot: RobotConfig) -> tuple[list[Num], Num]:
@@ -120,6 +124,12 @@ class GaitEngine:
         for name, spec in SPECS.items():
             cur, goal = getattr(live, name), getattr(target, name)
             if cur != goal:
+                rate = STEER_RATE.get(name)
+                if rate is not None:
+                    step = rate * dt
+                    v = goal if abs(goal - cur) <= step else cur + math.copysign(step, goal - cur)
+                    moved[name] = v
+                    continue
                 v = cur + a * (goal - cur)
                 moved[name] = goal if abs(goal - v) <= 1e-9 * (spec.hi - spec.lo) else v
         self._live = target if all(moved[n] == getattr(target, n) for n in moved) \

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -12,22 +13,31 @@ FALL_HEIGHT_RATIO = 0.5    # torso below this share of its standing height → f
 FALL_TILT_RAD = math.radians(45.0)
 
 
-def yaw_of(quat_wxyz: np.ndarray) -> float:
+def yaw_of(quat_wxyz: Sequence[float] | np.ndarray) -> float:
     w, x, y, z = (float(v) for v in quat_wxyz)
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def tilt_of(quat_wxyz: Sequence[float]) -> float:
+    """Angle between the body's z axis and world z [rad] for a (w, x, y, z) quaternion
+    (not necessarily unit); as ``MujocoBus.upright_angle``."""
+    w, x, y, z = quat_wxyz
+    qn = w * w + x * x + y * y + z * z
+    return math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (x * x + y * y) / qn)))
 
 
 @dataclass
 class WalkMonitor:
     """Fed once per tick with the sim bus; summarises the walk.
 
-    standing_height: torso height when standing [m].
+    standing_height: torso height when standing [m]. Positions are world x, y [m]; yaw and
+    tilt [rad] are the torso's (tilt: angle of its z axis from world z).
     """
 
     standing_height: float
-    start_xy: np.ndarray | None = None
+    start_xy: tuple[float, float] | None = None
     start_yaw: float = 0.0
-    last_xy: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    last_xy: tuple[float, float] = (0.0, 0.0)
     last_yaw: float = 0.0
     heading: float = 0.0  # unwrapped yaw change since the start [rad]
     fell: bool = False
@@ -35,30 +45,43 @@ class WalkMonitor:
     min_height: float = math.inf
     max_tilt: float = 0.0
 
+    def update_qpos(self, t: float, qpos: Sequence[float]) -> None:
+        """``update`` from the free joint's qpos (x, y, z, qw, qx, qy, qz) as Python floats
+        (one ``data.qpos[:7].tolist()`` per tick is cheaper than numpy views)."""
+        x, y, z, qw, qx, qy, qz = qpos
+        yaw = math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+        self._update(t, x, y, z, yaw, tilt_of((qw, qx, qy, qz)))
+
     def update(self, t: float, pos: np.ndarray, quat: np.ndarray, tilt: float) -> None:
+        """One tick at time ``t`` [s]: torso position ``pos`` [m], orientation ``quat``
+        (w, x, y, z), ``tilt`` [rad]."""
+        self._update(t, float(pos[0]), float(pos[1]), float(pos[2]), yaw_of(quat), tilt)
+
+    def _update(self, t: float, x: float, y: float, z: float, yaw: float, tilt: float) -> None:
         if self.start_xy is None:
-            self.start_xy = pos[:2].copy()
-            self.start_yaw = self.last_yaw = yaw_of(quat)
-        self.last_xy = pos[:2].copy()
-        yaw = yaw_of(quat)
+            self.start_xy = (x, y)
+            self.start_yaw = self.last_yaw = yaw
+        self.last_xy = (x, y)
         self.heading += math.atan2(math.sin(yaw - self.last_yaw), math.cos(yaw - self.last_yaw))
         self.last_yaw = yaw
-        self.min_height = min(self.min_height, float(pos[2]))
-        self.max_tilt = max(self.max_tilt, tilt)
-        if not self.fell and (pos[2] < FALL_HEIGHT_RATIO * self.standing_height
+        if z < self.min_height:
+            self.min_height = z
+        if tilt > self.max_tilt:
+            self.max_tilt = tilt
+        if not self.fell and (z < FALL_HEIGHT_RATIO * self.standing_height
                               or tilt > FALL_TILT_RAD):
             self.fell, self.fell_at = True, t
 
     def summary(self, walk_seconds: float) -> dict[str, Any]:
         start = self.start_xy if self.start_xy is not None else self.last_xy
-        d = self.last_xy - start
+        dx, dy = self.last_xy[0] - start[0], self.last_xy[1] - start[1]
         c, s = math.cos(self.start_yaw), math.sin(self.start_yaw)
-        forward = float(c * d[0] + s * d[1])
-        lateral = float(-s * d[0] + c * d[1])
+        forward = c * dx + s * dy
+        lateral = -s * dx + c * dy
         return {
             "distance_m": forward,
             "speed_m_s": forward / walk_seconds if walk_seconds > 0 else 0.0,
-            "displacement_m": float(np.hypot(*d)),
+            "displacement_m": math.hypot(dx, dy),
             "lateral_drift_m": lateral,
             "heading_change_deg": math.degrees(self.heading),  # unwrapped: 2 turns = 720
             "fell": self.fell,

@@ -1,29 +1,20 @@
 """The MuJoCo mock bus: the real buses' interface, speaking ticks, with simulated servos.
 
-Servo model, per physics step (``timestep``, default 0.002 s):
+The servo model (goal → setpoint slewed at ``max_speed_rad_s`` → position actuator with its
+force limited to the stall torque; torque, load, thermal model, overload flag) lives in
+``sim.sim_servos``; its docstring states the discretisation. Like real servos after
+power-up, torque starts off; the robot starts in the ``home`` keyframe (or ``pose``) with
+its goals at the present positions.
 
-- the setpoint moves toward the goal at most ``max_speed_rad_s`` (JointConfig) per second,
-  like a servo's velocity profile; the position actuator (sim.mjcf) tracks the setpoint
-  with its force limited to the stall torque;
-- torque off zeroes the actuator's gains (the joint goes limp); torque on restarts the
-  setpoint from the present position, so the servo never snaps;
-- load = actuator force / stall torque [%], signed in the servo's direction;
-- temperature: a first-order thermal *model*, not a measurement: it relaxes toward
-  ``AMBIENT_C + STALL_RISE_K * (force / stall torque)^2`` with time constant ``THERMAL_TAU_S``;
-- errors: ``{"overload"}`` while the actuator has been saturated for more than 1 s.
-
-Like real servos after power-up, torque starts off; the robot starts in the ``home``
-keyframe (or ``pose``) with its goals at the present positions.
-
-Time is simulation time: ``bus.clock.sleep_until(t)`` steps the physics to exactly ``t``.
+Time is simulation time: ``bus.clock.sleep_until(t)`` steps the physics to exactly ``t``
+(whole ``timestep`` steps, batched into one ``mj_step`` call once the setpoints are
+constant, then one shorter step to land on ``t``).
 """
 
 from __future__ import annotations
 
 import logging
 import math
-import os
-import time
 from collections.abc import Iterable, Mapping
 from typing import Any
 
@@ -36,54 +27,16 @@ from robot.config import RobotConfig
 from robot.errors import BusError
 from robot.servo_map import ServoMap
 from sim.mjcf import FOOT_GEOMS, build_mjcf, standing_qpos
+from sim.sim_servos import AMBIENT_C, SimServos
+from sim.sim_view import SimClock, WallPacer, check_display, launch_viewer
+
+__all__ = ["AMBIENT_C", "MujocoBus", "SimClock"]
 
 log = logging.getLogger(__name__)
 
-AMBIENT_C = 25.0  # [°C]
-STALL_RISE_K = 60.0  # steady-state rise at continuous stall torque [K]
-THERMAL_TAU_S = 180.0  # thermal time constant [s]
-OVERLOAD_AFTER_S = 1.0  # saturated this long → "overload" [s]
-VIEW_SYNC_S = 1 / 60  # viewer refresh period [wall s]
-REANCHOR_LAG_S = 0.25  # realtime: behind the wall clock by more than this → re-anchor [s]
 _TIME_EPS = 1e-9  # [s]
-
-
-def _check_display() -> None:
-    """BusError unless a window can open (MuJoCo's viewer exits the process otherwise)."""
-    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-        raise BusError("--view needs a display; run without --view or use `biped render`")
-    import glfw
-
-    reporting, glfw.ERROR_REPORTING = glfw.ERROR_REPORTING, "ignore"
-    try:
-        ok = glfw.init()
-    finally:
-        glfw.ERROR_REPORTING = reporting
-    if not ok:
-        display = os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
-        raise BusError(f"--view: cannot open display {display!r}; run without --view or "
-                       f"use `biped render`")
-
-
-def _launch_viewer(model: mujoco.MjModel, data: mujoco.MjData) -> Any:
-    import mujoco.viewer as mujoco_viewer
-
-    return mujoco_viewer.launch_passive(model, data)
-
-
-class SimClock:
-    """``robot.clock.Clock`` on simulation time: ``sleep_until`` steps the physics."""
-
-    def __init__(self, bus: MujocoBus) -> None:
-        self._bus = bus
-
-    def now(self) -> float:
-        """Simulation time [s]."""
-        return float(self._bus.data.time)
-
-    def sleep_until(self, deadline: float) -> None:
-        """Step the physics until ``now() == deadline`` (no-op if already past)."""
-        self._bus.advance(deadline)
+_OVERLOAD = frozenset({"overload"})
+_NO_ERRORS: frozenset[str] = frozenset()
 
 
 class MujocoBus(Bus):
@@ -110,8 +63,7 @@ class MujocoBus(Bus):
         self._data: mujoco.MjData | None = None
         self._viewer: Any = None
         self._renderer: mujoco.Renderer | None = None
-        self._wall0 = 0.0
-        self._last_sync = -math.inf
+        self._pacer = WallPacer()
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -119,7 +71,7 @@ class MujocoBus(Bus):
         if self._model is not None:
             return
         if self.view:
-            _check_display()
+            check_display()
         model = build_mjcf(self.robot, timestep=self.timestep).model()
         data = mujoco.MjData(model)
         mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
@@ -135,30 +87,27 @@ class MujocoBus(Bus):
         self._act = np.array([model.actuator(n).id for n in names])
         self._kp = model.actuator_gainprm[self._act, 0].copy()
         self._kv = -model.actuator_biasprm[self._act, 2].copy()
-        self._stall = np.array([self.robot.servo(j).stall_torque for j in self.robot.joints])
+        stall = np.array([self.robot.servo(j).stall_torque for j in self.robot.joints])
         self._floor = model.geom("floor").id
         self._feet = tuple(model.geom(n).id for n in FOOT_GEOMS)
         self._torso = model.body("torso").id
-        n = len(names)
-        self._goal = data.qpos[self._qadr].copy()  # [rad]
-        self._setpoint = self._goal.copy()  # [rad]
-        self._enabled = np.zeros(n, dtype=bool)
-        self._saturated_s = np.zeros(n)
-        self._temperature = np.full(n, AMBIENT_C)
+        self._dt = float(model.opt.timestep)
+        self._opt = model.opt
+        self._servos = SimServos(self.servo_map, stall, data.qpos[self._qadr])
         self._model, self._data = model, data
         self._apply_torque()
-        data.ctrl[self._act] = self._setpoint
-        self._wall0 = time.monotonic() - data.time
+        data.ctrl[self._act] = self._servos.setpoint
+        self._pacer.anchor(data.time)
         if self.view:
-            self._viewer = _launch_viewer(model, data)
-        log.info("sim bus open: %s, %d servos, timestep %.4f s", self.robot.name, n,
+            self._viewer = launch_viewer(model, data)
+        log.info("sim bus open: %s, %d servos, timestep %.4f s", self.robot.name, len(names),
                  model.opt.timestep)
 
     def close(self, *, torque_off: bool = True) -> None:
         if self._model is None:
             return
         if torque_off:
-            self._enabled[:] = False
+            self._servos.enabled[:] = False
             self._apply_torque()
         if self._viewer is not None:
             self._viewer.close()
@@ -216,36 +165,34 @@ class MujocoBus(Bus):
 
     def set_torque(self, ids: Iterable[int], *, enabled: bool) -> None:
         idx = self._indices(ids)
-        if enabled:
-            # Torque on: the setpoint restarts from where the joint is.
-            off = [i for i in idx if not self._enabled[i]]
-            self._setpoint[off] = self.data.qpos[self._qadr[off]]
-        self._enabled[idx] = enabled
+        self._servos.set_torque(idx, enabled, self.data.qpos[self._qadr])
         self._apply_torque()
 
     def write_goals(self, goals: Mapping[int, int]) -> None:
         if not goals:
             return
-        idx = np.array(self._indices(goals))
-        q = (np.array(list(goals.values()), float) - self.servo_map.zero[idx]) \
-            * self.servo_map.sign[idx] / self.servo_map.ticks_per_rad[idx]
-        self._goal[idx] = np.clip(q, self.servo_map.q_min[idx], self.servo_map.q_max[idx])
+        d = self.data  # BusError if closed
+        servos = self._servos
+        idx = servos.index_all(goals)
+        if idx is None:
+            idx = np.array(self._indices(goals))
+        servos.write(idx, servos.to_rad(goals, idx), d.time)
 
     def read_state(self, ids: Iterable[int]) -> dict[int, ServoState]:
         idx = self._indices(ids)
-        ticks = self.present_ticks()
+        servos = self._servos
         force = self.data.actuator_force[self._act]
-        load = 100.0 * self.servo_map.sign * force / self._stall
+        servos.flush(force)
+        ticks = self.present_ticks().tolist()
+        load = servos.load_percent(force).tolist()
+        temperature = servos.temperature.tolist()
+        overloaded = servos.overloaded().tolist()
         volts = self.robot.bus.servo.nominal_voltage
-        out: dict[int, ServoState] = {}
-        for i in idx:
-            errors = frozenset({"overload"}) if self._saturated_s[i] > OVERLOAD_AFTER_S \
-                else frozenset()
-            sid = self.servo_map.ids[i]
-            out[sid] = ServoState(id=sid, position=int(ticks[i]), load=float(load[i]),
-                                  temperature=float(self._temperature[i]), voltage=volts,
-                                  errors=errors)
-        return out
+        sids = self.servo_map.ids
+        return {sids[i]: ServoState(id=sids[i], position=ticks[i], load=load[i],
+                                    temperature=temperature[i], voltage=volts,
+                                    errors=_OVERLOAD if overloaded[i] else _NO_ERRORS)
+                for i in idx}
 
     # ------------------------------------------------------------------ simulation
 
@@ -257,75 +204,49 @@ class MujocoBus(Bus):
 
     def _apply_torque(self) -> None:
         m = self.model
-        on = self._enabled.astype(float)
+        on = self._servos.enabled.astype(float)
         m.actuator_gainprm[self._act, 0] = self._kp * on
         m.actuator_biasprm[self._act, 1] = -self._kp * on
         m.actuator_biasprm[self._act, 2] = -self._kv * on
 
-    def _step(self, nstep: int = 1) -> None:
-        """Advance ``nstep`` physics steps; the setpoint slews only if nstep == 1 (callers
-        batch steps only once every enabled setpoint has reached its goal)."""
-        m, d = self.model, self.data
-        dt = m.opt.timestep
-        if nstep == 1:
-            vmax = self.servo_map.max_speed * dt
-            error = self._goal - self._setpoint
-            self._setpoint = np.where(np.abs(error) <= vmax, self._goal,
-                                      self._setpoint + np.sign(error) * vmax)
-            d.ctrl[self._act] = self._setpoint
-        mujoco.mj_step(m, d, nstep)
-        span = nstep * dt
-        ratio = np.abs(d.actuator_force[self._act]) / self._stall
-        saturated = self._enabled & (ratio >= 0.999)
-        self._saturated_s = np.where(saturated, self._saturated_s + span, 0.0)
-        steady = AMBIENT_C + STALL_RISE_K * np.minimum(ratio, 1.0) ** 2
-        self._temperature += (steady - self._temperature) * -math.expm1(-span / THERMAL_TAU_S)
-
-    def _settled(self) -> bool:
-        """Every torque-on setpoint is at its goal (the controls are constant)."""
-        return bool(np.all((self._setpoint == self._goal) | ~self._enabled))
-
     def advance(self, deadline: float) -> None:
         """Step the physics until data.time == deadline [s] exactly (a last partial step
-        if needed); with realtime, then wait for the wall clock. No-op if already past."""
-        m, d = self.model, self.data
-        dt = m.opt.timestep
-        if deadline <= d.time:
+        if needed), applying delayed goals when they fall due; with realtime, then wait for
+        the wall clock. No-op if already past."""
+        d = self.data
+        t0 = float(d.time)
+        if deadline <= t0:
             return
-        while (remaining := deadline - d.time) > _TIME_EPS:
-            if remaining < dt:
-                m.opt.timestep = remaining
-                try:
-                    self._step()
-                finally:
-                    m.opt.timestep = dt
-            elif self._settled():
-                self._step(max(1, int(remaining / dt + 1e-6)))
-            else:
-                self._step()
+        servos = self._servos
+        while (due := servos.next_due()) < deadline - _TIME_EPS:
+            if due > d.time:
+                self._physics_to(due)
+                d.time = due
+            servos.release_due(due)
+        self._physics_to(deadline)
         d.time = deadline
+        servos.release_due(deadline)
+        servos.elapse(d.actuator_force[self._act], deadline - t0)
         if self.realtime:
-            self._wait_wall(deadline)
+            self._pacer.wait(deadline)
         if self._viewer is not None:
-            self._sync_viewer()
+            self._pacer.sync_viewer(self._viewer)
 
-    def _wait_wall(self, deadline: float) -> None:
-        wall_deadline = self._wall0 + deadline
-        lag = time.monotonic() - wall_deadline
-        if lag > REANCHOR_LAG_S:
-            log.debug("sim bus: %.3f s behind real time; re-anchoring", lag)
-            self._wall0 += lag
-            return
-        while (remaining := wall_deadline - time.monotonic()) > 0:
-            time.sleep(remaining)
-
-    def _sync_viewer(self) -> None:
-        now = time.monotonic()
-        if now - self._last_sync < VIEW_SYNC_S:
-            return
-        self._last_sync = now
-        if self._viewer.is_running():
-            self._viewer.sync()
+    def _physics_to(self, stop: float) -> None:
+        """Physics steps up to ``stop`` [s]: the setpoints slew before each step until they
+        are settled, then the remaining whole steps run in one call, then one short step."""
+        m, d, opt, servos, dt = self.model, self.data, self._opt, self._servos, self._dt
+        while (remaining := stop - d.time) > _TIME_EPS:
+            if not servos.settled:
+                d.ctrl[self._act] = servos.slew(min(dt, remaining))
+            if remaining < dt:
+                opt.timestep = remaining
+                try:
+                    mujoco.mj_step(m, d)
+                finally:
+                    opt.timestep = dt
+            else:
+                mujoco.mj_step(m, d, int(remaining / dt + 1e-6) if servos.settled else 1)
 
     # ------------------------------------------------------------------ observation
 

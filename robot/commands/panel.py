@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from robot.commands.balance_args import feedback_factory, imu_for
 from robot.commands.common import add_set_arg, bus_from, params_from, robot_from
 from robot.commands.signals import SignalLatch, stop_on_signals
 from robot.commands.walk import add_walk_args
@@ -82,9 +83,11 @@ def run(args: argparse.Namespace) -> int:
     presets = PresetStore(Path(args.presets_dir)) if args.presets_dir else PresetStore()
     options: dict[str, Any] = {"realtime": True, "view": args.view} if kind == "sim" else {}
     bus = bus_from(args, robot, kind=kind, **options)
+    imu = imu_for(args, robot, bus)
     controller = make_controller(
         robot, bus, params,
-        options=LoopOptions(rate_hz=args.rate, read_every=args.read_every, hold=args.hold),
+        options=LoopOptions(rate_hz=args.rate, read_every=args.read_every, hold=args.hold,
+                            feedback=feedback_factory(imu)),
         presets=presets, preset=gait.name)
     try:
         server = build_server(controller, host=args.host, port=args.http_port, token=token)
@@ -113,6 +116,8 @@ def run(args: argparse.Namespace) -> int:
             controller.shutdown(abort=lambda: signals.abort)
             server.shutdown()
             server.server_close()
+            if imu is not None:
+                imu.close()
     print("biped panel: stopped; torque " + ("left ON (holding)" if controller.holding and
                                              not signals.abort else "off"), flush=True)
     return latch.exit_code(None)

@@ -10,6 +10,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from robot.commands.balance_args import add_balance_args, balance_for, imu_for
 from robot.commands.common import (
     add_bus_args,
     add_robot_args,
@@ -43,6 +44,7 @@ def add_walk_args(p: argparse.ArgumentParser) -> None:
                    help="hold the rest pose with torque on at the end (default: torque off)")
     p.add_argument("--realtime", action="store_true", help="pace the simulation to the wall clock")
     p.add_argument("--view", action="store_true", help="open the MuJoCo viewer (needs a display)")
+    add_balance_args(p)
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
@@ -74,6 +76,7 @@ def run(args: argparse.Namespace) -> int:
         observers.append(recorder.open())    # an unwritable path fails before the bus opens
     latch = SignalLatch()
     stats: LoopStats | None = None
+    imu = imu_for(args, robot, bus)
     wall0 = time.perf_counter()
     try:
         bus.open()
@@ -91,19 +94,24 @@ def run(args: argparse.Namespace) -> int:
         def observe(tel: Telemetry) -> None:
             for o in observers:
                 o(tel)
+        if imu is not None:
+            imu.open()
         streamer = Streamer(smap, bus, engine, rate_hz=args.rate, read_every=args.read_every,
-                            hold_at_end=args.hold, observer=observe)
+                            hold_at_end=args.hold, observer=observe,
+                            feedback=balance_for(imu, engine))
         with stop_on_signals(streamer, latch):
             stats = streamer.run(seconds=args.seconds)
     finally:
         # The streamer has already left the servos as its end requires (holding, or torque
         # off); a refused start left them untouched. Closing must not undo either.
         bus.close(torque_off=False)
+        if imu is not None:
+            imu.close()
         record_error = recorder.close_quietly() if recorder is not None else None
     assert stats is not None
     wall = time.perf_counter() - wall0
     result: dict[str, Any] = {"robot": robot.name, "gait": gait.name, "bus": kind,
-                              "seconds": args.seconds}
+                              "seconds": args.seconds, "balance": imu is not None}
     if monitor is not None:
         result.update(monitor.summary(args.seconds))
     result.update({

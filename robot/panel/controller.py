@@ -27,7 +27,7 @@ from robot.panel.presets import PresetStore
 from robot.panel.sim_monitor import sim_monitor_factory
 from robot.params import GROUPS, SPECS, GaitParams
 from robot.servo_map import ServoMap
-from robot.streamer import LoopStats, Streamer, Telemetry
+from robot.streamer import Feedback, LoopStats, Streamer, Telemetry
 
 log = logging.getLogger(__name__)
 
@@ -41,11 +41,13 @@ class PanelStateError(BipedError):
 @dataclass(frozen=True)
 class LoopOptions:
     """rate_hz: control rate [Hz]; read_every: read back every N ticks; hold: keep torque
-    on at the rest pose after a stop."""
+    on at the rest pose after a stop; feedback: builds each run's feedback stage (balance)
+    for its engine, after the bus is open (None: open loop)."""
 
     rate_hz: float = 200.0
     read_every: int = 10
     hold: bool = False
+    feedback: Callable[[GaitEngine], Feedback | None] | None = None
 
 
 class PanelController:
@@ -134,7 +136,8 @@ class PanelController:
             o = self.options
             self._streamer = Streamer(self._map, self.bus, engine, rate_hz=o.rate_hz,
                                       read_every=o.read_every, hold_at_end=o.hold,
-                                      observer=observe)
+                                      observer=observe,
+                                      feedback=o.feedback(engine) if o.feedback else None)
             self._tel = {"state": "starting"}
             self.runs += 1
             self._holding = self._estop_requested = False

@@ -10,11 +10,11 @@ import pytest
 
 from robot import xmath as xm
 from robot.balance import (
+    Attitude,
     Balance,
     BalanceState,
     Correction,
     JointSlots,
-    Attitude,
     apply,
     balance_step,
     wrap,

@@ -86,9 +86,10 @@ def run(args: argparse.Namespace) -> int:
             sim_bus: Any = bus
             monitor = WalkMonitor(standing_height=sim_bus.standing_height)
 
+            qpos = sim_bus.data.qpos
+
             def watch(tel: Telemetry) -> None:
-                pos, quat = sim_bus.base_pose()
-                monitor.update(tel.t, pos, quat, sim_bus.upright_angle())
+                monitor.update_qpos(tel.t, qpos[:7].tolist())
             observers.insert(0, watch)
 
         def observe(tel: Telemetry) -> None:

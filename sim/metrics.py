@@ -30,11 +30,14 @@ def tilt_of(quat_wxyz: Sequence[float]) -> float:
 class WalkMonitor:
     """Fed once per tick with the sim bus; summarises the walk.
 
-    standing_height: torso height when standing [m]. Positions are world x, y [m]; yaw and
-    tilt [rad] are the torso's (tilt: angle of its z axis from world z).
+    standing_height: torso height above the floor when standing [m]; floor_normal: unit
+    normal of the floor plane through the origin (a sloped world; the torso's height is
+    measured along it). Positions are world x, y [m] (distance and drift: horizontal);
+    yaw and tilt [rad] are the torso's (tilt: angle of its z axis from world z, gravity).
     """
 
     standing_height: float
+    floor_normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
     start_xy: tuple[float, float] | None = None
     start_yaw: float = 0.0
     last_xy: tuple[float, float] = (0.0, 0.0)
@@ -64,6 +67,9 @@ class WalkMonitor:
         self.last_xy = (x, y)
         self.heading += math.atan2(math.sin(yaw - self.last_yaw), math.cos(yaw - self.last_yaw))
         self.last_yaw = yaw
+        if self.floor_normal != (0.0, 0.0, 1.0):
+            nx, ny, nz = self.floor_normal
+            z = nx * x + ny * y + nz * z
         if z < self.min_height:
             self.min_height = z
         if tilt > self.max_tilt:

@@ -21,6 +21,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -29,6 +30,9 @@ import numpy.typing as npt
 from robot.config import RobotConfig
 from robot.errors import ConfigError
 from sim.mjcf_robot import add_actuators_and_sensors, add_assets, add_defaults, add_worldbody, fmt
+
+if TYPE_CHECKING:
+    from sim.world import World
 
 ROBOT_FILE = "robot.xml"
 SCENE_FILE = "scene.xml"
@@ -98,8 +102,9 @@ def _look_at(eye: tuple[float, float, float], target: tuple[float, float, float]
     return fmt(*x, *y)
 
 
-def scene_xml(robot: RobotConfig) -> str:
-    """Floor (checker), light, skybox and the ``track`` camera; includes robot.xml."""
+def scene_xml(robot: RobotConfig, *, world: World | None = None) -> str:
+    """Floor (checker), light, skybox and the ``track`` camera; includes robot.xml.
+    ``world``: tilt the floor and add bumps (``sim.world_scene``)."""
     g = robot.geometry
     height = g.thigh + g.shin + g.ankle_height + g.torso_height  # overall height [m]
     root = ET.Element("mujoco", model=f"{robot.name} scene")
@@ -119,14 +124,18 @@ def scene_xml(robot: RobotConfig) -> str:
                   width="300", height="300")
     ET.SubElement(asset, "material", name="groundplane", texture="groundplane",
                   texuniform="true", texrepeat="5 5", reflectance="0.2")
-    world = ET.SubElement(root, "worldbody")
-    ET.SubElement(world, "light", pos="0 0 3", dir="0 0 -1", type="directional")
-    ET.SubElement(world, "geom", name="floor", size="0 0 0.05", type="plane",
-                  material="groundplane", contype="1", conaffinity="1")
+    worldbody = ET.SubElement(root, "worldbody")
+    ET.SubElement(worldbody, "light", pos="0 0 3", dir="0 0 -1", type="directional")
+    floor = ET.SubElement(worldbody, "geom", name="floor", size="0 0 0.05", type="plane",
+                          material="groundplane", contype="1", conaffinity="1")
+    if world is not None:
+        from sim.world_scene import add_world_to_scene
+
+        add_world_to_scene(worldbody, floor, world)
     # trackcom in the world body follows the whole model's centre of mass: the robot.
     target = (0.0, 0.0, 0.6 * height)
     eye = (1.1 * height, -1.7 * height, 0.75 * height)
-    ET.SubElement(world, "camera", name="track", mode="trackcom", pos=fmt(*eye),
+    ET.SubElement(worldbody, "camera", name="track", mode="trackcom", pos=fmt(*eye),
                   xyaxes=_look_at(eye, target))
     return _to_string(root)
 
@@ -156,12 +165,15 @@ def standing_qpos(model: mujoco.MjModel, pose: Mapping[str, float]) -> npt.NDArr
     return qpos
 
 
-def build_mjcf(robot: RobotConfig, *, timestep: float | None = None) -> Mjcf:
-    """Robot and scene MJCF for ``robot``; timestep [s] (default 0.002)."""
+def build_mjcf(robot: RobotConfig, *, timestep: float | None = None,
+               world: World | None = None) -> Mjcf:
+    """Robot and scene MJCF for ``robot``; timestep [s] (default 0.002); ``world``: the
+    scene's floor and bumps (``sim.world``; None or ``World()``: the plain floor)."""
     dt = DEFAULT_TIMESTEP if timestep is None else timestep
     if not 0 < dt <= 0.01:
         raise ConfigError(f"MJCF: timestep must be in (0, 0.01] s, got {dt}")
     bare = _compile(robot_xml(robot, timestep=dt))
     fixed = {j.name: j.fixed_rad for j in robot.joints if j.fixed_rad is not None}
     home = standing_qpos(bare, {**robot.rest, **fixed})
-    return Mjcf(robot=robot_xml(robot, timestep=dt, home=home), scene=scene_xml(robot))
+    return Mjcf(robot=robot_xml(robot, timestep=dt, home=home),
+                scene=scene_xml(robot, world=world))

@@ -28,7 +28,9 @@ from robot.errors import BusError
 from robot.servo_map import ServoMap
 from sim.mjcf import FOOT_GEOMS, build_mjcf, standing_qpos
 from sim.sim_servos import AMBIENT_C, SimServos
-from sim.sim_view import SimClock, WallPacer, check_display, launch_viewer
+from sim.sim_view import OffscreenRenderer, SimClock, WallPacer, check_display, launch_viewer
+from sim.world import PUSH_WINDOW_S, TimedForces, World
+from sim.world_scene import apply_world_to_model, place_on_floor
 
 __all__ = ["AMBIENT_C", "MujocoBus", "SimClock"]
 
@@ -44,14 +46,18 @@ class MujocoBus(Bus):
 
     realtime: also wait on the wall clock so the sim runs at 1x; view: open the passive
     viewer (needs a display); timestep: physics step [s] (default 0.002); pose: start pose
-    {joint: rad} instead of the ``home`` keyframe (standing, soles on the floor).
+    {joint: rad} instead of the ``home`` keyframe (standing, soles on the floor); world:
+    perturbations (``sim.world.World``: slope, bumps, latency, friction, mass; pushes via
+    ``push`` / ``sim.world.PushScheduler``), None for the plain scene.
     """
 
     kind = "sim"
 
     def __init__(self, robot: RobotConfig, *, realtime: bool = False, view: bool = False,
-                 timestep: float | None = None, pose: Mapping[str, float] | None = None) -> None:
+                 timestep: float | None = None, pose: Mapping[str, float] | None = None,
+                 world: World | None = None) -> None:
         self.robot = robot
+        self.world = world
         self.realtime = realtime
         self.view = view
         self.timestep = timestep
@@ -62,8 +68,9 @@ class MujocoBus(Bus):
         self._model: mujoco.MjModel | None = None
         self._data: mujoco.MjData | None = None
         self._viewer: Any = None
-        self._renderer: mujoco.Renderer | None = None
+        self._renderer = OffscreenRenderer()
         self._pacer = WallPacer()
+        self._forces = TimedForces()  # pushes on the torso in progress
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -72,8 +79,11 @@ class MujocoBus(Bus):
             return
         if self.view:
             check_display()
-        model = build_mjcf(self.robot, timestep=self.timestep).model()
+        world = self.world
+        model = build_mjcf(self.robot, timestep=self.timestep, world=world).model()
         data = mujoco.MjData(model)
+        if world is not None:
+            apply_world_to_model(model, data, world)
         mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
         if self.pose is not None:
             unknown = sorted(set(self.pose) - set(self.robot.joint_names))
@@ -81,6 +91,8 @@ class MujocoBus(Bus):
                 raise BusError(f"sim bus: pose: unknown joint {unknown[0]!r}; valid: "
                                f"{', '.join(self.robot.joint_names)}")
             data.qpos[:] = standing_qpos(model, self.pose)
+        if world is not None:
+            place_on_floor(data, world)
         mujoco.mj_forward(model, data)
         names = self.robot.joint_names
         self._qadr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names])
@@ -88,12 +100,15 @@ class MujocoBus(Bus):
         self._kp = model.actuator_gainprm[self._act, 0].copy()
         self._kv = -model.actuator_biasprm[self._act, 2].copy()
         stall = np.array([self.robot.servo(j).stall_torque for j in self.robot.joints])
-        self._floor = model.geom("floor").id
+        self._ground = np.flatnonzero((model.geom_bodyid == 0)
+                                      & ((model.geom_contype | model.geom_conaffinity) != 0))
         self._feet = tuple(model.geom(n).id for n in FOOT_GEOMS)
         self._torso = model.body("torso").id
         self._dt = float(model.opt.timestep)
         self._opt = model.opt
-        self._servos = SimServos(self.servo_map, stall, data.qpos[self._qadr])
+        self._servos = SimServos(self.servo_map, stall, data.qpos[self._qadr],
+                                 latency_s=world.latency_s if world is not None else 0.0)
+        self._forces = TimedForces()
         self._model, self._data = model, data
         self._apply_torque()
         data.ctrl[self._act] = self._servos.setpoint
@@ -112,9 +127,7 @@ class MujocoBus(Bus):
         if self._viewer is not None:
             self._viewer.close()
             self._viewer = None
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
+        self._renderer.close()
         self._model = None
         self._data = None
 
@@ -126,6 +139,11 @@ class MujocoBus(Bus):
     def standing_height(self) -> float:
         """Torso (pelvis origin) height in the ``home`` keyframe [m]."""
         return float(self.model.key("home").qpos[2])
+
+    @property
+    def floor_normal(self) -> tuple[float, float, float]:
+        """Unit normal of the floor plane through the origin (world frame)."""
+        return self.world.floor_normal() if self.world is not None else (0.0, 0.0, 1.0)
 
     @property
     def model(self) -> mujoco.MjModel:
@@ -217,20 +235,40 @@ class MujocoBus(Bus):
         t0 = float(d.time)
         if deadline <= t0:
             return
-        servos = self._servos
-        while (due := servos.next_due()) < deadline - _TIME_EPS:
-            if due > d.time:
-                self._physics_to(due)
-                d.time = due
-            servos.release_due(due)
+        while (event := self._next_event()) < deadline - _TIME_EPS:
+            if event > d.time:
+                self._physics_to(event)
+                d.time = event
+            self._events_due(event)
         self._physics_to(deadline)
         d.time = deadline
-        servos.release_due(deadline)
-        servos.elapse(d.actuator_force[self._act], deadline - t0)
+        self._events_due(deadline)
+        self._servos.elapse(d.actuator_force[self._act], deadline - t0)
         if self.realtime:
             self._pacer.wait(deadline)
         if self._viewer is not None:
             self._pacer.sync_viewer(self._viewer)
+
+    def _next_event(self) -> float:
+        """Sim time [s] of the next delayed goal or push end (inf if none)."""
+        return min(self._servos.next_due(), self._forces.next_end())
+
+    def _events_due(self, now: float) -> None:
+        self._servos.release_due(now)
+        self._forces.end_due(now, self.data.xfrc_applied[self._torso])
+
+    def push(self, jx: float, jy: float, *, window_s: float = PUSH_WINDOW_S) -> None:
+        """An impulse on the torso starting now: jx forward, jy left in the torso's
+        heading frame (yaw only) [N*s], as a constant force at its centre of mass
+        J / window_s [N] for window_s [s] of sim time."""
+        if not window_s > 0:
+            raise BusError(f"sim bus: push window must be > 0 s, got {window_s}")
+        d = self.data
+        w, x, y, z = d.qpos[3:7].tolist()
+        yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+        c, s = math.cos(yaw), math.sin(yaw)
+        force = np.array([c * jx - s * jy, s * jx + c * jy, 0.0]) / window_s
+        self._forces.start(d.time + window_s, force, d.xfrc_applied[self._torso])
 
     def _physics_to(self, stop: float) -> None:
         """Physics steps up to ``stop`` [s]: the setpoints slew before each step until they
@@ -262,31 +300,18 @@ class MujocoBus(Bus):
         return math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (x * x + y * y) / qn)))
 
     def contacts_feet(self) -> tuple[bool, bool]:
-        """(right, left): is each foot box touching the floor (as of the last step)."""
+        """(right, left): is each foot box touching the ground (floor or a bump; as of the
+        last step)."""
         d = self.data
         pairs = d.contact.geom[: d.ncon]
+        ground = np.isin(pairs, self._ground)
         touching = []
         for foot in self._feet:
-            hit = ((pairs[:, 0] == foot) & (pairs[:, 1] == self._floor)) \
-                | ((pairs[:, 1] == foot) & (pairs[:, 0] == self._floor))
+            hit = ((pairs[:, 0] == foot) & ground[:, 1]) | ((pairs[:, 1] == foot) & ground[:, 0])
             touching.append(bool(hit.any()))
         return touching[0], touching[1]
 
     def render(self, width: int, height: int, camera: str = "track") -> npt.NDArray[np.uint8]:
         """An offscreen RGB frame (height, width, 3) of the current state (needs MUJOCO_GL
         set, e.g. egl, before mujoco is imported). Reuses one renderer per size."""
-        m = self.model
-        r = self._renderer
-        if r is None or (r.width, r.height) != (width, height):
-            if r is not None:
-                r.close()
-            try:
-                r = mujoco.Renderer(m, height=height, width=width)
-            except ValueError as e:
-                raise BusError(f"sim bus: render {width}x{height}: {e}") from e
-            self._renderer = r
-        try:
-            r.update_scene(self.data, camera=camera)
-        except ValueError as e:
-            raise BusError(f"sim bus: render: no camera {camera!r} ({e})") from e
-        return r.render()
+        return self._renderer.render(self.model, self.data, width, height, camera)

@@ -1,5 +1,5 @@
 """Helpers of the MuJoCo bus that touch the wall clock or a display: the sim-time clock,
-the passive viewer (and its display check), realtime pacing."""
+the passive viewer (and its display check), realtime pacing, offscreen rendering."""
 
 from __future__ import annotations
 
@@ -9,6 +9,8 @@ import time
 from typing import TYPE_CHECKING, Any
 
 import mujoco
+import numpy as np
+import numpy.typing as npt
 
 from robot.errors import BusError
 
@@ -88,3 +90,31 @@ class WallPacer:
         self._last_sync = now
         if viewer.is_running():
             viewer.sync()
+
+
+class OffscreenRenderer:
+    """One ``mujoco.Renderer``, rebuilt when the frame size changes."""
+
+    def __init__(self) -> None:
+        self._r: mujoco.Renderer | None = None
+
+    def render(self, model: mujoco.MjModel, data: mujoco.MjData, width: int, height: int,
+               camera: str) -> npt.NDArray[np.uint8]:
+        r = self._r
+        if r is None or (r.width, r.height) != (width, height):
+            self.close()
+            try:
+                r = mujoco.Renderer(model, height=height, width=width)
+            except ValueError as e:
+                raise BusError(f"sim bus: render {width}x{height}: {e}") from e
+            self._r = r
+        try:
+            r.update_scene(data, camera=camera)
+        except ValueError as e:
+            raise BusError(f"sim bus: render: no camera {camera!r} ({e})") from e
+        return r.render()
+
+    def close(self) -> None:
+        if self._r is not None:
+            self._r.close()
+            self._r = None

@@ -24,6 +24,7 @@ from robot.commands.common import (
     seconds,
 )
 from robot.commands.signals import SignalLatch, stop_on_signals
+from robot.commands.world_args import add_world_args, describe_world, world_from, world_summary
 from robot.engine import GaitEngine
 from robot.errors import ConfigError
 from robot.recorder import Recorder
@@ -55,6 +56,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                    help="per-tick record (.csv or .jsonl)")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     add_set_arg(p)
+    add_world_args(p)
     return p
 
 
@@ -64,13 +66,17 @@ def run(args: argparse.Namespace) -> int:
     kind = args.bus or "sim"
     if kind != "sim" and (args.view or args.realtime):
         raise ConfigError("--view and --realtime apply to --bus sim only")
+    world = world_from(args, kind)       # perturbations: sim only, None if none given
     options: dict[str, Any] = (
         {"realtime": args.realtime, "view": args.view} if kind == "sim" else {})
+    if world is not None:
+        options["world"] = world
     bus = bus_from(args, robot, kind=kind, **options)
     recorder = Recorder(args.record, robot.joint_names, robot.ids) if args.record else None
     engine = GaitEngine(robot, params)
     smap = ServoMap(robot)
     monitor = None
+    pushes = None
     observers: list[Callable[[Telemetry], None]] = []
     if recorder is not None:
         observers.append(recorder.open())    # an unwritable path fails before the bus opens
@@ -84,13 +90,18 @@ def run(args: argparse.Namespace) -> int:
             from sim.metrics import WalkMonitor
 
             sim_bus: Any = bus
-            monitor = WalkMonitor(standing_height=sim_bus.standing_height)
-
+            monitor = WalkMonitor(standing_height=sim_bus.standing_height,
+                                  floor_normal=sim_bus.floor_normal)
             qpos = sim_bus.data.qpos
 
             def watch(tel: Telemetry) -> None:
                 monitor.update_qpos(tel.t, qpos[:7].tolist())
             observers.insert(0, watch)
+            if world is not None and world.pushes:
+                from sim.world import PushScheduler
+
+                pushes = PushScheduler(sim_bus, world.pushes)
+                observers.insert(1, pushes)
 
         def observe(tel: Telemetry) -> None:
             for o in observers:
@@ -115,6 +126,7 @@ def run(args: argparse.Namespace) -> int:
                               "seconds": args.seconds, "balance": imu is not None}
     if monitor is not None:
         result.update(monitor.summary(args.seconds))
+        result["world"] = world_summary(world, pushes)
     result.update({
         "ticks": stats.ticks, "rate_hz": stats.rate_hz, "achieved_hz": stats.achieved_hz,
         "period_error_p50_ms": stats.period_error_p50_ms,
@@ -148,6 +160,9 @@ def format_summary(r: dict[str, Any]) -> str:
             f"  fell          {fell} (lowest torso {r['min_torso_height_m']:.3f} m,"
             f" max tilt {r['max_tilt_deg']:.1f} deg)",
         ]
+        world = describe_world(r.get("world"))
+        if world:
+            lines.append(f"  world         {world}")
     lines += [
         f"  loop          {r['ticks']} ticks at {r['rate_hz']:g} Hz"
         f" (achieved {r['achieved_hz']:.1f} Hz), period error"

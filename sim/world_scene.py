@@ -7,7 +7,6 @@ exactly as without a world.
 
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
@@ -110,7 +109,3 @@ def place_on_floor(data: mujoco.MjData, world: World) -> None:
     mujoco.mju_rotVecQuat(data.qpos[0:3], pos, quat)
     mujoco.mju_mulQuat(data.qpos[3:7], quat, body)
 
-
-def tilt_deg(world: World) -> float:
-    """Angle between the floor normal and +z [deg]."""
-    return math.degrees(math.acos(world.floor_normal()[2]))

@@ -1,6 +1,6 @@
 """The paper's channels (robot.gait) against an independent transcription of equations.md.
 
-``EQUATIONS`` below is typed from /work/shared/equations.md (eq number, channel name, the
+``EQUATIONS`` below is typed from ../shared/equations.md (eq number, channel name, the
 printed expression) and evaluated with ``eval`` on T = t * fps and time = t, in table
 order, so each expression may use the channels above it. Nothing from robot.gait is used
 to build the expected values.
@@ -56,7 +56,8 @@ EQUATIONS: tuple[tuple[str, str, str], ...] = (
     ("20", "LeftShoulder_tZ", "-tz * f_spine"),
 )
 CHANNEL_NAMES = tuple(name for _, name, _ in EQUATIONS)
-SHARED_EQUATIONS = Path("/work/shared/equations.md")
+#: The shared reference beside the checkout (../shared, as CI lays it out).
+SHARED_EQUATIONS = Path(__file__).resolve().parents[2] / "shared" / "equations.md"
 TOL = 1e-12
 
 
@@ -89,8 +90,8 @@ def test_channel_names_are_the_table_in_order() -> None:
     assert gait.CHANNELS == CHANNEL_NAMES
 
 
-@pytest.mark.skipif(not SHARED_EQUATIONS.exists(), reason="shared equations.md not present")
 def test_transcription_matches_the_shared_reference() -> None:
+    assert SHARED_EQUATIONS.is_file(), f"{SHARED_EQUATIONS} missing: ../shared must sit beside the repo"
     rows = re.findall(r"^\| (\d+) \| `(\w+)` \| (.+?) \|$", SHARED_EQUATIONS.read_text(),
                       flags=re.M)
     assert tuple(rows) == EQUATIONS

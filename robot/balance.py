@@ -30,8 +30,8 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from robot.imu.base import Imu
-from robot.imu.tilt import TiltEstimator, tilt_from_quat
-from robot.params import SPECS, GaitParams
+from robot.imu.tilt import TiltEstimator, tilt_from_quat, wrap
+from robot.params import GaitParams
 from robot.targets import NO_TRIM, BodyTrim
 
 if TYPE_CHECKING:
@@ -83,11 +83,6 @@ class Correction(NamedTuple):
     pelvis_roll: float = 0.0
     pelvis_pitch: float = 0.0
     feet: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
-
-
-def wrap(angle: float) -> float:
-    """``angle`` [rad] wrapped into [-pi, pi)."""
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def _clip(x: float, limit: float) -> float:
@@ -150,24 +145,21 @@ def balance_step(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float, 
                         True), corr
 
 
-#: The turn range the trimmed turn must stay inside [rad/step].
-TURN_LIMIT = SPECS["turn"].hi
-
-
 class JointSlots(NamedTuple):
-    """Indices of the corrected joints in a robot's joint vector (-1: the robot has none)."""
+    """Indices of the corrected joints (right, left) in a robot's joint vector; a joint
+    the robot lacks is left out."""
 
-    ankle_pitch: tuple[int, ...]
-    ankle_roll: tuple[int, ...]
-    hip_pitch: tuple[int, ...]
-    hip_roll: tuple[int, ...]
+    ankle_pitch: list[int]
+    ankle_roll: list[int]
+    hip_pitch: list[int]
+    hip_roll: list[int]
 
     @classmethod
     def of(cls, joint_names: Sequence[str]) -> JointSlots:
         index = {n: i for i, n in enumerate(joint_names)}
 
-        def both(joint: str) -> tuple[int, ...]:
-            return tuple(index[f"{s}_{joint}"] for s in ("r", "l") if f"{s}_{joint}" in index)
+        def both(joint: str) -> list[int]:
+            return [index[f"{s}_{joint}"] for s in ("r", "l") if f"{s}_{joint}" in index]
         return cls(both("ankle_pitch"), both("ankle_roll"), both("hip_pitch"),
                    both("hip_roll"))
 
@@ -175,10 +167,10 @@ class JointSlots(NamedTuple):
 def apply(q: np.ndarray, corr: Correction, slots: JointSlots) -> np.ndarray:
     """``q`` [rad] with ``corr`` added to both legs (a new array)."""
     out = np.array(q, dtype=float)
-    out[list(slots.ankle_pitch)] += corr.ankle_pitch
-    out[list(slots.ankle_roll)] += corr.ankle_roll
-    out[list(slots.hip_pitch)] += corr.hip_pitch
-    out[list(slots.hip_roll)] += corr.hip_roll
+    out[slots.ankle_pitch] += corr.ankle_pitch
+    out[slots.ankle_roll] += corr.ankle_roll
+    out[slots.hip_pitch] += corr.hip_pitch
+    out[slots.hip_roll] += corr.hip_roll
     return out
 
 
@@ -194,7 +186,6 @@ class Balance:
         self.engine = engine
         self._read_tilt = read_tilt
         self.slots = JointSlots.of(engine.robot.joint_names)
-        self._yaw = engine.robot.has_hip_yaw
         self.state = BalanceState()
         self.last = Correction()
 
@@ -205,7 +196,6 @@ class Balance:
         self.stop()
 
     def stop(self) -> None:
-        self.engine.turn_trim = 0.0
         self.engine.trim = NO_TRIM
 
     def __call__(self, q: np.ndarray, dt: float) -> np.ndarray:
@@ -214,8 +204,8 @@ class Balance:
         self.state, corr = balance_step(self.state, tilt, self.engine.live_params, dt,
                                         amplitude=self.engine.amplitude,
                                         swinging=(lift[0] > 0.0, lift[1] > 0.0))
-        self.engine.turn_trim = corr.turn if self._yaw else 0.0
-        self.engine.trim = BodyTrim(corr.pelvis_roll, corr.pelvis_pitch, *corr.feet)
+        self.engine.trim = BodyTrim(corr.pelvis_roll, corr.pelvis_pitch, *corr.feet,
+                                    turn=corr.turn)
         self.last = corr
         return apply(q, corr, self.slots)
 

@@ -83,9 +83,6 @@ class GaitEngine:
         self._ramp = 0.0          # linear ramp variable in [0, 1]
         self._running = False
         self.unreachable_ticks = 0
-        #: Added to ``turn`` [rad/step] by a feedback loop (robot.balance's heading loop);
-        #: the sum is kept inside turn's range.
-        self.turn_trim = 0.0
         #: Posture change relative to the feet, set by a feedback loop (robot.balance).
         self.trim = NO_TRIM
         #: Lift of the right and left foot [m] at the last ``pose`` (> 0: swinging).
@@ -161,9 +158,6 @@ class GaitEngine:
         """Joint angles [rad] at the current phase (default: the current envelope)."""
         a = self.amplitude if amplitude is None else amplitude
         p = self._live
-        if self.turn_trim:
-            spec = SPECS["turn"]
-            p = dataclasses.replace(p, turn=min(max(p.turn + self.turn_trim, spec.lo), spec.hi))
         ch = gait.channels(self.phase, p, amplitude=a)
         targets = body_targets(ch, p, self.robot.geometry, amplitude=a,
                                leg_yaw=self._leg_yaw, trim=self.trim)

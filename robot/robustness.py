@@ -50,7 +50,6 @@ class Outcome:
     fell_at_s: float | None = None
     distance_m: float = 0.0
     heading_deg: float = 0.0
-    wall_s: float = 0.0
     error: str = ""
     summary: dict[str, Any] = field(default_factory=dict)
 
@@ -121,7 +120,7 @@ def run_one(cmd: Sequence[str], condition: Condition, *, balance: bool,
                        error=err[-1] if err else f"exit {proc.returncode}, no summary")
     return Outcome(condition, balance, bool(r.get("fell")), r.get("fell_at_s"),
                    float(r.get("distance_m", 0.0)), float(r.get("heading_change_deg", 0.0)),
-                   float(r.get("wall_s", 0.0)), summary=r)
+                   summary=r)
 
 
 def run_suite(robot: str, gait: str, conds: Iterable[Condition], *, seconds: float,

@@ -27,7 +27,7 @@ from typing import NamedTuple
 
 from robot import xmath as xm
 from robot.config import Geometry
-from robot.params import GaitParams
+from robot.params import SPECS, GaitParams
 from robot.xmath import Num, Rot, Vec
 
 HAND_OUT = 0.01  # hands this far outside the shoulder line [m], clear of the torso
@@ -72,9 +72,12 @@ class BodyTrim(NamedTuple):
     r_dy: float = 0.0
     l_dx: float = 0.0
     l_dy: float = 0.0
+    turn: float = 0.0
 
 
 NO_TRIM = BodyTrim()
+#: The valid range of ``turn`` [rad/step]; a trimmed turn stays inside it.
+TURN_RANGE = (SPECS["turn"].lo, SPECS["turn"].hi)
 
 
 def scale(g: Geometry, p: GaitParams) -> float:
@@ -120,7 +123,8 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
              -hip_h + lift_l)
     w_r = xm.clip(ty, 0.0, 1.0)
     w_l = xm.clip(ty_l, 0.0, 1.0)
-    turn = p.turn if leg_yaw else 0.0
+    turn = (0.0 if not leg_yaw else p.turn if trim.turn == 0.0
+            else min(max(p.turn + trim.turn, TURN_RANGE[0]), TURN_RANGE[1]))
     yaw_r = -0.5 * turn * tz
     yaw_l = 0.5 * turn * tz
     r_rot = xm.rz_ry(yaw_r, -p.toe_gain * ch["RightToe_tY"] * w_r)

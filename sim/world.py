@@ -34,10 +34,10 @@ from typing import Any, Protocol
 import numpy as np
 import numpy.typing as npt
 
-from robot.commands.world_args import RANGES
 from robot.errors import ConfigError
 from robot.telemetry import Telemetry
 from robot.toml_io import Range
+from robot.world_ranges import RANGES
 
 #: Duration of a push's constant force [s]: short next to a step (~0.4 s).
 PUSH_WINDOW_S = 0.02

@@ -160,7 +160,7 @@ def test_the_stage_trims_the_engine_and_start_forgets() -> None:
     engine.start()
     for _ in range(401):
         stage(engine.tick(DT), DT)
-    assert engine.turn_trim > 0.0 and engine.trim.pitch > 0.0
+    assert engine.trim.turn > 0.0 and engine.trim.pitch > 0.0
     stage.start()
-    assert engine.turn_trim == 0.0 and engine.trim == BodyTrim()
+    assert engine.trim.turn == 0.0 and engine.trim == BodyTrim()
     assert stage.state == BalanceState()

@@ -10,20 +10,8 @@ from typing import Any
 
 from robot.commands.common import bounded_float, bounded_int
 from robot.errors import ConfigError
-from robot.toml_io import Range
+from robot.world_ranges import RANGES
 
-#: Valid ranges, in the options' units (sim.world checks its fields against the same).
-RANGES: dict[str, Range] = {
-    "slope": Range(-20.0, 20.0, "deg"),
-    "cross_slope": Range(-20.0, 20.0, "deg"),
-    "bumps": Range(0.0, 50.0, "mm"),
-    "terrain_seed": Range(0, 2**31 - 1),
-    "push_time": Range(0.0, 1e6, "s"),
-    "push_impulse": Range(-10.0, 10.0, "N*s"),
-    "latency": Range(0.0, 100.0, "ms"),
-    "friction": Range(0.2, 3.0),
-    "mass_scale": Range(0.5, 2.0),
-}
 #: Option → (argparse dest, value of "not given").
 DEFAULTS: dict[str, tuple[str, Any]] = {
     "--slope": ("slope", 0.0), "--cross-slope": ("cross_slope", 0.0),

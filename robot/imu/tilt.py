@@ -104,12 +104,12 @@ class TiltEstimator:
         if ACCEL_TRUST[0] <= g <= ACCEL_TRUST[1]:
             a = self.tau_s / (self.tau_s + dt)
             meas = tilt_from_accel(sample.accel)
-            roll = a * roll + (1 - a) * (roll + _wrap(meas.roll - roll))
+            roll = a * roll + (1 - a) * (roll + wrap(meas.roll - roll))
             pitch = a * pitch + (1 - a) * meas.pitch
-        self._tilt, self._t = Tilt(_wrap(roll), pitch), sample.t
+        self._tilt, self._t = Tilt(wrap(roll), pitch), sample.t
         return self._tilt
 
 
-def _wrap(angle: float) -> float:
+def wrap(angle: float) -> float:
     """``angle`` wrapped into [-pi, pi) [rad]."""
     return angle - 2 * math.pi * math.floor((angle + math.pi) / (2 * math.pi))

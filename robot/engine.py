@@ -194,7 +194,7 @@ class GaitEngine:
         else:
             self._ramp = max(0.0, self._ramp - step)
         if self._ramp > 0.0:
-            self.phase = gait.advance(self.phase, p, dt)
+            self.phase = gait.advance(self.phase, p, dt * (1.0 + self.trim.tempo))
         else:
             # Fully ramped out: at zero amplitude the pose does not depend on the phase, so
             # resetting it is invisible and the next start begins a fresh stride.

@@ -108,10 +108,25 @@ SPECS: dict[str, ParamSpec] = {
                             "the lean a slope needs [rad/s per rad of tilt]", False),
     "bal_lean_max": ParamSpec(0.15, 0.0, 0.4, "rad", BALANCE, "largest learned lean (pelvis "
                               "roll/pitch relative to the feet)", False),
-    "bal_step_pd": ParamSpec(0.0, 0.0, 0.2, "m s", BALANCE, "feet moved toward the fall "
-                             "per torso tilt rate [m per rad/s] (stepping)", False),
-    "bal_step_max": ParamSpec(0.02, 0.0, 0.06, "m", BALANCE, "largest step toward the fall",
+    "bal_step_gain": ParamSpec(0.0, 0.0, 3.0, "-", BALANCE, "swinging foot placed this "
+                               "many times the capture-point error toward the fall (1: at "
+                               "the capture point; stepping)", False),
+    "bal_step_max": ParamSpec(0.04, 0.0, 0.08, "m", BALANCE, "largest step toward the fall",
                               False),
+    "bal_step_dead": ParamSpec(0.02, 0.0, 0.1, "m", BALANCE, "capture-point error ignored "
+                               "by stepping and tempo (the walk's own unlearned rocking)",
+                               False),
+    "bal_brace_xi": ParamSpec(0.0, 0.0, 0.2, "m", BALANCE, "capture-point error at which "
+                              "the swinging foot is put down and the gait holds still (0: "
+                              "never)", False),
+    "bal_brace_s": ParamSpec(0.5, 0.0, 3.0, "s", BALANCE, "the gait holds still this long "
+                             "after the error was last that large", False),
+    "bal_tempo_gain": ParamSpec(0.0, 0.0, 50.0, "1/m", BALANCE, "faster gait phase per m "
+                                "of capture-point error (an earlier next step)", False),
+    "bal_tempo_max": ParamSpec(0.5, 0.0, 2.0, "-", BALANCE, "largest phase speed-up "
+                               "(0.5: up to 1.5 x the gait's rate)", False),
+    "bal_learn_cycles": ParamSpec(4.0, 0.0, 50.0, "cycle", BALANCE, "time constant of the "
+                                  "learned gait rhythm the stepping ignores (0: none)", False),
     "bal_heading_p": ParamSpec(0.5, 0.0, 2.0, "1/step", BALANCE, "turn trim per rad of "
                                "heading error [rad/step per rad]", False),
     "bal_heading_i": ParamSpec(0.2, 0.0, 2.0, "1/(step s)", BALANCE, "turn trim per rad*s "
@@ -183,8 +198,14 @@ class GaitParams:
     bal_ankle_pp: float = SPECS["bal_ankle_pp"].default
     bal_lean_i: float = SPECS["bal_lean_i"].default
     bal_lean_max: float = SPECS["bal_lean_max"].default
-    bal_step_pd: float = SPECS["bal_step_pd"].default
+    bal_step_gain: float = SPECS["bal_step_gain"].default
     bal_step_max: float = SPECS["bal_step_max"].default
+    bal_step_dead: float = SPECS["bal_step_dead"].default
+    bal_brace_xi: float = SPECS["bal_brace_xi"].default
+    bal_brace_s: float = SPECS["bal_brace_s"].default
+    bal_tempo_gain: float = SPECS["bal_tempo_gain"].default
+    bal_tempo_max: float = SPECS["bal_tempo_max"].default
+    bal_learn_cycles: float = SPECS["bal_learn_cycles"].default
     bal_heading_p: float = SPECS["bal_heading_p"].default
     bal_heading_i: float = SPECS["bal_heading_i"].default
     bal_turn_max: float = SPECS["bal_turn_max"].default

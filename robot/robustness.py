@@ -9,6 +9,7 @@ tilted past the fall threshold) in ``seconds`` of gait.
 from __future__ import annotations
 
 import json
+import math
 import os
 import subprocess
 import sys
@@ -17,7 +18,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
 
-from robot.params import GaitParams
+from robot.params import SPECS, GaitParams
 
 #: Push impulse of the full suite [N*s] (issue 10's goal) and the gait time of the first
 #: push [s]: well after the ramp-in.
@@ -31,13 +32,25 @@ PARAM_SCALE = 0.2
 SKIP_PARAMS = frozenset({"speed", "turn", "side_step", "ramp_cycles", "rig_leg", "fps"})
 
 
+#: The straightness goal's walk [s]: heading within STRAIGHT_DEG and lateral drift within
+#: STRAIGHT_DRIFT of the distance over this long on flat ground.
+STRAIGHT_S = 60.0
+STRAIGHT_DEG = 5.0
+STRAIGHT_DRIFT = 0.05
+#: Scales of the sim IMU's datasheet noise and offsets (every run has x1, the robot
+#: file's "realistic" BNO055).
+IMU_NOISE = (2.0, 3.0)
+
+
 @dataclass(frozen=True)
 class Condition:
-    """One perturbation: a name, a group (one bar of the picture) and walk options."""
+    """One perturbation: a name, a group (one bar of the picture) and walk options;
+    seconds: this condition's walk [s] (None: the suite's)."""
 
     group: str
     name: str
     args: tuple[str, ...] = ()
+    seconds: float | None = None
 
 
 @dataclass
@@ -76,20 +89,36 @@ def conditions(params: GaitParams, *, quick: bool = False) -> list[Condition]:
                                  f"push {PUSH_NS:g} N*s {direction} at phase {ph:g}",
                                  ("--push", f"{t:.3f}:{ux * PUSH_NS:g},{uy * PUSH_NS:g}")))
     if not quick:
-        values = params.as_dict()
-        for name, v in values.items():
-            if name in SKIP_PARAMS or name.startswith("bal_") or v == 0.0:
-                continue
-            for sign in (1, -1):
-                out.append(Condition("params +/-20 %", f"{name} {sign * 20:+d} %",
-                                     ("--set", f"{name}={v * (1 + sign * PARAM_SCALE)!r}")))
+        out += scaled_params(params)
     for ms in ((20.0,) if quick else (10.0, 20.0)):
         out.append(Condition("latency", f"latency {ms:g} ms", ("--latency", f"{ms:g}")))
+    for scale in (IMU_NOISE[-1:] if quick else IMU_NOISE):
+        out.append(Condition("imu noise", f"imu noise x{scale:g}", ("--imu-noise", f"{scale:g}")))
     if not quick:
+        out.append(Condition("flat 60 s", f"flat {STRAIGHT_S:g} s", seconds=STRAIGHT_S))
         out += [Condition("friction", f"friction x{f:g}", ("--friction", f"{f:g}"))
                 for f in (0.5, 2.0)]
         out += [Condition("mass", f"mass x{m:g}", ("--mass-scale", f"{m:g}"))
                 for m in (0.8, 1.2)]
+    return out
+
+
+def scaled_params(params: GaitParams) -> list[Condition]:
+    """Every shaping parameter of ``params`` +/- PARAM_SCALE, clipped to its documented
+    range (a clipped change is named; one that the range leaves at the preset's value is
+    left out)."""
+    out = []
+    for name, v in params.as_dict().items():
+        if name in SKIP_PARAMS or name.startswith("bal_") or v == 0.0:
+            continue
+        spec = SPECS[name]
+        for sign in (1, -1):
+            want = v * (1 + sign * PARAM_SCALE)
+            got = min(max(want, spec.lo), spec.hi)
+            if got == v:
+                continue
+            label = f"{name} {sign * 20:+d} %" + ("" if got == want else f" (range: {got:g})")
+            out.append(Condition("params +/-20 %", label, ("--set", f"{name}={got!r}")))
     return out
 
 
@@ -130,17 +159,21 @@ def run_suite(robot: str, gait: str, conds: Iterable[Condition], *, seconds: flo
     """Every condition in every balance mode, ``jobs`` at a time (default: the cores)."""
     work = [(c, b) for c in conds for b in balance_modes]
     jobs = jobs or os.cpu_count() or 1
-    timeout = 60.0 + 10.0 * seconds
+    # Longest first, so that a long run does not start last and idle the other cores;
+    # the outcomes come back in suite order.
+    order = sorted(range(len(work)), key=lambda i: -(work[i][0].seconds or seconds))
 
     def one(item: tuple[Condition, bool]) -> Outcome:
         c, b = item
-        out = run_one(walk_command(robot, gait, seconds, c, balance=b, base_args=base_args),
-                      c, balance=b, timeout_s=timeout)
+        secs = seconds if c.seconds is None else c.seconds
+        out = run_one(walk_command(robot, gait, secs, c, balance=b, base_args=base_args),
+                      c, balance=b, timeout_s=60.0 + 10.0 * secs)
         if progress is not None:
             progress(out)
         return out
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        return list(pool.map(one, work))
+        done = dict(zip(order, pool.map(one, [work[i] for i in order]), strict=True))
+    return [done[i] for i in range(len(work))]
 
 
 def survival_table(outcomes: Sequence[Outcome]) -> list[tuple[str, dict[bool, tuple[int, int]]]]:
@@ -151,3 +184,19 @@ def survival_table(outcomes: Sequence[Outcome]) -> list[tuple[str, dict[bool, tu
         ok, n = row.get(o.balance, (0, 0))
         row[o.balance] = (ok + (o.fell is False), n + 1)
     return list(table.items())
+
+
+def straightness(outcomes: Sequence[Outcome]) -> dict[bool, dict[str, Any]]:
+    """Per balance mode, the flat STRAIGHT_S run's heading change [deg], lateral drift [m]
+    and drift / distance, and whether both are inside the goal."""
+    out: dict[bool, dict[str, Any]] = {}
+    for o in outcomes:
+        if o.condition.group != "flat 60 s" or o.fell is None:
+            continue
+        drift = float(o.summary.get("lateral_drift_m", 0.0))
+        ratio = abs(drift) / o.distance_m if o.distance_m > 0 else math.inf
+        out[o.balance] = {"heading_deg": o.heading_deg, "drift_m": drift,
+                          "drift_ratio": ratio, "distance_m": o.distance_m, "fell": o.fell,
+                          "ok": (not o.fell and abs(o.heading_deg) <= STRAIGHT_DEG
+                                 and ratio <= STRAIGHT_DRIFT)}
+    return out

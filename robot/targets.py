@@ -63,7 +63,11 @@ class BodyTrim(NamedTuple):
     roll, pitch: extra pelvis rotation [rad] (on a slope the feet follow the ground while
     the body stays upright); r_dx, r_dy, l_dx, l_dy: each foot moved forward / left [m]
     under the pelvis (a feedback loop moves a foot only while it swings, so it lands
-    where the body is falling, and keeps it there while it stands).
+    where the body is falling, and keeps it there while it stands); turn: added to the
+    gait's ``turn`` [rad/step], the sum kept inside its range; tempo: the gait phase runs
+    (1 + tempo) times faster [-] (read by robot.engine, not here); land: 0 walks, 1 keeps
+    both feet on the ground (each foot's lift x (1 - land); BodyTargets still report the
+    gait's own lift, so a feedback loop knows which foot the gait swings).
     """
 
     roll: float = 0.0
@@ -73,6 +77,8 @@ class BodyTrim(NamedTuple):
     l_dx: float = 0.0
     l_dy: float = 0.0
     turn: float = 0.0
+    tempo: float = 0.0
+    land: float = 0.0
 
 
 NO_TRIM = BodyTrim()
@@ -112,17 +118,18 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
     ty_l = 2.0 * a_delta - ty           # eq 8 in anti-phase
     lift_r = xm.maximum(s * ch["RightFoot_tY"], 0.0)
     lift_l = xm.maximum(s * p.Fhgt_L * ty_l, 0.0)
+    down = 1.0 - trim.land
     stride_r = ch["RightFoot_tZ"] - p.Fpos_R            # -tz * Slgt_R
     stride_l = -(ch["LeftFoot_tZ"] - p.Fpos_L)          # +tz * Slgt_L (anti-phase)
     half_w = g.hip_width / 2 + p.foot_spread
     r_pos = (s * (p.speed * stride_r + p.Fpos_R),
              -half_w - 0.5 * p.side_step * tz,
-             -hip_h + lift_r)
+             -hip_h + lift_r * down)
     l_pos = (s * (p.speed * stride_l + p.Fpos_L),
              half_w + 0.5 * p.side_step * tz,
-             -hip_h + lift_l)
-    w_r = xm.clip(ty, 0.0, 1.0)
-    w_l = xm.clip(ty_l, 0.0, 1.0)
+             -hip_h + lift_l * down)
+    w_r = xm.clip(ty, 0.0, 1.0) * down
+    w_l = xm.clip(ty_l, 0.0, 1.0) * down
     turn = (0.0 if not leg_yaw else p.turn if trim.turn == 0.0
             else min(max(p.turn + trim.turn, TURN_RANGE[0]), TURN_RANGE[1]))
     yaw_r = -0.5 * turn * tz

@@ -19,7 +19,16 @@ from robot.commands.common import (
     robot_from,
     seconds,
 )
-from robot.robustness import Outcome, conditions, run_suite, survival_table
+from robot.robustness import (
+    STRAIGHT_DEG,
+    STRAIGHT_DRIFT,
+    STRAIGHT_S,
+    Outcome,
+    conditions,
+    run_suite,
+    straightness,
+    survival_table,
+)
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
@@ -65,6 +74,7 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         plot_survival(table, args.out, title=f"{args.robot}, gait {gait.name}, {secs:g} s runs")
     errors = [o for o in outcomes if o.fell is None]
+    straight = straightness(outcomes)
     if args.json:
         print(json.dumps({
             "robot": args.robot, "gait": gait.name, "seconds": secs, "wall_s": wall,
@@ -73,13 +83,21 @@ def run(args: argparse.Namespace) -> int:
             "runs": [{"condition": o.condition.name, "group": o.condition.group,
                       "balance": o.balance, "fell": o.fell, "fell_at_s": o.fell_at_s,
                       "distance_m": o.distance_m, "heading_deg": o.heading_deg,
-                      "error": o.error} for o in outcomes]}))
+                      "error": o.error} for o in outcomes],
+            "straightness": {("balance" if b else "open_loop"): v
+                             for b, v in straight.items()}}))
     else:
         print(format_table(table, modes))
         falls = [o for o in outcomes if o.balance and o.fell]
         if falls:
             print("fell with balance: " + "; ".join(
                 f"{o.condition.name} at {o.fell_at_s:.1f} s" for o in falls))
+        for b, v in straight.items():
+            print(f"flat {STRAIGHT_S:g} s, {'balance' if b else 'open loop'}: heading "
+                  f"{v['heading_deg']:+.1f} deg, drift {v['drift_m']:+.3f} m = "
+                  f"{100 * v['drift_ratio']:.1f} % of {v['distance_m']:.2f} m "
+                  f"({'inside' if v['ok'] else 'OUTSIDE'} the goal: {STRAIGHT_DEG:g} deg, "
+                  f"{100 * STRAIGHT_DRIFT:g} %)")
         print(f"{total} runs of {secs:g} s in {wall:.0f} s")
         if args.out:
             print(f"wrote {args.out}")

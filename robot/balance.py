@@ -57,12 +57,12 @@ class JointSlots(NamedTuple):
 
 def apply(q: np.ndarray, corr: Correction, slots: JointSlots) -> np.ndarray:
     """``q`` [rad] with ``corr`` added to both legs (a new array)."""
-    out = np.array(q, dtype=float)
-    out[slots.ankle_pitch] += corr.ankle_pitch
-    out[slots.ankle_roll] += corr.ankle_roll
-    out[slots.hip_pitch] += corr.hip_pitch
-    out[slots.hip_roll] += corr.hip_roll
-    return out
+    out = q.tolist() if isinstance(q, np.ndarray) else [float(v) for v in q]
+    for idx, dq in ((slots.ankle_pitch, corr.ankle_pitch), (slots.ankle_roll, corr.ankle_roll),
+                    (slots.hip_pitch, corr.hip_pitch), (slots.hip_roll, corr.hip_roll)):
+        for i in idx:
+            out[i] += dq
+    return np.array(out)
 
 
 class Balance:

@@ -160,6 +160,8 @@ def _capture(rhythm: Rhythm, tilt: Attitude, p: GaitParams, g: GaitPhase, brace:
     """The learned rhythm after this tick and the capture-point error (forward, left) [m].
     The rhythm is expected in proportion to the envelope and to how much the gait moves
     (1 - brace); it is learned only while the gait walks at full amplitude."""
+    if p.bal_step_gain == 0.0 and p.bal_brace_xi == 0.0 and p.bal_tempo_gain == 0.0:
+        return rhythm, 0.0, 0.0                   # nothing uses it: no need to learn
     values = (tilt.roll, tilt.pitch, tilt.roll_rate, tilt.pitch_rate)
     a = g.amplitude * (1.0 - brace)
     learned = rhythm.at(g.theta)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -167,15 +168,15 @@ class RobotConfig:
         raise ConfigError(f"{self.source}: no joint {name!r}; valid: "
                           f"{', '.join(j.name for j in self.joints)}")
 
-    @property
+    @cached_property
     def joint_names(self) -> tuple[str, ...]:
         return tuple(j.name for j in self.joints)
 
-    @property
+    @cached_property
     def has_arms(self) -> bool:
         return any(j.name in ARM_NAMES for j in self.joints)
 
-    @property
+    @cached_property
     def has_hip_yaw(self) -> bool:
         """False for 5-DoF legs (no hip yaw: the gait cannot turn by yawing the feet)."""
         return "r_hip_yaw" in self.joint_names
@@ -184,7 +185,7 @@ class RobotConfig:
         """The servo model of ``joint`` (its own ``model``, else the bus's)."""
         return MODELS[joint.model or self.bus.model]
 
-    @property
+    @cached_property
     def layout(self) -> tuple[tuple[int, float], ...] | None:
         """How the engine's full joint vector (``JOINT_NAMES`` order, legs then arms) maps
         onto this robot's joints: per joint (index into it, or -1 and the fixed angle).
@@ -196,7 +197,7 @@ class RobotConfig:
         return tuple((index[j.name], 0.0) if j.fixed_rad is None else (-1, j.fixed_rad)
                      for j in self.joints)
 
-    @property
+    @cached_property
     def ids(self) -> tuple[int, ...]:
         return tuple(j.servo_id for j in self.joints)
 

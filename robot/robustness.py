@@ -1,20 +1,24 @@
 """The robustness suite: simulated walks under perturbations, with and without balance.
 
-Each condition is one ``biped walk --json`` run in its own process (the same code path a
-user runs, so the suite measures the product, not a copy of it), several at once across
-the cores. A condition survives when the walk does not fall (sim.metrics: torso low or
+Each condition is one ``biped walk --json`` run (``robot.cli.main``: the same code path a
+user runs, so the suite measures the product, not a copy of it), in a pool of worker
+processes, one per core, each running one walk after the other (no interpreter start
+and imports per run). A condition survives when the walk does not fall (sim.metrics: torso low or
 tilted past the fall threshold) in ``seconds`` of gait.
 """
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
+import logging
 import math
+import multiprocessing
 import os
-import subprocess
 import sys
 from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -122,31 +126,55 @@ def scaled_params(params: GaitParams) -> list[Condition]:
     return out
 
 
-def walk_command(robot: str, gait: str, seconds: float, condition: Condition, *,
-                 balance: bool, base_args: Sequence[str] = ()) -> list[str]:
-    """The ``biped walk`` command line of one run (``base_args``: e.g. ``--set`` items,
+def walk_argv(robot: str, gait: str, seconds: float, condition: Condition, *,
+              balance: bool, base_args: Sequence[str] = ()) -> list[str]:
+    """The ``biped walk`` arguments of one run (``base_args``: e.g. ``--set`` items,
     before the condition's own, which win)."""
-    cmd = [sys.executable, "-m", "robot.cli", "walk", "--json", "--robot", robot,
-           "--gait", gait, "--seconds", f"{seconds:g}", *base_args, *condition.args]
-    return cmd if balance else [*cmd, "--no-balance"]
+    argv = ["walk", "--json", "--robot", robot, "--gait", gait, "--seconds", f"{seconds:g}",
+            *base_args, *condition.args]
+    return argv if balance else [*argv, "--no-balance"]
 
 
-def run_one(cmd: Sequence[str], condition: Condition, *, balance: bool,
-            timeout_s: float) -> Outcome:
-    """Run one walk in a subprocess and read its JSON summary."""
-    env = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
-    try:
-        proc = subprocess.run(list(cmd), capture_output=True, text=True, timeout=timeout_s,
-                              env=env, check=False)
-    except subprocess.TimeoutExpired:
-        return Outcome(condition, balance, None, error=f"timed out after {timeout_s:g} s")
-    line = proc.stdout.strip().splitlines()[-1] if proc.stdout.strip() else ""
+class _Stderr:
+    """A log stream that writes to whatever ``sys.stderr`` is at the time."""
+
+    def write(self, text: str) -> int:
+        return sys.stderr.write(text)
+
+    def flush(self) -> None:
+        sys.stderr.flush()
+
+
+def _worker_init() -> None:
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    logging.basicConfig(level=logging.WARNING, stream=_Stderr(),  # type: ignore[arg-type]
+                        format="%(levelname)s %(name)s: %(message)s")
+
+
+def run_walk(argv: Sequence[str]) -> tuple[int, str, str]:
+    """``biped <argv>`` in this process: (exit code, stdout, stderr)."""
+    from robot.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main(list(argv))
+        except Exception as e:      # a bug in a run must not take the suite down
+            print(f"{type(e).__name__}: {e}", file=sys.stderr)
+            code = 1
+    return code, out.getvalue(), err.getvalue()
+
+
+def outcome(condition: Condition, balance: bool, code: int, stdout: str,
+            stderr: str) -> Outcome:
+    """The ``Outcome`` of one run from its exit code and output."""
+    line = stdout.strip().splitlines()[-1] if stdout.strip() else ""
     try:
         r = json.loads(line)
     except json.JSONDecodeError:
-        err = proc.stderr.strip().splitlines()
+        err = stderr.strip().splitlines()
         return Outcome(condition, balance, None,
-                       error=err[-1] if err else f"exit {proc.returncode}, no summary")
+                       error=err[-1] if err else f"exit {code}, no summary")
     return Outcome(condition, balance, bool(r.get("fell")), r.get("fell_at_s"),
                    float(r.get("distance_m", 0.0)), float(r.get("heading_change_deg", 0.0)),
                    summary=r)
@@ -156,23 +184,35 @@ def run_suite(robot: str, gait: str, conds: Iterable[Condition], *, seconds: flo
               balance_modes: Sequence[bool] = (True, False), jobs: int | None = None,
               progress: Callable[[Outcome], None] | None = None,
               base_args: Sequence[str] = ()) -> list[Outcome]:
-    """Every condition in every balance mode, ``jobs`` at a time (default: the cores)."""
+    """Every condition in every balance mode, ``jobs`` at a time (default: the cores),
+    in suite order."""
     work = [(c, b) for c in conds for b in balance_modes]
     jobs = jobs or os.cpu_count() or 1
-    # Longest first, so that a long run does not start last and idle the other cores;
-    # the outcomes come back in suite order.
+    # Longest first, so that a long run does not start last and idle the other cores.
     order = sorted(range(len(work)), key=lambda i: -(work[i][0].seconds or seconds))
-
-    def one(item: tuple[Condition, bool]) -> Outcome:
-        c, b = item
-        secs = seconds if c.seconds is None else c.seconds
-        out = run_one(walk_command(robot, gait, secs, c, balance=b, base_args=base_args),
-                      c, balance=b, timeout_s=60.0 + 10.0 * secs)
-        if progress is not None:
-            progress(out)
-        return out
-    with ThreadPoolExecutor(max_workers=jobs) as pool:
-        done = dict(zip(order, pool.map(one, [work[i] for i in order]), strict=True))
+    done: dict[int, Outcome] = {}
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx,
+                             initializer=_worker_init) as pool:
+        futures = {}
+        for i in order:
+            c, b = work[i]
+            secs = seconds if c.seconds is None else c.seconds
+            argv = walk_argv(robot, gait, secs, c, balance=b, base_args=base_args)
+            futures[pool.submit(run_walk, argv)] = i
+        try:
+            for f in as_completed(futures):
+                i = futures[f]
+                c, b = work[i]
+                try:
+                    done[i] = outcome(c, b, *f.result())
+                except Exception as e:   # the worker died (e.g. killed)
+                    done[i] = Outcome(c, b, None, error=f"{type(e).__name__}: {e}")
+                if progress is not None:
+                    progress(done[i])
+        except KeyboardInterrupt:        # the running walks stop on their own SIGINT
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
     return [done[i] for i in range(len(work))]
 
 

@@ -20,48 +20,48 @@ IDENTITY: Rot = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 
 
 def sin(x: Num) -> Num:
-    return math.sin(x) if isinstance(x, float) else np.sin(x)
+    return math.sin(x) if type(x) is float else np.sin(x)
 
 
 def cos(x: Num) -> Num:
-    return math.cos(x) if isinstance(x, float) else np.cos(x)
+    return math.cos(x) if type(x) is float else np.cos(x)
 
 
 def sqrt(x: Num) -> Num:
-    return math.sqrt(x) if isinstance(x, float) else np.sqrt(x)
+    return math.sqrt(x) if type(x) is float else np.sqrt(x)
 
 
 def atan2(y: Num, x: Num) -> Num:
-    if isinstance(y, float) and isinstance(x, float):
+    if type(y) is float and type(x) is float:
         return math.atan2(y, x)
     return np.arctan2(y, x)
 
 
 def clip(x: Num, lo: float, hi: float) -> Num:
-    if isinstance(x, float):
+    if type(x) is float:
         return lo if x < lo else hi if x > hi else x
     return np.clip(x, lo, hi)
 
 
 def acos(x: Num) -> Num:
     """arccos of ``x`` clipped to [-1, 1] (never NaN)."""
-    return math.acos(clip(x, -1.0, 1.0)) if isinstance(x, float) else np.arccos(np.clip(x, -1, 1))
+    return math.acos(clip(x, -1.0, 1.0)) if type(x) is float else np.arccos(np.clip(x, -1, 1))
 
 
 def asin(x: Num) -> Num:
     """arcsin of ``x`` clipped to [-1, 1] (never NaN)."""
-    return math.asin(clip(x, -1.0, 1.0)) if isinstance(x, float) else np.arcsin(np.clip(x, -1, 1))
+    return math.asin(clip(x, -1.0, 1.0)) if type(x) is float else np.arcsin(np.clip(x, -1, 1))
 
 
 def maximum(x: Num, y: float) -> Num:
-    if isinstance(x, float):
+    if type(x) is float:
         return x if x > y else y
     return np.maximum(x, y)
 
 
 def sign(x: Num) -> Num:
     """+1 for x >= 0, else -1."""
-    if isinstance(x, float):
+    if type(x) is float:
         return 1.0 if x >= 0 else -1.0
     return np.where(x >= 0, 1.0, -1.0)
 

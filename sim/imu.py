@@ -76,8 +76,9 @@ class SimImu(Imu):
         self._adr: dict[str, int] | None = None
         self._buffer: deque[ImuSample] = deque()
         self._rng = np.random.default_rng(config.seed)
-        self._gyro_bias = np.zeros(3)
-        self._accel_bias = np.zeros(3)
+        self._gyro_bias = (0.0, 0.0, 0.0)
+        self._accel_bias = (0.0, 0.0, 0.0)
+        self._normals = _Normals(self._rng)
 
     @property
     def is_open(self) -> bool:
@@ -99,8 +100,9 @@ class SimImu(Imu):
             adr[key] = int(model.sensor_adr[sid])
         c = self.config
         self._rng = np.random.default_rng(c.seed)
-        self._gyro_bias = self._rng.normal(0.0, c.bias * GYRO_OFFSET, 3)
-        self._accel_bias = self._rng.normal(0.0, c.bias * ACCEL_OFFSET, 3)
+        self._gyro_bias = _tuple3(self._rng.normal(0.0, c.bias * GYRO_OFFSET, 3))
+        self._accel_bias = _tuple3(self._rng.normal(0.0, c.bias * ACCEL_OFFSET, 3))
+        self._normals = _Normals(self._rng)
         self._buffer.clear()
         self._adr = adr
 
@@ -116,7 +118,7 @@ class SimImu(Imu):
         d = self.bus.data
         s = d.sensordata
         a = self._adr
-        quat = tuple(float(v) for v in s[a["quat"]:a["quat"] + 4])
+        quat = tuple(s[a["quat"]:a["quat"] + 4].tolist())
         return ImuSample(float(d.time), _vec(s, a["gyro"]), _vec(s, a["accel"]),
                          quat if self.config.fusion else None)  # type: ignore[arg-type]
 
@@ -140,14 +142,16 @@ class SimImu(Imu):
         c = self.config
         if c.noise == 0.0 and c.bias == 0.0:
             return dev
-        rng = self._rng
-        gyro = np.add(dev.gyro, self._gyro_bias) + rng.normal(0.0, c.noise * GYRO_SIGMA, 3)
-        accel = np.add(dev.accel, self._accel_bias) + rng.normal(0.0, c.noise * ACCEL_SIGMA, 3)
+        draw = self._normals.three
+        gyro = _noisy(dev.gyro, self._gyro_bias, c.noise * GYRO_SIGMA, draw())
+        accel = _noisy(dev.accel, self._accel_bias, c.noise * ACCEL_SIGMA, draw())
         quat = dev.quat
         if quat is not None and c.noise > 0.0:
-            quat = quat_normalize(quat_mul(quat, _small_rotation(
-                rng.normal(0.0, c.noise * QUAT_NOISE, 3))))
-        return ImuSample(dev.t, _tuple3(gyro), _tuple3(accel), quat)
+            sigma = c.noise * QUAT_NOISE
+            x, y, z = draw()
+            quat = quat_normalize(quat_mul(quat, _small_rotation((sigma * x, sigma * y,
+                                                                   sigma * z))))
+        return ImuSample(dev.t, gyro, accel, quat)
 
 
 def open_sim_imu(config: ImuConfig, *, bus: Any = None) -> SimImu:
@@ -160,19 +164,48 @@ def open_sim_imu(config: ImuConfig, *, bus: Any = None) -> SimImu:
     return SimImu(bus, config)
 
 
+class _Normals:
+    """Standard normal draws from ``rng``, three at a time, drawn in blocks: the same
+    numbers in the same order as drawing three per call (numpy's Generator fills a block
+    from its stream one value after the other), without a numpy call per sample."""
+
+    BLOCK = 3 * 4096
+
+    def __init__(self, rng: np.random.Generator) -> None:
+        self._rng = rng
+        self._buf: list[float] = []
+        self._i = 0
+
+    def three(self) -> tuple[float, float, float]:
+        i = self._i
+        if i + 3 > len(self._buf):
+            self._buf, i = self._rng.standard_normal(self.BLOCK).tolist(), 0
+        self._i = i + 3
+        b = self._buf
+        return b[i], b[i + 1], b[i + 2]
+
+
+def _noisy(v: tuple[float, float, float], bias: tuple[float, float, float], sigma: float,
+           z: tuple[float, float, float]) -> tuple[float, float, float]:
+    """(v + bias) + sigma * z, per axis (the order numpy's normal(0, sigma) adds in)."""
+    return (v[0] + bias[0] + sigma * z[0], v[1] + bias[1] + sigma * z[1],
+            v[2] + bias[2] + sigma * z[2])
+
+
 def _vec(s: Any, i: int) -> tuple[float, float, float]:
-    return (float(s[i]), float(s[i + 1]), float(s[i + 2]))
+    x, y, z = s[i:i + 3].tolist()
+    return (x, y, z)
 
 
 def _tuple3(v: Any) -> tuple[float, float, float]:
     return (float(v[0]), float(v[1]), float(v[2]))
 
 
-def _small_rotation(rotvec: Any) -> Quat:
+def _small_rotation(rotvec: tuple[float, float, float]) -> Quat:
     """Quaternion of the rotation vector ``rotvec`` [rad]."""
-    angle = float(np.linalg.norm(rotvec))
+    x, y, z = rotvec
+    angle = math.sqrt(x * x + y * y + z * z)
     if angle == 0.0:
         return (1.0, 0.0, 0.0, 0.0)
     s = math.sin(angle / 2) / angle
-    return (math.cos(angle / 2), float(rotvec[0]) * s, float(rotvec[1]) * s,
-            float(rotvec[2]) * s)
+    return (math.cos(angle / 2), x * s, y * s, z * s)

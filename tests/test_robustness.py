@@ -1,0 +1,99 @@
+"""`biped robustness`: the suite's conditions, and a --quick run end to end (real walks
+in MuJoCo, in worker processes) that must survive what the balance loop is for."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from robot.config import load_gait
+from robot.params import SPECS
+from robot.robustness import (
+    PUSH_AT_S,
+    STRAIGHT_S,
+    Condition,
+    Outcome,
+    conditions,
+    straightness,
+)
+
+WALK = load_gait("walk").params
+
+
+def test_every_parameter_condition_is_inside_its_documented_range() -> None:
+    seen = set()
+    for c in conditions(WALK):
+        if c.group != "params +/-20 %":
+            continue
+        name, value = c.args[1].split("=")
+        spec = SPECS[name]
+        v = float(value)
+        assert spec.lo <= v <= spec.hi, c.name
+        assert v != getattr(WALK, name), c.name          # a real change
+        seen.add(name)
+    # stance 0.88 +20 % = 1.056 is outside [0.6, 0.99]: clipped, not dropped or invalid.
+    assert "stance +20 % (range: 0.99)" in {c.name for c in conditions(WALK)}
+    assert {"vM", "Slgt_R", "Fhgt_L", "sway", "stance"} <= seen
+
+
+def test_the_full_suite_has_every_group_of_the_issue() -> None:
+    groups = {c.group for c in conditions(WALK)}
+    assert groups == {"flat", "slope", "cross slope", "bumps", "push forward",
+                      "push backward", "push left", "push right", "params +/-20 %",
+                      "latency", "imu noise", "flat 60 s", "friction", "mass"}
+    pushes = [c for c in conditions(WALK) if c.group.startswith("push")]
+    assert len(pushes) == 16                               # 4 directions x 4 phases
+    times = sorted({float(c.args[1].split(":")[0]) for c in pushes})
+    assert times[0] == PUSH_AT_S
+    assert times[-1] == pytest.approx(PUSH_AT_S + 0.75 * WALK.cycle_s, abs=1e-3)
+    long = [c for c in conditions(WALK) if c.seconds is not None]
+    assert [c.seconds for c in long] == [STRAIGHT_S]
+
+
+def test_straightness_judges_heading_and_drift_against_the_goal() -> None:
+    flat = Condition("flat 60 s", "flat 60 s", seconds=STRAIGHT_S)
+
+    def run(heading: float, drift: float, *, balance: bool = True) -> Outcome:
+        return Outcome(flat, balance, False, None, 6.0, heading,
+                       summary={"lateral_drift_m": drift})
+    assert straightness([run(4.9, 0.29)])[True]["ok"]
+    assert not straightness([run(5.1, 0.0)])[True]["ok"]
+    assert not straightness([run(0.0, -0.31)])[True]["ok"]      # 5.2 % of 6 m
+    assert straightness([run(0.0, -0.31)])[True]["drift_ratio"] == pytest.approx(0.31 / 6)
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
+    png = tmp_path_factory.mktemp("robustness") / "suite.png"
+    proc = subprocess.run([sys.executable, "-m", "robot.cli", "robustness", "--quick",
+                           "--json", "--out", str(png)], capture_output=True, text=True,
+                          timeout=900, check=False)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    return json.loads(proc.stdout), png
+
+
+def test_quick_suite_runs_with_and_without_balance(quick: tuple[dict, Path]) -> None:
+    result, png = quick
+    runs = result["runs"]
+    assert all(r["error"] == "" for r in runs)
+    assert {r["balance"] for r in runs} == {True, False}
+    assert len(runs) == 2 * len(conditions(WALK, quick=True))
+    assert png.stat().st_size > 10_000 and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("name", ["flat", "slope +5 deg", "slope -5 deg",
+                                  "cross slope +4 deg", "latency 20 ms", "imu noise x3"])
+def test_with_balance_the_quick_cases_survive(quick: tuple[dict, Path], name: str) -> None:
+    run = next(r for r in quick[0]["runs"] if r["condition"] == name and r["balance"])
+    assert run["fell"] is False, run
+
+
+def test_the_5_deg_uphill_needs_the_balance_loop(quick: tuple[dict, Path]) -> None:
+    """Open loop the walk falls on a 5 deg uphill (the issue's measurement); with the
+    learned lean it walks on."""
+    runs = {r["balance"]: r for r in quick[0]["runs"] if r["condition"] == "slope +5 deg"}
+    assert runs[False]["fell"] is True and runs[True]["fell"] is False

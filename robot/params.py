@@ -80,7 +80,7 @@ SPECS: dict[str, ParamSpec] = {
     # --- steering (robot mapping) -----------------------------------------------------------
     "speed": ParamSpec(1.0, -1.0, 1.5, "-", STEER, "stride multiplier; negative walks backward", False),
     "turn": ParamSpec(0.0, -0.5, 0.5, "rad/step", STEER, "turn per step, + = left (hip yaw)", False),
-    "side_step": ParamSpec(0.0, -0.03, 0.03, "m/step", STEER, "side step per step, + = left "
+    "side_step": ParamSpec(0.0, -0.025, 0.025, "m/step", STEER, "side step per step, + = left "
                            "(walks over the whole range with balance on)", False),
     # --- robot mapping ------------------------------------------------------------------------
     "rig_leg": ParamSpec(4.0, 1.0, 20.0, "rig", ROBOT, "leg length of the paper's rig in rig units; "

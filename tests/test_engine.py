@@ -283,8 +283,9 @@ def test_start_pose_has_both_feet_flat_on_the_ground(any_robot: RobotConfig,
 
 
 def test_steering_follows_a_live_change_at_a_bounded_rate() -> None:
-    """A live speed reversal -1 -> +1 passes through zero at STEER_RATE, not in one
-    first-order step; turn and side_step likewise; other parameters keep PARAM_TAU_S."""
+    """A live speed reversal -1 -> +0.3 passes through zero at STEER_RATE, not in one
+    first-order step; turn and side_step likewise; other parameters keep PARAM_TAU_S.
+    (0.3 / 1.5 + 0.2 / 0.5 + 0.015 / 0.025 = 1.2: inside the steering budget.)"""
     from robot.engine import STEER_RATE
 
     robot = load_robot("biped18-dynamixel")
@@ -292,17 +293,20 @@ def test_steering_follows_a_live_change_at_a_bounded_rate() -> None:
     engine.start()
     dt = 0.005
     engine.tick(dt)
-    engine.set_params({"speed": 1.0, "turn": 0.4, "side_step": 0.03, "sway": 0.03})
-    speeds = []
+    engine.set_params({"speed": 0.3, "turn": 0.2, "side_step": 0.015, "sway": 0.03})
+    speeds, turns, sides = [], [], []
     for _ in range(200):                                    # 1 s
         engine.tick(dt)
         speeds.append(engine.live_params.speed)
+        turns.append(engine.live_params.turn)
+        sides.append(engine.live_params.side_step)
     steps = np.diff([-1.0, *speeds])
     assert np.all(steps <= STEER_RATE["speed"] * dt + 1e-12) and np.all(steps > 0)
     assert speeds[-1] == pytest.approx(-1.0 + STEER_RATE["speed"] * 1.0, abs=1e-9)
-    assert engine.live_params.turn == pytest.approx(STEER_RATE["turn"] * 1.0, abs=1e-9)
-    assert engine.live_params.side_step == pytest.approx(0.02, abs=1e-9)
+    assert turns[99] == pytest.approx(STEER_RATE["turn"] * 0.5, abs=1e-9)      # at 0.5 s
+    assert sides[99] == pytest.approx(STEER_RATE["side_step"] * 0.5, abs=1e-9)
+    assert (turns[-1], sides[-1]) == pytest.approx((0.2, 0.015), abs=1e-12)
     assert engine.live_params.sway == pytest.approx(0.03, abs=1e-6)   # 10 time constants
     for _ in range(700):
         engine.tick(dt)
-    assert engine.live_params.speed == 1.0 and engine.live_params.side_step == 0.03
+    assert engine.live_params.speed == 0.3 and engine.live_params.side_step == 0.015

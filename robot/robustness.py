@@ -130,8 +130,8 @@ def walk_argv(robot: str, gait: str, seconds: float, condition: Condition, *,
               balance: bool, base_args: Sequence[str] = ()) -> list[str]:
     """The ``biped walk`` arguments of one run (``base_args``: e.g. ``--set`` items,
     before the condition's own, which win)."""
-    argv = ["walk", "--json", "--robot", robot, "--gait", gait, "--seconds", f"{seconds:g}",
-            *base_args, *condition.args]
+    argv = ["walk", "--json", "--stop-on-fall", "--robot", robot, "--gait", gait,
+            "--seconds", f"{seconds:g}", *base_args, *condition.args]
     return argv if balance else [*argv, "--no-balance"]
 
 

@@ -82,3 +82,26 @@ def test_json_world_defaults_without_options(capsys: pytest.CaptureFixture[str],
     assert w == {"slope_deg": 0.0, "cross_slope_deg": 0.0, "bumps_mm": 0.0,
                  "terrain_seed": 0, "pushes": [], "latency_s": 0.0, "friction_scale": 1.0,
                  "mass_scale": 1.0, "pushes_applied": []}
+
+
+def test_stop_on_fall_ends_the_walk_at_the_fall(capsys: pytest.CaptureFixture[str],
+                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    """A 3 N*s shove backward 1 s into the gait topples the robot; --stop-on-fall ends the
+    run there (torque off) instead of lying on the floor for the rest of the 6 s."""
+    argv = ["--json", "--seconds", "6", "--no-balance", "--push", "1:-3,0"]
+    _, out, _ = run_walk(argv, capsys, monkeypatch)
+    whole = json.loads(out)
+    code, out, _ = run_walk([*argv, "--stop-on-fall"], capsys, monkeypatch)
+    short = json.loads(out)
+    assert whole["fell"] and short["fell"] and short["fell_at_s"] == whole["fell_at_s"]
+    assert short["stop_reason"] == "fell" and whole["stop_reason"] == "completed"
+    assert short["ticks"] < whole["ticks"] - 200 * 3        # over 3 s of ticks saved
+    assert code == 0
+
+
+def test_stop_on_fall_is_refused_on_a_real_bus(capsys: pytest.CaptureFixture[str],
+                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    code, out, err = run_walk(["--bus", "feetech", "--port", "/dev/null/none",
+                               "--stop-on-fall"], capsys, monkeypatch)
+    assert code == 2 and out == "" and len(err.splitlines()) == 1
+    assert "--stop-on-fall apply to --bus sim only" in err

@@ -55,6 +55,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--record", type=output_file, metavar="PATH",
                    help="per-tick record (.csv or .jsonl)")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.add_argument("--stop-on-fall", action="store_true",
+                   help="sim: end the walk as soon as the robot falls (torque off at once, "
+                        "as a fall detector on a real robot would)")
     add_set_arg(p)
     add_world_args(p)
     return p
@@ -64,8 +67,8 @@ def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
     gait, params = params_from(args)
     kind = args.bus or "sim"
-    if kind != "sim" and (args.view or args.realtime):
-        raise ConfigError("--view and --realtime apply to --bus sim only")
+    if kind != "sim" and (args.view or args.realtime or args.stop_on_fall):
+        raise ConfigError("--view, --realtime and --stop-on-fall apply to --bus sim only")
     world = world_from(args, kind)       # perturbations: sim only, None if none given
     options: dict[str, Any] = (
         {"realtime": args.realtime, "view": args.view} if kind == "sim" else {})
@@ -96,6 +99,8 @@ def run(args: argparse.Namespace) -> int:
 
             def watch(tel: Telemetry) -> None:
                 monitor.update_qpos(tel.t, qpos[:7].tolist())
+                if monitor.fell and args.stop_on_fall:
+                    streamer.emergency_stop("fell")
             observers.insert(0, watch)
             if world is not None and world.pushes:
                 from sim.world import PushScheduler

@@ -88,8 +88,9 @@ class BalanceState(NamedTuple):
     [rad]; heading_ref: where it should be [rad]; heading_i: integral of the heading error
     [rad s]; turn: the turn trim [rad/step]; feet: (right dx, dy, left dx, dy) step offsets
     [m]; tempo: extra phase rate [-]; brace: 0 walking .. 1 braced (feet down, gait
-    still); brace_s: how much longer to stay braced [s]; rhythm: the learned walk;
-    started: False until the first sample."""
+    still); brace_s: how much longer to stay braced [s]; hold: 0 .. 1 the gait holds in
+    double support; next_lift: the foot the gait lifts next (0 right, 1 left); rhythm: the
+    learned walk; started: False until the first sample."""
 
     lean_pitch: float = 0.0
     lean_roll: float = 0.0
@@ -101,6 +102,8 @@ class BalanceState(NamedTuple):
     tempo: float = 0.0
     brace: float = 0.0
     brace_s: float = 0.0
+    hold: float = 0.0
+    next_lift: int = 0
     rhythm: Rhythm = Rhythm()
     started: bool = False
 
@@ -160,7 +163,8 @@ def _capture(rhythm: Rhythm, tilt: Attitude, p: GaitParams, g: GaitPhase, brace:
     """The learned rhythm after this tick and the capture-point error (forward, left) [m].
     The rhythm is expected in proportion to the envelope and to how much the gait moves
     (1 - brace); it is learned only while the gait walks at full amplitude."""
-    if p.bal_step_gain == 0.0 and p.bal_brace_xi == 0.0 and p.bal_tempo_gain == 0.0:
+    if (p.bal_step_gain == 0.0 and p.bal_brace_xi == 0.0 and p.bal_tempo_gain == 0.0
+            and p.bal_hold_xi == 0.0):
         return rhythm, 0.0, 0.0                   # nothing uses it: no need to learn
     values = (tilt.roll, tilt.pitch, tilt.roll_rate, tilt.pitch_rate)
     a = g.amplitude * (1.0 - brace)
@@ -229,6 +233,12 @@ def balance_step(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float,
     up = brace_s > 0.0
     brace = state.brace + min(1.0, dt / (BRACE_IN_S if up else BRACE_OUT_S)) * (
         (1.0 if up else 0.0) - state.brace)
+    # Hold: in double support, do not lift the foot the body is leaning onto.
+    next_lift = 1 if gait.swinging[0] else 0 if gait.swinging[1] else state.next_lift
+    toward = -xi_y if next_lift == 0 else xi_y       # the right foot is on the -y side
+    holding = (not any(gait.swinging) and 0.0 < p.bal_hold_xi < toward)
+    hold = state.hold + min(1.0, dt / (BRACE_IN_S if holding else BRACE_OUT_S)) * (
+        (1.0 if holding else 0.0) - state.hold)
     corr = Correction(
         ankle_pitch=p.bal_ankle_pd * tilt.pitch_rate + p.bal_ankle_pp * e_pitch,
         ankle_roll=p.bal_ankle_pd * tilt.roll_rate + p.bal_ankle_pp * e_roll,
@@ -236,6 +246,7 @@ def balance_step(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float,
         hip_roll=p.bal_hip_pd * tilt.roll_rate,
         turn=a * turn, pelvis_roll=lean_roll, pelvis_pitch=lean_pitch,
         feet=(a * feet[0], a * feet[1], a * feet[2], a * feet[3]),
-        tempo=(1.0 - brace) * (1.0 + a * tempo) - 1.0, land=brace, capture=(xi_x, xi_y))
+        tempo=(1.0 - brace) * (1.0 - hold) * (1.0 + a * tempo) - 1.0, land=brace,
+        capture=(xi_x, xi_y))
     return BalanceState(lean_pitch, lean_roll, heading, heading_ref, heading_i, turn, feet,
-                        tempo, brace, brace_s, rhythm, True), corr
+                        tempo, brace, brace_s, hold, next_lift, rhythm, True), corr

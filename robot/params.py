@@ -121,6 +121,9 @@ SPECS: dict[str, ParamSpec] = {
                               "never)", False),
     "bal_brace_s": ParamSpec(0.5, 0.0, 3.0, "s", BALANCE, "the gait holds still this long "
                              "after the error was last that large", False),
+    "bal_hold_xi": ParamSpec(0.0, 0.0, 0.2, "m", BALANCE, "lateral capture-point error "
+                             "toward the foot that lifts next at which the gait holds in "
+                             "double support (a loaded foot is not lifted; 0: never)", False),
     "bal_tempo_gain": ParamSpec(0.0, 0.0, 50.0, "1/m", BALANCE, "faster gait phase per m "
                                 "of capture-point error (an earlier next step)", False),
     "bal_tempo_max": ParamSpec(0.5, 0.0, 2.0, "-", BALANCE, "largest phase speed-up "
@@ -203,6 +206,7 @@ class GaitParams:
     bal_step_dead: float = SPECS["bal_step_dead"].default
     bal_brace_xi: float = SPECS["bal_brace_xi"].default
     bal_brace_s: float = SPECS["bal_brace_s"].default
+    bal_hold_xi: float = SPECS["bal_hold_xi"].default
     bal_tempo_gain: float = SPECS["bal_tempo_gain"].default
     bal_tempo_max: float = SPECS["bal_tempo_max"].default
     bal_learn_cycles: float = SPECS["bal_learn_cycles"].default

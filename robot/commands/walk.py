@@ -79,6 +79,7 @@ def run(args: argparse.Namespace) -> int:
     engine = GaitEngine(robot, params)
     smap = ServoMap(robot)
     monitor = None
+    effort: Any = None
     pushes = None
     observers: list[Callable[[Telemetry], None]] = []
     if recorder is not None:
@@ -90,15 +91,18 @@ def run(args: argparse.Namespace) -> int:
     try:
         bus.open()
         if kind == "sim":
+            from sim.effort import EffortMonitor
             from sim.metrics import WalkMonitor
 
             sim_bus: Any = bus
             monitor = WalkMonitor(standing_height=sim_bus.standing_height,
                                   floor_normal=sim_bus.floor_normal)
+            effort = EffortMonitor(sim_bus.model, sim_bus.data, robot)
             qpos = sim_bus.data.qpos
 
             def watch(tel: Telemetry) -> None:
                 monitor.update_qpos(tel.t, qpos[:7].tolist())
+                effort.update(tel.t)
                 if monitor.fell and args.stop_on_fall:
                     streamer.emergency_stop("fell")
             observers.insert(0, watch)
@@ -131,6 +135,7 @@ def run(args: argparse.Namespace) -> int:
                               "seconds": args.seconds, "balance": imu is not None}
     if monitor is not None:
         result.update(monitor.summary(args.seconds))
+        result.update(effort.summary(result["distance_m"]))
         result["world"] = world_summary(world, pushes)
     result.update({
         "ticks": stats.ticks, "rate_hz": stats.rate_hz, "achieved_hz": stats.achieved_hz,

@@ -34,6 +34,7 @@ COMMANDS: tuple[str, ...] = (
     "find_port",
     "monitor",
     "robustness",
+    "tune",
 )
 
 

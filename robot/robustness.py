@@ -107,6 +107,22 @@ def conditions(params: GaitParams, *, quick: bool = False) -> list[Condition]:
     return out
 
 
+#: A push needs this long after it [s] to tell a recovery from a slow fall.
+AFTER_PUSH_S = 2.0
+
+
+def check_seconds(conds: Iterable[Condition], seconds: float) -> None:
+    """Refuse runs too short for the latest push to land and be recovered from."""
+    from robot.errors import ConfigError
+
+    last = max((float(c.args[c.args.index("--push") + 1].split(":")[0])
+                for c in conds if "--push" in c.args and c.seconds is None), default=None)
+    if last is not None and seconds < last + AFTER_PUSH_S:
+        raise ConfigError(f"--seconds {seconds:g}: the suite's pushes land up to "
+                          f"{last:.2f} s into the gait; give at least "
+                          f"{last + AFTER_PUSH_S:.1f} s (or leave the pushes out)")
+
+
 def scaled_params(params: GaitParams) -> list[Condition]:
     """Every shaping parameter of ``params`` +/- PARAM_SCALE, clipped to its documented
     range (a clipped change is named; one that the range leaves at the preset's value is

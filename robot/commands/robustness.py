@@ -24,6 +24,7 @@ from robot.robustness import (
     STRAIGHT_DRIFT,
     STRAIGHT_S,
     Outcome,
+    check_seconds,
     conditions,
     run_suite,
     straightness,
@@ -54,6 +55,7 @@ def run(args: argparse.Namespace) -> int:
     gait, params = params_from(args)
     secs = args.seconds if args.seconds is not None else (12.0 if args.quick else 30.0)
     conds = conditions(params, quick=args.quick)
+    check_seconds(conds, secs)
     modes = (True,) if args.balance_only else (True, False)
     total = len(conds) * len(modes)
     done = [0]

@@ -1,0 +1,148 @@
+"""`biped tune`: gait and balance parameters found for the user's robot in simulation
+(robot.tuning: Optuna over the robustness suite), written as a gait preset."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from robot.commands.common import (
+    add_robot_args,
+    add_set_arg,
+    bounded_float,
+    output_file,
+    params_from,
+    positive_int,
+    robot_from,
+    seconds,
+)
+from robot.errors import ConfigError
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
+    p = sub.add_parser("tune", help="find gait and balance parameters that walk robustly "
+                       "on this robot (sim, Optuna) and write them as a preset")
+    add_robot_args(p)
+    add_set_arg(p)
+    p.add_argument("--out", type=output_file, required=True, metavar="TOML",
+                   help="the tuned preset to write (also NAME.history.png, "
+                        "NAME.importance.png beside it)")
+    p.add_argument("--trials", type=positive_int, default=40,
+                   help="finished trials the study should hold (default: %(default)s; "
+                        "a resumed study counts its earlier ones)")
+    p.add_argument("--param", action="append", default=[], metavar="NAME[=LO:HI]",
+                   help="search this parameter (repeatable; a pair such as Slgt sets "
+                        "Slgt_R and Slgt_L; default range: the preset's value +-50 %%); "
+                        "default: the set of docs/tuning.md")
+    p.add_argument("--suite", choices=("quick", "full"), default="quick",
+                   help="perturbations each trial must survive (biped robustness "
+                        "[--quick]; default: %(default)s)")
+    p.add_argument("--skip", action="append", default=[], metavar="GROUP",
+                   help="leave a condition group out, e.g. 'push left' or 'push*' "
+                        "(repeatable)")
+    p.add_argument("--seconds", type=seconds, default=12.0,
+                   help="gait seconds per run (default: %(default)s)")
+    p.add_argument("--speed", type=bounded_float(0.01, 2.0, "m/s", what="a speed"),
+                   default=None, metavar="M_S",
+                   help="walking speed to aim for [m/s] (default: the starting preset's)")
+    p.add_argument("--storage", default=None, metavar="URL",
+                   help="Optuna storage (default: sqlite:///OUT.db beside --out); a "
+                        "postgresql:// or mysql:// URL shares one study between machines")
+    p.add_argument("--study", default=None, metavar="NAME",
+                   help="study name (default: ROBOT-GAIT-OUT)")
+    p.add_argument("--jobs", type=positive_int, default=None,
+                   help="worker processes (default: the number of cores)")
+    p.add_argument("--seed", type=positive_int, default=1, help="sampler seed")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    import optuna
+    from tqdm import tqdm
+
+    from robot.robustness import check_seconds
+    from robot.tuning.objective import Setup, check_skip, suite_for
+    from robot.tuning.report import format_report, group_survival, plot_study, write_preset
+    from robot.tuning.space import search_space
+    from robot.tuning.study import Plan, best_params, best_trial, references, run_study
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    robot = robot_from(args)
+    gait, start = params_from(args)
+    knobs = tuple(search_space(args.param, start))
+    out = Path(args.out)
+    if out.suffix != ".toml":
+        raise ConfigError(f"--out {args.out}: a gait preset is a .toml file")
+    storage = args.storage or f"sqlite:///{out.with_suffix('.db')}"
+    name = args.study or f"{robot.name}-{gait.name}-{out.stem}"
+    jobs = args.jobs or os.cpu_count() or 1
+    check_skip(tuple(args.skip), start, args.suite)
+    setup = Setup(args.robot, args.suite, args.seconds, skip=tuple(args.skip))
+    check_seconds(suite_for(setup, start), args.seconds)
+    plan = Plan(storage, name, setup, start, knobs, args.trials, args.seed)
+    wall0 = time.perf_counter()
+    from robot.tuning.study import open_study
+
+    study = open_study(plan)
+    if not args.json:
+        print(f"{name}: measuring the starting preset '{gait.name}' on the {args.suite} "
+              "suite ...", file=sys.stderr, flush=True)
+    setup, ref = references(study, setup, start, target_speed=args.speed)
+    plan = Plan(storage, name, setup, start, knobs, args.trials, args.seed)
+    bar = tqdm(total=args.trials, desc="trials", unit="trial", file=sys.stderr,
+               disable=args.json or None)
+
+    def progress(n: int) -> None:
+        bar.update(max(0, n - bar.n))
+    t_study = time.perf_counter()
+    study = run_study(plan, jobs=jobs, progress=progress)
+    from robot.tuning.study import finished
+
+    done = finished(study)
+    progress(done)
+    bar.close()
+    study_s = time.perf_counter() - t_study
+    best = best_params(study, plan)
+    top = best_trial(study)
+    best_score = top.value if top is not None else None
+    start_score = float(ref["score"])
+    groups = {c.name: c.group for c in suite_for(setup, start)}
+    groups.update({c.name: c.group for c in suite_for(setup, best)})
+    start_groups = group_survival(ref["runs"], groups)
+    best_groups = group_survival(top.user_attrs["runs"], groups) if top else {}
+    if top is not None and top.user_attrs.get("survived", 0) < ref["survived"]:
+        best, best_groups = start, start_groups       # never write something worse
+    written = write_preset(out, best, name=out.stem,
+                           description=f"tuned by biped tune for {robot.name} from "
+                           f"'{gait.name}' ({done} trials, {args.suite} suite)")
+    pngs = plot_study(study, out.with_suffix(""))
+    wall = time.perf_counter() - wall0
+    per_trial = study_s * jobs / max(1, done)
+    result: dict[str, Any] = {
+        "robot": robot.name, "gait": gait.name, "out": str(out), "study": name,
+        "storage": storage, "trials": done, "wall_s": wall,
+        "cpu_s_per_trial": per_trial, "start_survived": ref["survived"],
+        "best_survived": best_groups and sum(ok for ok, _ in best_groups.values()),
+        "runs_per_trial": ref["runs_total"], "best_score": best_score,
+        "knobs": {k.name: {"start": getattr(start, k.targets[0]),
+                           "best": getattr(best, k.targets[0]), "lo": k.lo, "hi": k.hi}
+                  for k in knobs},
+        "groups": {g: {"start": start_groups.get(g), "best": best_groups.get(g)}
+                   for g in dict.fromkeys([*start_groups, *best_groups])},
+        "plots": [str(p) for p in pngs]}
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(format_report(knobs, start, written.params, start_score + 0.0, best_score,
+                            start_groups, best_groups))
+        print(f"\nwrote {out} ({done} trials in {study_s:.0f} s on {jobs} workers: "
+              f"{per_trial:.1f} s of one core per trial); plots: "
+              + ", ".join(str(p) for p in pngs))
+        print(f"resume or extend: the same command (study '{name}' in {storage})")
+    return 0

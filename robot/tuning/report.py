@@ -1,0 +1,97 @@
+"""What `biped tune` leaves behind: the preset (checked by the normal loader), a table of
+the best parameters against the starting preset with the survival of both per condition
+group, and the optimisation history and parameter importance as PNGs."""
+
+from __future__ import annotations
+
+import json
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import optuna
+
+from robot.config import Gait, gait_to_toml, load_gait
+from robot.errors import ConfigError
+from robot.params import SPECS, GaitParams
+from robot.tuning.space import Knob
+
+
+def write_preset(path: str | Path, params: GaitParams, *, name: str,
+                 description: str) -> Gait:
+    """Write ``params`` as a gait preset and read it back with the normal loader; the
+    file must give the same parameters exactly."""
+    path = Path(path)
+    gait = Gait(name=name, params=params, source=str(path))
+    text = f"# {description}\n" + gait_to_toml(gait)
+    path.write_text(text)
+    back = load_gait(str(path))
+    if back.params != params:
+        raise ConfigError(f"{path}: the written preset does not load back unchanged")
+    return back
+
+
+def group_survival(runs_json: str, groups: dict[str, str]) -> dict[str, tuple[int, int]]:
+    """{group: (survived, runs)} from a trial's per-condition JSON."""
+    out: dict[str, tuple[int, int]] = {}
+    for name, result in json.loads(runs_json).items():
+        g = groups.get(name, name)
+        ok, n = out.get(g, (0, 0))
+        out[g] = (ok + (result == "ok"), n + 1)
+    return out
+
+
+def format_report(knobs: Sequence[Knob], start: GaitParams, best: GaitParams,
+                  start_score: float, best_score: float | None,
+                  start_groups: dict[str, tuple[int, int]],
+                  best_groups: dict[str, tuple[int, int]]) -> str:
+    lines = [f"{'parameter':<18}{'start':>12}{'tuned':>12}  unit      range searched",
+             "-" * 66]
+    for k in knobs:
+        t = k.targets[0]
+        lines.append(f"{k.name:<18}{getattr(start, t):>12.4g}{getattr(best, t):>12.4g}  "
+                     f"{SPECS[t].unit:<9} [{k.lo:.4g}, {k.hi:.4g}]")
+    best_text = "-" if best_score is None else f"{best_score:.3f}"
+    lines += ["", f"score (survived + 0.9 x quality): start {start_score:.3f}, tuned "
+              f"{best_text}", "", f"{'condition':<18}{'start':>10}{'tuned':>10}",
+              "-" * 38]
+    for g in dict.fromkeys([*start_groups, *best_groups]):
+        s, b = start_groups.get(g, (0, 0)), best_groups.get(g, (0, 0))
+        lines.append(f"{g:<18}{s[0]:>6}/{s[1]:<3}{b[0]:>6}/{b[1]:<3}")
+    return "\n".join(lines)
+
+
+def plot_study(study: optuna.Study, prefix: str | Path) -> list[Path]:
+    """history and importance PNGs at ``prefix``.history.png / .importance.png (the
+    importance needs two finished trials; PED-ANOVA, which needs no scikit-learn)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import optuna.visualization.matplotlib as ovm
+
+    out: list[Path] = []
+    prefix = str(prefix)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ax: Any = ovm.plot_optimization_history(study)
+        ax.set_ylabel("score (survived + 0.9 x quality)")
+        ax.figure.set_size_inches(8, 4.5)
+        ax.figure.tight_layout()
+        path = Path(prefix + ".history.png")
+        ax.figure.savefig(path, dpi=90)
+        plt.close(ax.figure)
+        out.append(path)
+        done = study.get_trials(deepcopy=False,
+                                states=(optuna.trial.TrialState.COMPLETE,))
+        if len(done) >= 2 and len({t.value for t in done}) > 1:
+            ax = ovm.plot_param_importances(
+                study, evaluator=optuna.importance.PedAnovaImportanceEvaluator())
+            ax.figure.set_size_inches(8, 4.5)
+            ax.figure.tight_layout()
+            path = Path(prefix + ".importance.png")
+            ax.figure.savefig(path, dpi=90)
+            plt.close(ax.figure)
+            out.append(path)
+    return out

@@ -72,26 +72,23 @@ def plot_study(study: optuna.Study, prefix: str | Path) -> list[Path]:
     import optuna.visualization.matplotlib as ovm
 
     out: list[Path] = []
-    prefix = str(prefix)
+
+    def save(ax: Any, suffix: str) -> None:
+        ax.figure.set_size_inches(8, 4.5)
+        ax.figure.tight_layout()
+        path = Path(f"{prefix}.{suffix}.png")
+        ax.figure.savefig(path, dpi=90)
+        plt.close(ax.figure)
+        out.append(path)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ax: Any = ovm.plot_optimization_history(study)
         ax.set_ylabel("score (survived + 0.9 x quality)")
-        ax.figure.set_size_inches(8, 4.5)
-        ax.figure.tight_layout()
-        path = Path(prefix + ".history.png")
-        ax.figure.savefig(path, dpi=90)
-        plt.close(ax.figure)
-        out.append(path)
+        save(ax, "history")
         done = study.get_trials(deepcopy=False,
                                 states=(optuna.trial.TrialState.COMPLETE,))
         if len(done) >= 2 and len({t.value for t in done}) > 1:
-            ax = ovm.plot_param_importances(
-                study, evaluator=optuna.importance.PedAnovaImportanceEvaluator())
-            ax.figure.set_size_inches(8, 4.5)
-            ax.figure.tight_layout()
-            path = Path(prefix + ".importance.png")
-            ax.figure.savefig(path, dpi=90)
-            plt.close(ax.figure)
-            out.append(path)
+            save(ovm.plot_param_importances(
+                study, evaluator=optuna.importance.PedAnovaImportanceEvaluator()),
+                "importance")
     return out

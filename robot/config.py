@@ -36,7 +36,7 @@ from robot.joint_names import (  # noqa: F401 (re-exported)
     LEG_NAMES,
     SIDES,
 )
-from robot.params import SPECS, GaitParams, canonical_name, check_value
+from robot.params import BALANCE, SPECS, GaitParams, canonical_name, check_value
 from robot.toml_io import Range, build, number, read_toml, show, spec, table
 
 # Valid ranges of the numeric fields (checked at load; see robot/toml_io.py).
@@ -160,6 +160,10 @@ class RobotConfig:
     source: str = "<memory>"
     #: The ``[imu]`` section (optional; robot.imu.config): None when the robot has no IMU.
     imu: ImuConfig | None = None
+    #: The ``[balance]`` section (optional): balance gains (robot/params.py group
+    #: "balance feedback") for this robot; a gait preset that names a gain itself, and
+    #: --set, take precedence.
+    balance: Mapping[str, float] = field(default_factory=dict)
 
     def joint(self, name: str) -> JointConfig:
         for j in self.joints:
@@ -210,11 +214,20 @@ class RobotConfig:
 
 @dataclass(frozen=True)
 class Gait:
-    """A named gait preset: parameters plus where it came from."""
+    """A named gait preset: parameters plus where it came from; given: the parameters
+    the file names itself (the others are defaults)."""
 
     name: str
     params: GaitParams
     source: str = "<memory>"
+    given: frozenset[str] = frozenset()
+
+    def for_robot(self, robot: RobotConfig) -> GaitParams:
+        """The parameters with the robot's ``[balance]`` gains for those the preset does
+        not name itself."""
+        own = {k: v for k, v in robot.balance.items() if k not in self.given}
+        return self.params.replace(own, where=f"{robot.source}: balance") if own else \
+            self.params
 
 
 # ---------------------------------------------------------------------------- robots
@@ -229,7 +242,7 @@ def load_robot(name_or_path: str | Path | None = None) -> RobotConfig:
 
 def parse_robot(data: Mapping[str, Any], *, source: str = "<memory>") -> RobotConfig:
     src = source
-    allowed = {"name", "bus", "geometry", "mass", "joints", "rest", "imu"}
+    allowed = {"name", "bus", "geometry", "mass", "joints", "rest", "imu", "balance"}
     unknown = sorted(set(data) - allowed)
     if unknown:
         raise ConfigError(f"{src}: {unknown[0]}: unknown key; valid: {', '.join(sorted(allowed))}")
@@ -286,8 +299,17 @@ def parse_robot(data: Mapping[str, Any], *, source: str = "<memory>") -> RobotCo
                               f"[{names[jn].min_rad}, {names[jn].max_rad}]")
         rest[jn] = q
     imu = parse_imu(src, data["imu"]) if "imu" in data else None
+    balance: dict[str, float] = {}
+    for key, v in table(src, "balance", data.get("balance", {})).items():
+        where = f"{src}: balance.{key}"
+        canon = canonical_name(key, where=where)
+        if SPECS[canon].group != BALANCE:
+            gains = ", ".join(n for n, spec in SPECS.items() if spec.group == BALANCE)
+            raise ConfigError(f"{where}: not a balance gain (a gait parameter belongs in a "
+                              f"gait preset); valid: {gains}")
+        balance[canon] = check_value(canon, v, where=where)
     robot = RobotConfig(name=name, bus=bus, geometry=geometry, mass=mass, joints=tuple(joints),
-                        rest=rest, source=src, imu=imu)
+                        rest=rest, source=src, imu=imu, balance=balance)
     check_ticks(robot)
     return robot
 
@@ -326,7 +348,8 @@ def parse_gait(data: Mapping[str, Any], *, source: str = "<memory>") -> Gait:
             if canon in values:
                 raise ConfigError(f"{where}: {canon} given twice (alias of {canon})")
             values[canon] = check_value(canon, v, where=where)
-    return Gait(name=name, params=GaitParams().replace(values, where=src), source=src)
+    return Gait(name=name, params=GaitParams().replace(values, where=src), source=src,
+                given=frozenset(values))
 
 
 def gait_to_toml(gait: Gait) -> str:

@@ -268,7 +268,10 @@ def parse_sets(items: list[str]) -> dict[str, float]:
     return out
 
 
-def params_from(args: argparse.Namespace) -> tuple[Gait, GaitParams]:
-    """The ``--gait`` preset and its parameters with every ``--set`` applied (validated)."""
+def params_from(args: argparse.Namespace, robot: RobotConfig | None = None
+                ) -> tuple[Gait, GaitParams]:
+    """The ``--gait`` preset and its parameters (with ``robot``'s ``[balance]`` gains for
+    those the preset does not name) with every ``--set`` applied (validated)."""
     gait = gait_from(args)
-    return gait, gait.params.replace(parse_sets(args.set), where="--set")
+    base = gait.params if robot is None else gait.for_robot(robot)
+    return gait, base.replace(parse_sets(args.set), where="--set")

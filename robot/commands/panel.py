@@ -73,7 +73,7 @@ class _Deferred:
 
 def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
-    gait, params = params_from(args)
+    gait, params = params_from(args, robot)
     kind = args.bus or "sim"
     if kind != "sim" and args.view:
         raise ConfigError("--view applies to --bus sim only")

@@ -51,8 +51,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
 
 
 def run(args: argparse.Namespace) -> int:
-    robot_from(args)                     # validate names before starting processes
-    gait, params = params_from(args)
+    gait, params = params_from(args, robot_from(args))   # validates names before any run
     secs = args.seconds if args.seconds is not None else (12.0 if args.quick else 30.0)
     conds = conditions(params, quick=args.quick)
     check_seconds(conds, secs)

@@ -74,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     robot = robot_from(args)
-    gait, start = params_from(args)
+    gait, start = params_from(args, robot)
     knobs = tuple(search_space(args.param, start))
     out = Path(args.out)
     if out.suffix != ".toml":

@@ -65,7 +65,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
 
 def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
-    gait, params = params_from(args)
+    gait, params = params_from(args, robot)
     kind = args.bus or "sim"
     if kind != "sim" and (args.view or args.realtime or args.stop_on_fall):
         raise ConfigError("--view, --realtime and --stop-on-fall apply to --bus sim only")

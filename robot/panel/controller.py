@@ -104,7 +104,7 @@ class PanelController:
 
     def load_preset(self, name: object) -> GaitParams:
         gait = self.presets.load(name)
-        new = self.set_params(gait.params.as_dict())
+        new = self.set_params(gait.for_robot(self.robot).as_dict())
         self.preset = str(name)
         return new
 

@@ -161,7 +161,7 @@ class _Stderr:
         sys.stderr.flush()
 
 
-def _worker_init() -> None:
+def worker_init() -> None:
     os.environ.setdefault("MUJOCO_GL", "egl")
     logging.basicConfig(level=logging.WARNING, stream=_Stderr(),  # type: ignore[arg-type]
                         format="%(levelname)s %(name)s: %(message)s")
@@ -209,7 +209,7 @@ def run_suite(robot: str, gait: str, conds: Iterable[Condition], *, seconds: flo
     done: dict[int, Outcome] = {}
     ctx = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx,
-                             initializer=_worker_init) as pool:
+                             initializer=worker_init) as pool:
         futures = {}
         for i in order:
             c, b = work[i]

@@ -130,3 +130,21 @@ def test_a_detuned_legs_only_preset_is_tuned_back_to_walking(tmp_path: Path) -> 
     for name in ("flat", "slope +5 deg", "slope -5 deg", "cross slope +4 deg",
                  "bumps 5 mm seed 0", "latency 20 ms", "imu noise x3"):
         assert runs[name]["fell"] is False, (name, runs[name])
+
+
+def test_sensitivity_candidates_move_one_knob_and_switch_zero_gains_on() -> None:
+    from robot.tuning.sensitivity import candidates
+
+    cands = dict(candidates(WALK))
+    assert cands["Slgt"] == pytest.approx((0.55 * 0.8, 0.55 * 1.2))
+    assert cands["stance"] == pytest.approx((0.88 * 0.8, 0.99))        # clipped
+    lo, hi = SPECS["bal_step_gain"].lo, SPECS["bal_step_gain"].hi
+    assert cands["bal_step_gain"] == pytest.approx((lo + 0.25 * (hi - lo), lo + 0.5 * (hi - lo)))
+    assert "Slgt_R" not in cands and "speed" not in cands and "Hosc" not in cands
+
+
+def test_tune_without_out_is_one_line() -> None:
+    r = biped("tune", "--robot", "biped12-legs")
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr.strip().splitlines() == [
+        "biped tune: error: --out: required (the tuned preset to write), unless --sensitivity"]

@@ -29,7 +29,10 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                        "on this robot (sim, Optuna) and write them as a preset")
     add_robot_args(p)
     add_set_arg(p)
-    p.add_argument("--out", type=output_file, required=True, metavar="TOML",
+    p.add_argument("--sensitivity", action="store_true",
+                   help="do not tune: print how much each parameter moves the score "
+                        "(+-20 %%, or a balance gain switched on), largest first")
+    p.add_argument("--out", type=output_file, default=None, metavar="TOML",
                    help="the tuned preset to write (also NAME.history.png, "
                         "NAME.importance.png beside it)")
     p.add_argument("--trials", type=positive_int, default=40,
@@ -75,6 +78,10 @@ def run(args: argparse.Namespace) -> int:
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     robot = robot_from(args)
     gait, start = params_from(args, robot)
+    if args.sensitivity:
+        return sensitivity(args, start)
+    if args.out is None:
+        raise ConfigError("--out: required (the tuned preset to write), unless --sensitivity")
     knobs = tuple(search_space(args.param, start))
     out = Path(args.out)
     if out.suffix != ".toml":
@@ -146,3 +153,32 @@ def run(args: argparse.Namespace) -> int:
               + ", ".join(str(p) for p in pngs))
         print(f"resume or extend: the same command (study '{name}' in {storage})")
     return 0
+
+
+def sensitivity(args: argparse.Namespace, start: Any) -> int:
+    from tqdm import tqdm
+
+    from robot.robustness import check_seconds
+    from robot.tuning.objective import Setup, check_skip, suite_for
+    from robot.tuning.sensitivity import format_sensitivity, study
+
+    check_skip(tuple(args.skip), start, args.suite)
+    setup = Setup(args.robot, args.suite, args.seconds, speed_or(args), skip=tuple(args.skip))
+    check_seconds(suite_for(setup, start), args.seconds)
+    bar = tqdm(desc="evaluations", unit="eval", file=sys.stderr, disable=args.json or None)
+
+    def progress(done: int, total: int) -> None:
+        bar.total = total
+        bar.update(done - bar.n)
+    base, rows = study(setup, start, jobs=args.jobs or os.cpu_count() or 1,
+                       progress=progress)
+    bar.close()
+    if args.json:
+        print(json.dumps({"start_score": base, "knobs": [r._asdict() for r in rows]}))
+    else:
+        print(format_sensitivity(base, rows))
+    return 0
+
+
+def speed_or(args: argparse.Namespace) -> float | None:
+    return float(args.speed) if args.speed is not None else None

@@ -17,6 +17,7 @@ prunes with it).
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import tempfile
 from collections.abc import Callable
@@ -45,6 +46,9 @@ class Setup:
     target_speed: float | None = None
     baseline_energy: float | None = None
     skip: tuple[str, ...] = ()
+
+    def _replace(self, **changes: Any) -> Setup:
+        return dataclasses.replace(self, **changes)
 
 
 @dataclass

@@ -44,7 +44,7 @@ class Knob(NamedTuple):
         return {t: x for t in self.targets}
 
 
-def _targets(name: str, where: str) -> tuple[str, ...]:
+def targets_of(name: str, where: str) -> tuple[str, ...]:
     if name in PAIRS:
         return PAIRS[name]
     canon = ALIASES.get(name, name)
@@ -59,7 +59,7 @@ def _targets(name: str, where: str) -> tuple[str, ...]:
 
 def default_range(name: str, params: GaitParams, *, span: float = SPAN) -> tuple[float, float]:
     """The preset's value of ``name`` (a knob) x [1 - span, 1 + span], inside SPECS."""
-    targets = _targets(name, "--param")
+    targets = targets_of(name, "--param")
     spec = SPECS[targets[0]]
     v = getattr(params, targets[0])
     if v == 0.0:
@@ -75,7 +75,7 @@ def parse_knob(text: str, params: GaitParams) -> Knob:
     where = f"--param {text}"
     name, sep, rng = text.partition("=")
     name = name.strip()
-    targets = _targets(name, where)
+    targets = targets_of(name, where)
     if not sep:
         lo, hi = default_range(name, params)
         return Knob(name, lo, hi, targets)

@@ -104,15 +104,20 @@ def objective(plan: Plan) -> Callable[[optuna.Trial], float]:
     return run
 
 
-def work(plan: Plan, worker: int = 0) -> None:
-    """One worker: trials until the study holds ``plan.trials`` finished ones."""
+def work(plan: Plan, worker: int = 0, parent: int | None = None) -> None:
+    """One worker: trials until the study holds ``plan.trials`` finished ones, or until
+    the process that started it (``parent``) is gone."""
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     os.environ.setdefault("MUJOCO_GL", "egl")
     logging.getLogger("robot").setLevel(logging.ERROR)
     study = open_study(Plan(**{**plan.__dict__, "seed": plan.seed + 7919 * worker}))
     stop = optuna.study.MaxTrialsCallback(plan.trials, states=FINISHED)
+
+    def orphaned(st: optuna.Study, _trial: optuna.trial.FrozenTrial) -> None:
+        if parent is not None and os.getppid() != parent:
+            st.stop()
     if finished(study) < plan.trials:
-        study.optimize(objective(plan), callbacks=[stop], gc_after_trial=True)
+        study.optimize(objective(plan), callbacks=[stop, orphaned], gc_after_trial=True)
 
 
 def run_study(plan: Plan, *, jobs: int,
@@ -125,7 +130,8 @@ def run_study(plan: Plan, *, jobs: int,
         work(plan)
         return study
     ctx = multiprocessing.get_context("spawn")
-    procs = [ctx.Process(target=work, args=(plan, i), daemon=False) for i in range(jobs)]
+    procs = [ctx.Process(target=work, args=(plan, i, os.getpid()), daemon=False)
+             for i in range(jobs)]
     for p in procs:
         p.start()
     try:

@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint typecheck unit bench clean browser wheel-check
+.PHONY: demo test lint typecheck unit bench clean system-deps wheel-check
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -21,13 +21,15 @@ lint: $(STAMP)
 typecheck: $(STAMP)
 	$(BIN)/mypy
 
-# The panel's end-to-end test drives Debian's headless Chromium (never a downloaded browser).
-browser:
-	@command -v chromium >/dev/null || { \
-	  if [ "$$(id -u)" = 0 ]; then apt-get update -q && apt-get install -y -q chromium chromium-driver; \
-	  else sudo apt-get update -q && sudo apt-get install -y -q chromium chromium-driver; fi; }
+# The panel's end-to-end test drives Debian's headless Chromium (never a downloaded browser);
+# the tuner's shared-study test starts a throwaway PostgreSQL server (Debian's).
+SYSTEM_PKGS := chromium chromium-driver postgresql
+system-deps:
+	@{ command -v chromium >/dev/null && ls /usr/lib/postgresql/*/bin/initdb >/dev/null 2>&1; } || { \
+	  if [ "$$(id -u)" = 0 ]; then apt-get update -q && apt-get install -y -q $(SYSTEM_PKGS); \
+	  else sudo apt-get update -q && sudo apt-get install -y -q $(SYSTEM_PKGS); fi; }
 
-unit: $(STAMP) browser
+unit: $(STAMP) system-deps
 	MUJOCO_GL=egl $(BIN)/python -m pytest
 
 # The wheel, installed (not editable) into a fresh venv and run from a directory outside

@@ -148,3 +148,22 @@ def test_tune_without_out_is_one_line() -> None:
     assert r.returncode == 2 and r.stdout == ""
     assert r.stderr.strip().splitlines() == [
         "biped tune: error: --out: required (the tuned preset to write), unless --sensitivity"]
+
+
+def test_two_workers_share_one_postgresql_study(tmp_path: Path) -> None:
+    """The several-machines path: a PostgreSQL server (started here, Debian's binaries)
+    as the storage; two worker processes put their trials into one study there."""
+    from pg_server import postgres
+
+    with postgres() as url:
+        out = tmp_path / "pg.toml"
+        skip = [a for g in ("slope", "cross slope", "bumps", "push*", "latency", "imu noise")
+                for a in ("--skip", g)]
+        r = biped("tune", "--robot", "biped12-legs", "--out", str(out), "--param", "sway",
+                  "--seconds", "3", "--jobs", "2", "--trials", "4", "--storage", url,
+                  "--study", "shared", *skip, "--json")
+        assert r.returncode == 0, r.stderr[-2000:]
+        study = optuna.load_study(study_name="shared", storage=url)
+        assert len(study.trials) >= 4
+        assert len({t.user_attrs.get("worker_pid") for t in study.trials} - {None}) == 2
+        assert load_gait(str(out)).name == "pg"

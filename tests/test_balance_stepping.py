@@ -204,3 +204,24 @@ def _sole_heights(engine: GaitEngine) -> tuple[float, float]:
     t = body_targets(ch, engine.live_params, engine.robot.geometry,
                      amplitude=engine.amplitude, trim=engine.trim)
     return float(t.r_sole[2]), float(t.l_sole[2])
+
+
+def test_the_gait_holds_rather_than_lift_the_foot_the_body_leans_onto() -> None:
+    """Both feet down after the left foot's swing (the right lifts next): leaning right
+    (roll rate > 0: capture point to the -y side) past bal_hold_xi holds the phase; leaning
+    left does not; once the right foot swings, the left is next and the test reverses."""
+    p = STEP.replace({"bal_step_gain": 0.0, "bal_hold_xi": 0.03})
+    lean = 0.05 / (H / W0)                       # a 5 cm capture error
+    state, _ = settle(LEARNT, LEVEL, p, GaitPhase(height=H, swinging=(False, True)), 0.05)
+    assert state.next_lift == 0
+    down = GaitPhase(height=H, swinging=(False, False))
+    held, corr = settle(state, LEVEL._replace(roll_rate=lean), p, down, 0.2)
+    assert 1.0 + corr.tempo < 0.01 and corr.land == 0.0     # still, feet where they are
+    _, corr = settle(state, LEVEL._replace(roll_rate=-lean), p, down, 0.2)
+    assert corr.tempo == pytest.approx(0.0, abs=1e-9)
+    released, corr = settle(held, LEVEL, p, down, 0.6)
+    assert corr.tempo == pytest.approx(0.0, abs=0.01)
+    state, _ = settle(released, LEVEL, p, GaitPhase(height=H, swinging=(True, False)), 0.05)
+    assert state.next_lift == 1
+    _, corr = settle(state, LEVEL._replace(roll_rate=-lean), p, down, 0.2)
+    assert 1.0 + corr.tempo < 0.01

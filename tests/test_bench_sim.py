@@ -1,0 +1,17 @@
+"""`biped bench --only sim`: a smoke run reports a realtime factor and the physics share
+for both robots, open loop and with balance (values are measured, never asserted)."""
+
+from __future__ import annotations
+
+from robot.bench_sim import run_sim_bench
+
+
+def test_the_sim_bench_reports_every_configuration() -> None:
+    out = run_sim_bench(quick=True)
+    keys = {k for k in out if k.startswith("biped18")}
+    assert keys == {f"biped18-{r} {m}" for r in ("dynamixel", "feetech")
+                    for m in ("open loop", "balance")}
+    for k in keys:
+        row = out[k]
+        assert row["realtime_factor_median"] > 0.0
+        assert 0.0 < row["mj_step_share_of_loop"] < 1.0

@@ -19,6 +19,7 @@ from robot.errors import BipedError, SafetyStop
 # Order is the order of `biped --help`.
 COMMANDS: tuple[str, ...] = (
     "walk",
+    "play",
     "curves",
     "scan",
     "torque",

@@ -1,8 +1,9 @@
 """Gait engines that record or replay the parameter timeline, for the one streaming loop.
 
 Both are ``GaitEngine``s (with an optional keyframe layer, robot.layered), so a recorded
-or replayed run goes through ``robot.streamer`` exactly like a walk: ramp in from the present pose, balance, clamp, slew, watchdog, ramp
-out, rest, torque off. They only count gait ticks (calls of ``tick``):
+or replayed run goes through ``robot.streamer`` exactly like a walk: ramp in from the
+present pose, balance, clamp, slew, watchdog, ramp out, rest, torque off. They only count
+gait ticks (calls of ``tick``):
 
 - ``RecordingEngine`` reports every parameter change and the stop with the gait tick it
   takes effect at (the streamer applies pending changes and stops just before a tick);

@@ -23,6 +23,7 @@ from robot.engine import GaitEngine
 from robot.errors import BipedError
 from robot.panel.figure import views
 from robot.panel.idle_pose import IdlePose
+from robot.panel.labels import LABELS, SIMPLE
 from robot.panel.presets import PresetStore
 from robot.panel.sim_monitor import sim_monitor_factory
 from robot.params import GROUPS, SPECS, GaitParams
@@ -325,7 +326,8 @@ class PanelController:
             "params": p, "preset": self.preset,
             "groups": [{"name": g, "params": [
                 {"name": n, "value": p[n], "lo": s.lo, "hi": s.hi, "unit": s.unit,
-                 "default": s.default, "doc": s.doc, "paper": s.paper}
+                 "default": s.default, "doc": s.doc, "paper": s.paper,
+                 "label": LABELS.get(n, n), "simple": n in SIMPLE}
                 for n, s in SPECS.items() if s.group == g]} for g in GROUPS],
         }
 

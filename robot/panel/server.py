@@ -51,7 +51,9 @@ log = logging.getLogger(__name__)
 STATIC = {"/": ("index.html", "text/html; charset=utf-8"),
           "/index.html": ("index.html", "text/html; charset=utf-8"),
           "/panel.js": ("panel.js", "text/javascript; charset=utf-8"),
-          "/panel.css": ("panel.css", "text/css; charset=utf-8")}
+          "/panel.css": ("panel.css", "text/css; charset=utf-8"),
+          "/input.js": ("input.js", "text/javascript; charset=utf-8"),
+          "/studio.js": ("studio.js", "text/javascript; charset=utf-8")}
 ACTIONS = {"/api/start": "start", "/api/stop": "stop", "/api/estop": "emergency_stop",
            "/api/reset": "reset_sim"}
 READ_TIMEOUT_S = 10.0  # a client that stalls mid-request is dropped after this

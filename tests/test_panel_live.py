@@ -1,0 +1,149 @@
+"""The panel's live WebSocket (/api/live) as a client meets it: real sockets against a
+served panel on the MuJoCo bus. Frames carry the loop's state and parameters as they
+change, every client gets them, the handshake passes the same guard as the API (Origin,
+Host, token), and a client that goes away is forgotten."""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import json
+import os
+import socket
+import time
+from collections.abc import Callable, Iterator
+
+import pytest
+from websockets.sync.client import ClientConnection, connect
+
+from robot.config import DEFAULT_ROBOT, load_gait, load_robot
+from robot.panel.controller import LoopOptions, PanelController, make_controller
+from robot.panel.live import LiveHub
+from robot.panel.server import build_server, serve_in_thread
+from sim.mujoco_bus import MujocoBus
+
+
+@pytest.fixture(scope="module")
+def served() -> Iterator[tuple[PanelController, int, LiveHub]]:
+    robot = load_robot(DEFAULT_ROBOT)
+    controller = make_controller(robot, MujocoBus(robot, realtime=True),
+                                 load_gait("walk").params,
+                                 options=LoopOptions(rate_hz=100.0, read_every=5))
+    server = build_server(controller, port=0, token="tok3n")
+    serve_in_thread(server)
+    hub = getattr(server, "hub")
+    yield controller, int(server.server_address[1]), hub
+    server.shutdown()
+    server.server_close()
+    controller.emergency_stop()
+    controller.shutdown(timeout=2.0)
+
+
+def ws(port: int, *, token: str = "tok3n", origin: str | None = None) -> ClientConnection:
+    own = f"http://127.0.0.1:{port}"
+    return connect(f"ws://127.0.0.1:{port}/api/live?token={token}",
+                   origin=origin or own, open_timeout=5)  # type: ignore[arg-type]
+
+
+def frames(conn: ClientConnection, n: int) -> list[dict]:
+    return [json.loads(conn.recv(timeout=5)) for _ in range(n)]
+
+
+def until(pred: Callable[[], bool], timeout: float = 5.0) -> bool:
+    end = time.monotonic() + timeout
+    while not pred() and time.monotonic() < end:
+        time.sleep(0.05)
+    return pred()
+
+
+def handshake(port: int, *, query: str = "?token=tok3n", origin: str | None = None,
+              upgrade: bool = True) -> str:
+    """The server's reply head to a raw WebSocket handshake (or a plain GET)."""
+    key = base64.b64encode(os.urandom(16)).decode()
+    head = f"GET /api/live{query} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n"
+    if upgrade:
+        head += (f"Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: {key}"
+                 "\r\nSec-WebSocket-Version: 13\r\n")
+    if origin:
+        head += f"Origin: {origin}\r\n"
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as s:
+        s.sendall((head + "\r\n").encode())
+        data = b""
+        while b"\r\n\r\n" not in data and (chunk := s.recv(65536)):
+            data += chunk
+        if b" 101 " not in data.split(b"\r\n")[0]:  # a refusal: read its body to the end
+            while chunk := s.recv(65536):
+                data += chunk
+        return data.decode("latin-1")
+
+
+def test_frames_follow_the_running_loop(served: tuple[PanelController, int, LiveHub]) -> None:
+    controller, port, _ = served
+    with ws(port) as conn:
+        first = frames(conn, 2)
+        assert first[0]["state"] == "idle" and not first[0]["running"]
+        assert first[0]["params"] == controller.params.as_dict()
+        controller.start()
+        seen = frames(conn, 40)  # 2 s at 20 Hz
+        states = [f["state"] for f in seen]
+        assert "walking" in states or "ramp_in" in states, states
+        ticks = [f["tick"] for f in seen if f["running"]]
+        assert ticks == sorted(ticks) and ticks[-1] > ticks[0]
+        assert seen[-1]["figure"]["cmd"] is not None
+        controller.set_params({"turn": 0.2})
+        assert any(f["params"]["turn"] == 0.2 for f in frames(conn, 5))
+        walking = [f for f in seen if f["state"] == "walking"]
+        assert walking and len(walking[-1]["q_cmd"]) == len(controller.robot.joints)
+    controller.stop()
+    assert controller.wait(15.0)
+    controller.set_params({"turn": 0.0})
+
+
+def test_many_clients_share_one_snapshot(served: tuple[PanelController, int, LiveHub]
+                                         ) -> None:
+    _, port, hub = served
+    assert until(lambda: hub.clients == 0)
+    with contextlib.ExitStack() as stack:
+        conns = [stack.enter_context(ws(port)) for _ in range(20)]
+        assert hub.clients == 20
+        f0 = hub.frames
+        got = [frames(c, 3) for c in conns]
+        pushed = hub.frames - f0
+        # Every client got every frame it was sent: one snapshot per push, not per client.
+        assert all(len(g) == 3 for g in got) and pushed < 3 * 20
+        walls = {round(g[-1]["wall_time"], 6) for g in got}
+        assert len(walls) <= pushed + 1  # the same snapshot object went to all of them
+    assert until(lambda: hub.clients == 0)  # closed clients are forgotten
+
+
+def test_handshake_is_guarded(served: tuple[PanelController, int, LiveHub]) -> None:
+    _, port, hub = served
+    assert until(lambda: hub.clients == 0)
+    own = f"http://127.0.0.1:{port}"
+    assert " 101 " in handshake(port, origin=own).split("\r\n")[0]
+    for reply, status in ((handshake(port, origin="http://evil.example"), "403"),
+                          (handshake(port, origin="null"), "403"),
+                          (handshake(port, query="?token=wrong", origin=own), "401"),
+                          (handshake(port, query="", origin=own), "401"),
+                          (handshake(port, upgrade=False), "400")):
+        line = reply.split("\r\n")[0]
+        assert line.split()[1] == status, (status, line)
+        assert '"error"' in reply
+    assert until(lambda: hub.clients == 0)
+
+
+def test_a_client_that_vanishes_is_dropped(served: tuple[PanelController, int, LiveHub]
+                                           ) -> None:
+    _, port, hub = served
+    assert until(lambda: hub.clients == 0)
+    raw = socket.create_connection(("127.0.0.1", port), timeout=5)
+    key = base64.b64encode(os.urandom(16)).decode()
+    raw.sendall((f"GET /api/live?token=tok3n HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n"
+                 f"Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: {key}\r\n"
+                 "Sec-WebSocket-Version: 13\r\n\r\n").encode())
+    assert b" 101 " in raw.recv(65536)
+    assert until(lambda: hub.clients == 1)
+    raw.close()  # no close frame: the peer just disappears
+    assert until(lambda: hub.clients == 0)
+    with ws(port) as again:  # and the hub still serves
+        assert frames(again, 1)[0]["state"]

@@ -20,6 +20,8 @@ from robot.errors import BipedError, SafetyStop
 COMMANDS: tuple[str, ...] = (
     "walk",
     "play",
+    "capture",
+    "export",
     "curves",
     "scan",
     "torque",

@@ -20,7 +20,7 @@ from robot.commands import capture as capture_cmd
 from robot.config import DEFAULT_ROBOT, RobotConfig, load_robot
 from robot.errors import ConfigError
 from robot.interp import min_jerk, smooth
-from robot.keyframes import load_sequence, parse_sequence
+from robot.keyframes import load_sequence
 from robot.takes import read_take
 from sim.emulator import Emulator
 

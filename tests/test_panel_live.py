@@ -31,7 +31,7 @@ def served() -> Iterator[tuple[PanelController, int, LiveHub]]:
                                  options=LoopOptions(rate_hz=100.0, read_every=5))
     server = build_server(controller, port=0, token="tok3n")
     serve_in_thread(server)
-    hub = getattr(server, "hub")
+    hub = server.hub
     yield controller, int(server.server_address[1]), hub
     server.shutdown()
     server.server_close()

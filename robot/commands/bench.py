@@ -11,6 +11,7 @@ SECTIONS: dict[str, str] = {
     "core": "robot.bench:run_core_bench",
     "bus": "robot.bench:run_bus_section",
     "loop": "robot.bench_loop:run_loop_bench",
+    "panel": "robot.bench_panel:run_panel_bench",
 }
 
 

@@ -49,9 +49,10 @@ def _client_main(mode: str, n: int, base: str, seconds: float) -> None:
 
     def live(i: int) -> None:
         from websockets.sync.client import connect
+        from websockets.typing import Origin
 
         url = base.replace("http://", "ws://") + "api/live"
-        with connect(url, origin=base.rstrip("/"), open_timeout=20) as ws:
+        with connect(url, origin=Origin(base.rstrip("/")), open_timeout=20) as ws:
             while time.monotonic() < stop:
                 ws.recv(timeout=10)
                 got[i] += 1

@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 import robot.cli as cli
 from robot.bus.tables import MODELS
 from robot.commands import capture as capture_cmd
-from robot.config import DEFAULT_ROBOT, RobotConfig, load_robot
+from robot.config import DEFAULT_ROBOT, RobotConfig, load_gait, load_robot
 from robot.errors import ConfigError
 from robot.interp import min_jerk, smooth
 from robot.keyframes import load_sequence
@@ -239,3 +239,38 @@ def test_capture_by_hand_on_the_emulator(emu: Emulator, robot: RobotConfig, robo
             assert math.isclose(want, pose.get(joint, 0.0), abs_tol=1.0 / per_rad)
     assert {emu.registers(i)["torque_enable"] for i in robot.ids} == {0}  # all limp at the end
     assert "torque OFF on every servo" in capsys.readouterr().out
+
+
+def test_panel_capture_on_the_emulator(emu: Emulator, robot: RobotConfig, robot_toml: Path,
+                                       tmp_path: Path) -> None:
+    """The panel's studio: release the right arm, the hand moves it, capture, save."""
+    from robot.bus.factory import make_bus
+    from robot.panel.controller import LoopOptions, make_controller
+    from robot.panel.studio import Studio
+
+    robot = load_robot(robot_toml)
+    bus = make_bus(emu.protocol, robot=robot, port=emu.port)
+    controller = make_controller(robot, bus, load_gait("walk").params,
+                                 options=LoopOptions(rate_hz=50.0))
+    studio = Studio(controller, takes_dir=tmp_path / "t", keys_dir=tmp_path / "k")
+    arm = ("r_shoulder_pitch", "r_shoulder_roll", "r_elbow")
+    try:
+        with pytest.raises(ConfigError, match="limb 'tail': unknown; valid"):
+            studio.release("tail")
+        assert studio.release("right_arm")["capture_joints"] == list(arm)
+        assert [emu.registers(robot.joint(j).servo_id)["torque_enable"] for j in arm] == [0] * 3
+        assert emu.registers(robot.joint("l_elbow").servo_id)["torque_enable"] == 1
+        for k, elbow in enumerate((-0.3, -1.2)):
+            ticks = ticks_of(robot, "r_elbow", elbow)
+            sid = robot.joint("r_elbow").servo_id
+            emu.set_register(sid, "goal_position", ticks)
+            emu.set_register(sid, "present_position", ticks)
+            got = studio.capture()
+            assert got["t"] == float(k) and got["pose"]["r_elbow"] == pytest.approx(
+                elbow, abs=1.0 / MODELS[robot.bus.model].ticks_per_rad)
+        path = Path(studio.save("reach"))
+        seq = load_sequence(path, robot)
+        assert seq.joints == arm and len(seq.times) == 2 and studio.sequences() == ["reach"]
+    finally:
+        controller.shutdown(timeout=5)
+    assert {emu.registers(i)["torque_enable"] for i in robot.ids} == {0}

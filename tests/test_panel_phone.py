@@ -259,3 +259,8 @@ def test_keyboard_steers_stops_and_estops(panel: tuple[PanelController, str],
         page.close()
         controller.set_params({"speed": 1.0, "turn": 0.0})
     assert not errors, errors
+
+
+def test_every_parameter_has_a_label_in_words() -> None:
+    assert set(LABELS) == set(SPECS)
+    assert all(label and label != name for name, label in LABELS.items())

@@ -63,15 +63,17 @@ def test_panel_take_with_live_changes_replays_exactly(tmp_path: Path) -> None:
     done = threading.Event()
 
     def puppeteer() -> None:
-        for changes in ({"speed": 0.6}, {"turn": 0.2}, {"Fhgt_R": 0.7, "Fhgt_L": 0.7},
-                        {"turn": -0.1}, {"side_step": 0.01}):
+        for changes in ({"speed": 0.7}, {"turn": 0.1}, {"Slgt_R": 0.6, "Slgt_L": 0.6},
+                        {"turn": -0.05}, {"speed": 0.9}):
             time.sleep(0.15)
             controller.set_params(changes)
         done.set()
     threading.Thread(target=puppeteer).start()
     assert done.wait(10)
+    assert controller.running, controller.state()  # walking still, no fault
     controller.stop()
     assert controller.wait(30) and studio.recording is None
+    assert controller.last_stats is not None and not controller.last_stats.fault
     controller.shutdown(timeout=5)
     path = tmp_path / "takes" / f"{name}.take.jsonl"
     take = read_take(path)

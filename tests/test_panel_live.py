@@ -20,16 +20,20 @@ from robot.config import DEFAULT_ROBOT, load_gait, load_robot
 from robot.panel.controller import LoopOptions, PanelController, make_controller
 from robot.panel.live import LiveHub
 from robot.panel.server import build_server, serve_in_thread
+from robot.panel.studio import Studio
 from sim.mujoco_bus import MujocoBus
 
 
 @pytest.fixture(scope="module")
-def served() -> Iterator[tuple[PanelController, int, LiveHub]]:
+def served(tmp_path_factory: pytest.TempPathFactory
+           ) -> Iterator[tuple[PanelController, int, LiveHub]]:
     robot = load_robot(DEFAULT_ROBOT)
     controller = make_controller(robot, MujocoBus(robot, realtime=True),
                                  load_gait("walk").params,
                                  options=LoopOptions(rate_hz=100.0, read_every=5))
-    server = build_server(controller, port=0, token="tok3n")
+    tmp = tmp_path_factory.mktemp("studio")
+    server = build_server(controller, port=0, token="tok3n", studio=Studio(
+        controller, takes_dir=tmp / "takes", keys_dir=tmp / "keys"))
     serve_in_thread(server)
     hub = server.hub
     yield controller, int(server.server_address[1]), hub
@@ -150,3 +154,51 @@ def test_a_client_that_vanishes_is_dropped(served: tuple[PanelController, int, L
     assert until(lambda: hub.clients == 0)
     with ws(port) as again:  # and the hub still serves
         assert frames(again, 1)[0]["state"]
+
+
+def post(port: int, path: str, body: dict | None = None) -> tuple[int, dict]:
+    import urllib.error
+    import urllib.request
+
+    req = urllib.request.Request(f"http://127.0.0.1:{port}{path}", method="POST",
+                                 data=json.dumps(body or {}).encode(),
+                                 headers={"Content-Type": "application/json",
+                                          "Authorization": "Bearer tok3n"})
+    try:
+        with urllib.request.urlopen(req, timeout=10) as r:
+            return r.status, json.loads(r.read())
+    except urllib.error.HTTPError as e:
+        return e.code, json.loads(e.read())
+
+
+def test_studio_over_http(served: tuple[PanelController, int, LiveHub]) -> None:
+    """Record a take, list it, replay it (sliders refused meanwhile), over the API."""
+    controller, port, _ = served
+    assert until(lambda: not controller.running, 20)
+    status, r = post(port, "/api/record", {"name": "http-take"})
+    assert status == 200 and r["take"] == "http-take" and r["studio"]["recording"]
+    assert until(lambda: controller.state()["state"] == "walking", 10)
+    assert post(port, "/api/pose/release", {"limb": "arms"})[0] == 409  # not while walking
+    assert post(port, "/api/params", {"turn": 0.1})[0] == 200
+    time.sleep(0.5)
+    assert post(port, "/api/stop")[0] == 200
+    assert until(lambda: not controller.running, 20)
+    with connect_get(port, "/api/takes") as names:
+        assert "http-take" in names["takes"]
+    status, r = post(port, "/api/play", {"name": "http-take"})
+    assert status == 200 and r["take"] == "http-take"
+    status, r = post(port, "/api/params", {"turn": 0.3})
+    assert status == 409 and "take http-take is playing" in r["error"]
+    assert until(lambda: not controller.running, 30)
+    assert post(port, "/api/play", {"name": "../etc"})[0] == 400
+    assert post(port, "/api/pose/release", {"limb": "tail"})[0] == 400
+
+
+@contextlib.contextmanager
+def connect_get(port: int, path: str) -> Iterator[dict]:
+    import urllib.request
+
+    req = urllib.request.Request(f"http://127.0.0.1:{port}{path}",
+                                 headers={"Authorization": "Bearer tok3n"})
+    with urllib.request.urlopen(req, timeout=10) as r:
+        yield json.loads(r.read())

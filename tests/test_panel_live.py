@@ -18,7 +18,7 @@ from websockets.sync.client import ClientConnection, connect
 
 from robot.config import DEFAULT_ROBOT, load_gait, load_robot
 from robot.panel.controller import LoopOptions, PanelController, make_controller
-from robot.panel.live import LiveHub
+from robot.panel.live import RATE_HZ, LiveHub
 from robot.panel.server import build_server, serve_in_thread
 from robot.panel.studio import Studio
 from sim.mujoco_bus import MujocoBus
@@ -46,7 +46,8 @@ def served(tmp_path_factory: pytest.TempPathFactory
 def ws(port: int, *, token: str = "tok3n", origin: str | None = None) -> ClientConnection:
     own = f"http://127.0.0.1:{port}"
     return connect(f"ws://127.0.0.1:{port}/api/live?token={token}", origin=origin or own,
-                   open_timeout=10, close_timeout=2)  # type: ignore[arg-type]
+                   open_timeout=10, close_timeout=2,  # type: ignore[arg-type]
+                   max_queue=None)  # never stops reading: a close is always seen
 
 
 def frames(conn: ClientConnection, n: int) -> list[dict]:
@@ -105,21 +106,19 @@ def test_frames_follow_the_running_loop(served: tuple[PanelController, int, Live
 
 def test_many_clients_share_one_snapshot(served: tuple[PanelController, int, LiveHub]
                                          ) -> None:
+    """20 clients cost the server one snapshot per push, not one per client."""
     _, port, hub = served
     assert until(lambda: hub.clients == 0)
+    t0, f0 = time.monotonic(), hub.frames
     with contextlib.ExitStack() as stack:
         conns = [stack.enter_context(ws(port)) for _ in range(20)]
         assert hub.clients == 20
-        f0 = hub.frames
-        got: list[list[dict]] = [[] for _ in conns]
-        for _ in range(3):  # round robin: no client's queue fills while another is read
-            for g, c in zip(got, conns, strict=True):
-                g.extend(frames(c, 1))
-        pushed = hub.frames - f0
-        # Every client got every frame it was sent: one snapshot per push, not per client.
-        assert all(len(g) == 3 for g in got) and pushed < 3 * 20
-        walls = {round(g[-1]["wall_time"], 6) for g in got}
-        assert len(walls) <= pushed + 1  # the same snapshot object went to all of them
+        got = [frames(c, 3) for c in conns]  # unbounded client queues: read in any order
+        elapsed, pushed = time.monotonic() - t0, hub.frames - f0
+    assert pushed <= elapsed * RATE_HZ + 2  # the push rate, whatever the audience
+    walls = {f["wall_time"] for g in got for f in g}
+    assert len(walls) <= pushed  # every frame received is one of those snapshots
+    assert sum(len(g) for g in got) == 60
     assert until(lambda: hub.clients == 0)  # closed clients are forgotten
 
 

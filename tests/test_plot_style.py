@@ -39,7 +39,9 @@ def check(fig: Any) -> None:
             assert box.x0 >= data.x1, (ax.get_title(), box, data)  # right of the data
 
 
-def test_curves_plot(any_robot: Any) -> None:
+@pytest.mark.parametrize("name", ["biped18-dynamixel", "biped12-legs"])
+def test_curves_plot(name: str) -> None:
+    any_robot = load_robot(name)
     times = np.linspace(0, 3, 301)
     ch, q = GaitEngine(any_robot, load_gait("walk").params).curves(times)
     fig = curves_figure(times, ch, any_robot.joint_names, q, title="t")

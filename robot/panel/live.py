@@ -86,13 +86,15 @@ class LiveHub:
         protocol.send_response(response)
         client = _Client(sock, protocol)
         sock.settimeout(None)
-        with client.lock:
+        accepted = response.status_code == 101
+        with client.lock:  # counted once the 101 is out, before any frame can follow it
+            if accepted:
+                with self._lock:
+                    self._clients.append(client)
             client.flush(block=True)
-        if response.status_code != 101:
+        if not accepted:
             return
         self._ensure_running()
-        with self._lock:
-            self._clients.append(client)
         try:
             self._read(client)
         finally:

@@ -50,7 +50,7 @@ def _slopes(times: Array, values: Array) -> Array:
     h0, h1 = h[:-1], h[1:]
     same = (d0 * d1) > 0
     w0, w1 = 2.0 * h1 + h0, h1 + 2.0 * h0
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         inner = (w0 + w1) / (w0 / d0 + w1 / d1)
     m[1:-1] = np.where(same, inner, 0.0)
     # Ends: the one-sided three-point estimate, kept monotone (Fritsch-Carlson).

@@ -104,6 +104,20 @@ def test_frames_follow_the_running_loop(served: tuple[PanelController, int, Live
     controller.set_params({"turn": 0.0})
 
 
+def test_pings_answered_and_closes_completed(served: tuple[PanelController, int, LiveHub]
+                                             ) -> None:
+    """The protocol runs both ways: a ping gets its pong, a close gets the server's
+    close frame and then the end of the stream (no waiting for a timeout)."""
+    _, port, hub = served
+    with ws(port) as conn:
+        frames(conn, 1)
+        assert conn.ping().wait(5)
+        conn.close()
+        assert conn.protocol.close_rcvd is not None and conn.protocol.close_rcvd.code == 1000
+        assert conn.protocol.close_rcvd_then_sent is False  # we closed, the server echoed
+    assert until(lambda: hub.clients == 0)
+
+
 def test_many_clients_share_one_snapshot(served: tuple[PanelController, int, LiveHub]
                                          ) -> None:
     """20 clients cost the server one snapshot per push, not one per client."""

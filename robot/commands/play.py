@@ -99,6 +99,10 @@ def run(args: argparse.Namespace) -> int:
         rate, read_every, limit = h.rate_hz, h.read_every, None
         header = h
     elif Path(args.file).suffix in SUFFIXES:
+        if args.record and is_take(args.record):
+            raise ConfigError(f"--record {args.record}: a take records a walk's timeline; "
+                              "record a sequence's playback as .csv or .jsonl (the sequence "
+                              "file itself is what replays it)")
         robot = load_robot(args.robot) if args.robot else load_robot()
         seq = load_sequence(args.file, robot)
         gait, params = params_from(args)

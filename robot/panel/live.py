@@ -44,16 +44,26 @@ class _Client:
         self.pending = b""            # the unsent rest of the last frame
         self.stalled_since: float | None = None
         self.closed = False
+        self.eof = 0                  # 1: the protocol wants EOF sent, 2: sent
 
     def flush(self, *, block: bool = False) -> None:
-        """Send what the protocol has queued (lock held), never blocking unless asked."""
-        self.pending += b"".join(self.protocol.data_to_send())
+        """Send what the protocol has queued (lock held), never blocking unless asked;
+        its end-of-stream marker (an empty chunk, after a close) half-closes the socket,
+        which is what tells the client the closing handshake is complete."""
+        for chunk in self.protocol.data_to_send():
+            if chunk:
+                self.pending += chunk
+            elif not self.eof:
+                self.eof = 1
         while self.pending:
             try:
                 sent = self.sock.send(self.pending, 0 if block else socket.MSG_DONTWAIT)
             except BlockingIOError:
                 return
             self.pending = self.pending[sent:]
+        if self.eof == 1:
+            self.eof = 2
+            self.sock.shutdown(socket.SHUT_WR)
 
 
 class LiveHub:
@@ -78,10 +88,20 @@ class LiveHub:
         return len(self._clients) >= self.max_clients
 
     # -- one connection (runs in the HTTP handler's thread) ------------------------------
-    def serve(self, sock: socket.socket, path: str, headers: Mapping[str, str]) -> None:
-        """Complete the handshake on ``sock`` and serve it until the client goes away."""
+    def serve(self, sock: socket.socket, request_line: str,
+              headers: list[tuple[str, str]]) -> None:
+        """Complete the handshake on ``sock`` and serve it until the client goes away.
+
+        The HTTP server has read the request already; it is handed to the protocol as the
+        bytes it was (request line and headers), so the library parses the handshake and
+        then reads frames."""
         protocol = ServerProtocol(logger=log)
-        request = Request(path, Headers(list(headers.items())))
+        head = request_line + "\r\n" + "".join(f"{k}: {v}\r\n" for k, v in headers)
+        protocol.receive_data((head + "\r\n").encode("latin-1"))
+        events = protocol.events_received()
+        request = events[0] if events and isinstance(events[0], Request) else None
+        if request is None:
+            request = Request("/", Headers())  # unparseable: accept() answers 400
         response = protocol.accept(request)
         protocol.send_response(response)
         client = _Client(sock, protocol)

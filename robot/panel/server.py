@@ -218,7 +218,7 @@ def build_server(controller: PanelController, *, host: str = "127.0.0.1", port: 
                 raise Refused(HTTPStatus.SERVICE_UNAVAILABLE, f"{hub.max_clients} live "
                               "clients already; close one")
             self.close_connection = True
-            hub.serve(self.connection, self.path, dict(self.headers.items()))
+            hub.serve(self.connection, self.requestline, list(self.headers.items()))
 
         def _post(self, path: str, body: dict[str, Any]) -> None:
             c = controller

@@ -19,6 +19,9 @@ from robot.errors import BipedError, SafetyStop
 # Order is the order of `biped --help`.
 COMMANDS: tuple[str, ...] = (
     "walk",
+    "play",
+    "capture",
+    "export",
     "curves",
     "scan",
     "torque",

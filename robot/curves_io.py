@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -38,10 +39,29 @@ def write_csv(path: str | Path, times: npt.NDArray[np.float64],
         w.writerows(data.tolist())  # repr precision: the channels round-trip exactly
 
 
-def plot_curves(path: str | Path, times: npt.NDArray[np.float64],
-                channels: dict[str, npt.NDArray[np.float64]], joint_names: tuple[str, ...],
-                q: npt.NDArray[np.float64], *, title: str) -> None:
-    """A PNG: one panel per channel group, then leg and arm joint angles."""
+def palette(n: int) -> list[tuple[float, float, float, float]]:
+    """``n`` distinct colours (n <= 20): tab20's dark shades first, then its light ones,
+    so a panel of up to 10 lines gets 10 different hues."""
+    import matplotlib
+
+    if n > 20:
+        raise ValueError(f"at most 20 distinct colours, asked for {n}")
+    cmap = matplotlib.colormaps["tab20"]
+    order = list(range(0, 20, 2)) + list(range(1, 20, 2))
+    return [cmap(i) for i in order[:n]]
+
+
+def outside_legend(ax: Any, *, n: int) -> None:
+    """A legend right of the axes (never over the data)."""
+    ax.legend(fontsize=7, ncol=1 if n <= 10 else 2, loc="upper left",
+              bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+
+
+def curves_figure(times: npt.NDArray[np.float64],
+                  channels: dict[str, npt.NDArray[np.float64]], joint_names: tuple[str, ...],
+                  q: npt.NDArray[np.float64], *, title: str) -> Any:
+    """The curves figure: one panel per channel group, then leg and arm joint angles; a
+    colour per line that does not repeat within a panel, legends outside the data."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -50,25 +70,36 @@ def plot_curves(path: str | Path, times: npt.NDArray[np.float64],
     legs = [i for i, n in enumerate(joint_names) if "shoulder" not in n and "elbow" not in n]
     arms = [i for i, n in enumerate(joint_names) if i not in legs]
     panels = len(CHANNEL_GROUPS) + 1 + (1 if arms else 0)
-    fig, axes = plt.subplots(panels, 1, figsize=(12, 3.2 * panels), sharex=True)
+    fig, axes = plt.subplots(panels, 1, figsize=(14, 3.2 * panels), sharex=True,
+                             layout="constrained")
     for ax, (group, names) in zip(axes, CHANNEL_GROUPS.items(), strict=False):
-        for n in names:
-            ax.plot(times, channels[n], label=n, lw=1.2)
+        for n, colour in zip(names, palette(len(names)), strict=True):
+            ax.plot(times, channels[n], label=n, lw=1.2, color=colour)
         ax.set_title(group, loc="left", fontsize=10)
-        ax.set_ylabel("rig units")
-        ax.legend(fontsize=7, ncol=5, loc="upper right")
-        ax.grid(alpha=0.3)
+        ax.set_ylabel("channel [rig units]")
+        outside_legend(ax, n=len(names))
     rest = axes[len(CHANNEL_GROUPS):]
     for ax, idx, label in zip(rest, (legs, arms), ("leg joints", "arm joints"), strict=False):
-        for i in idx:
+        for i, colour in zip(idx, palette(len(idx)), strict=True):
             ls = "-" if joint_names[i].startswith("r_") else "--"
-            ax.plot(times, q[i], ls, label=joint_names[i], lw=1.2)
+            ax.plot(times, q[i], ls, label=joint_names[i], lw=1.2, color=colour)
         ax.set_title(label, loc="left", fontsize=10)
-        ax.set_ylabel("rad")
-        ax.legend(fontsize=7, ncol=6, loc="upper right")
+        ax.set_ylabel("angle [rad]")
+        outside_legend(ax, n=len(idx))
+    for ax in axes:
         ax.grid(alpha=0.3)
-    axes[-1].set_xlabel("t [s]")
+        ax.set_xlabel("t [s]")
+        ax.tick_params(labelbottom=True)
     fig.suptitle(title)
-    fig.tight_layout()
+    return fig
+
+
+def plot_curves(path: str | Path, times: npt.NDArray[np.float64],
+                channels: dict[str, npt.NDArray[np.float64]], joint_names: tuple[str, ...],
+                q: npt.NDArray[np.float64], *, title: str) -> None:
+    """The curves figure (``curves_figure``) as a PNG."""
+    import matplotlib.pyplot as plt
+
+    fig = curves_figure(times, channels, joint_names, q, title=title)
     fig.savefig(path, dpi=90)
     plt.close(fig)

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from robot.curves_io import plot_curves
+from robot.curves_io import outside_legend, palette, plot_curves
 from robot.errors import ConfigError
 from robot.gait import CHANNELS
 
@@ -91,8 +91,9 @@ def plot_file(path: str | Path, out: str | Path) -> str:
     return kind
 
 
-def plot_record(table: Table, out: str | Path) -> None:
-    """Commanded vs present joint positions (legs, arms), loop timing, temperatures, loads."""
+def record_figure(table: Table) -> Any:
+    """Commanded vs present joint positions (legs, arms), loop timing, temperatures, loads;
+    every axis labelled with its unit, a colour per joint within a panel, legends outside."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -104,43 +105,56 @@ def plot_record(table: Table, out: str | Path) -> None:
     legs = [n for n in names if "shoulder" not in n and "elbow" not in n]
     arms = [n for n in names if n not in legs]
     groups = [(g, label) for g, label in ((legs, "leg joints"), (arms, "arm joints")) if g]
-    fig, axes = plt.subplots(len(groups) + 3, 1, figsize=(12, 3.0 * (len(groups) + 3)),
-                             sharex=True)
-    colours = [plt.get_cmap("tab20")(i) for i in range(20)]
+    fig, axes = plt.subplots(len(groups) + 3, 1, figsize=(14, 3.0 * (len(groups) + 3)),
+                             sharex=True, layout="constrained")
     for ax, (group, label) in zip(axes, groups, strict=False):
-        for i, n in enumerate(group):
-            col = colours[i % len(colours)]
+        for n, col in zip(group, palette(len(group)), strict=True):
             ax.plot(t, c[f"cmd_{n}"], "-", color=col, lw=1.1, label=n)
             present = c.get(f"present_{n}")
             if present is not None and np.isfinite(present).any():
                 ok = np.isfinite(present)
                 ax.plot(t[ok], present[ok], ".", color=col, ms=2.5)
         ax.set_title(f"{label}: commanded (lines) vs present (dots)", loc="left", fontsize=10)
-        ax.set_ylabel("rad")
-        ax.legend(fontsize=7, ncol=6, loc="upper right")
+        ax.set_ylabel("angle [rad]")
+        outside_legend(ax, n=len(group))
     timing = axes[len(groups)]
-    timing.plot(t, c["period_error_ms"], lw=0.8, label="period error [ms]")
+    timing.plot(t, c["period_error_ms"], lw=0.8, color="tab:blue", label="period error")
+    timing.set_ylabel("period error [ms]")
     if "overruns" in c:
-        timing.plot(t, c["overruns"], lw=1.2, label="overruns (cumulative)")
+        count = timing.twinx()
+        count.plot(t, c["overruns"], lw=1.2, color="tab:red", label="overruns (cumulative)")
+        count.set_ylabel("overruns [count]")
+        timing.plot([], [], lw=1.2, color="tab:red", label="overruns (cumulative, right)")
     if len(t) > 1:
         dt = np.diff(t)
         rate = 1.0 / np.median(dt[dt > 0]) if (dt > 0).any() else 0.0
         timing.set_title(f"loop timing (median rate {rate:.0f} Hz, "
                          f"p99 period error {np.nanpercentile(c['period_error_ms'], 99):.3f} ms)",
                          loc="left", fontsize=10)
-    timing.legend(fontsize=7, loc="upper right")
-    for ax, prefix, unit in ((axes[-2], "temp_", "°C"), (axes[-1], "load_", "% of max")):
-        for i, n in enumerate(table.joints(prefix)):
+    timing.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.06, 1.0), borderaxespad=0.0)
+    for ax, prefix, unit in ((axes[-2], "temp_", "temperature [°C]"),
+                             (axes[-1], "load_", "load [% of max torque]")):
+        joints = table.joints(prefix)
+        for n, col in zip(joints, palette(len(joints)), strict=True):
             v = c[f"{prefix}{n}"]
             ok = np.isfinite(v)
-            ax.plot(t[ok], v[ok], "-", color=colours[i % len(colours)], lw=1.0, label=n)
+            ax.plot(t[ok], v[ok], "-", color=col, lw=1.0, label=n)
         ax.set_title("temperatures" if prefix == "temp_" else "loads", loc="left", fontsize=10)
         ax.set_ylabel(unit)
-        ax.legend(fontsize=7, ncol=6, loc="upper right")
+        if joints:
+            outside_legend(ax, n=len(joints))
     for ax in axes:
         ax.grid(alpha=0.3)
-    axes[-1].set_xlabel("t [s]")
+        ax.set_xlabel("t [s]")
+        ax.tick_params(labelbottom=True)
     fig.suptitle(f"run record {Path(table.source).name}")
-    fig.tight_layout()
+    return fig
+
+
+def plot_record(table: Table, out: str | Path) -> None:
+    """The record figure (``record_figure``) as a PNG."""
+    import matplotlib.pyplot as plt
+
+    fig = record_figure(table)
     fig.savefig(out, dpi=90)
     plt.close(fig)

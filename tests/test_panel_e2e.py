@@ -95,12 +95,15 @@ def test_slider_reaches_the_running_loop(running: tuple[PanelController, str],
     s1 = s0 + 0.7
     cycle = streamer.engine.params.cycle_s
     before = hip_pitch_swing(controller, cycle)
-    box = page.locator("#range-Slgt_R").bounding_box()
+    slider = page.locator("#range-Slgt_R")
+    slider.scroll_into_view_if_needed()  # above the fixed bar of run controls
+    box = slider.bounding_box()
     assert box is not None
     y = box["y"] + box["height"] / 2
-    # Drag the thumb from s0 to s1 (the thumb's centre is inset by ~8 px at the ends).
+    # Drag the thumb from s0 to s1 (the thumb's centre is inset by half its width, 14 px,
+    # at the ends).
     def x_of(v: float) -> float:
-        return box["x"] + 8 + (box["width"] - 16) * v / 3
+        return box["x"] + 14 + (box["width"] - 28) * v / 3
     page.mouse.move(x_of(s0), y)
     page.mouse.down()
     page.mouse.move(x_of((s0 + s1) / 2), y, steps=4)
@@ -172,7 +175,7 @@ def test_token_mode_from_a_phone(browser: Browser) -> None:
         assert statuses[url] == statuses[url + "panel.js"] == statuses[url + "panel.css"] == 200
         assert statuses[url + "api/params"] == 401
         pg.goto(url + "?token=phone-t0ken")
-        pg.wait_for_selector("#range-Slgt_R")
+        pg.wait_for_selector("#range-Slgt_R")  # in the phone's simple view too
         expect(pg.locator("#state")).to_have_text(re.compile("^idle"))
         pg.click("#start")
         assert wait_for(lambda: controller.state()["state"] == "walking")

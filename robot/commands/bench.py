@@ -12,6 +12,7 @@ SECTIONS: dict[str, str] = {
     "bus": "robot.bench:run_bus_section",
     "loop": "robot.bench_loop:run_loop_bench",
     "sim": "robot.bench_sim:run_sim_bench",
+    "panel": "robot.bench_panel:run_panel_bench",
 }
 
 

@@ -23,6 +23,7 @@ from robot.errors import ConfigError
 from robot.panel.controller import LoopOptions, make_controller
 from robot.panel.presets import PresetStore, user_presets_dir
 from robot.panel.server import build_server, is_loopback, panel_url, serve_in_thread
+from robot.panel.studio import Studio, user_data_dir
 
 log = logging.getLogger(__name__)
 
@@ -52,6 +53,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                    "serving beyond loopback without one)")
     p.add_argument("--presets-dir", default=None, metavar="DIR",
                    help=f"where 'save as preset' writes (default: {user_presets_dir()})")
+    p.add_argument("--studio-dir", default=None, metavar="DIR",
+                   help=f"where takes and keyframe sequences are kept (default: "
+                        f"{user_data_dir()}: takes/, keyframes/)")
     p.add_argument("--no-start", action="store_true", help="serve without starting the gait")
     return p
 
@@ -90,7 +94,11 @@ def run(args: argparse.Namespace) -> int:
                             feedback=feedback_factory(imu)),
         presets=presets, preset=gait.name)
     try:
-        server = build_server(controller, host=args.host, port=args.http_port, token=token)
+        studio_dir = Path(args.studio_dir) if args.studio_dir else user_data_dir()
+        studio = Studio(controller, takes_dir=studio_dir / "takes",
+                        keys_dir=studio_dir / "keyframes")
+        server = build_server(controller, host=args.host, port=args.http_port, token=token,
+                              studio=studio)
     except OSError as e:
         raise ConfigError(f"--http-port {args.http_port}: cannot serve on {args.host}: "
                           f"{e.strerror or e}") from e

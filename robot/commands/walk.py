@@ -16,6 +16,7 @@ from robot.commands.common import (
     add_robot_args,
     add_set_arg,
     bus_from,
+    input_file,
     output_file,
     params_from,
     positive_int,
@@ -27,9 +28,13 @@ from robot.commands.signals import SignalLatch, stop_on_signals
 from robot.commands.world_args import add_world_args, describe_world, world_from, world_summary
 from robot.engine import GaitEngine
 from robot.errors import ConfigError
+from robot.keyframes import load_sequence
+from robot.layered import LayeredEngine
 from robot.recorder import Recorder
+from robot.scripted import RecordingEngine
 from robot.servo_map import ServoMap
 from robot.streamer import LoopStats, Streamer, Telemetry
+from robot.takes import TakeHeader, TakeWriter, is_take
 
 log = logging.getLogger(__name__)
 
@@ -53,7 +58,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     add_walk_args(p)
     p.add_argument("--seconds", type=seconds, default=10.0, help="gait duration [s]")
     p.add_argument("--record", type=output_file, metavar="PATH",
-                   help="per-tick record (.csv or .jsonl)")
+                   help="per-tick log (.csv or .jsonl: commanded and present joints, timing, "
+                        "temperatures, loads), or a take to replay with `biped play` "
+                        "(NAME.take.jsonl: the parameter timeline and the joint stream)")
+    p.add_argument("--keyframes", type=input_file, metavar="FILE",
+                   help="layer a keyframe sequence (.toml/.json) on the gait: its joints "
+                        "(arms, extra joints) follow the keyframes while the legs walk")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--stop-on-fall", action="store_true",
                    help="sim: end the walk as soon as the robot falls (torque off at once, "
@@ -75,8 +85,22 @@ def run(args: argparse.Namespace) -> int:
     if world is not None:
         options["world"] = world
     bus = bus_from(args, robot, kind=kind, **options)
-    recorder = Recorder(args.record, robot.joint_names, robot.ids) if args.record else None
-    engine = GaitEngine(robot, params)
+    imu = imu_for(args, robot, bus)
+    layer = load_sequence(args.keyframes, robot) if args.keyframes else None
+    recorder: Recorder | TakeWriter | None = None
+    engine: GaitEngine
+    if args.record and is_take(args.record):
+        recorder = TakeWriter(args.record, TakeHeader(
+            robot=robot.name, robot_file=robot.source, joints=robot.joint_names,
+            rate_hz=args.rate, read_every=args.read_every, gait=gait.name, params=params,
+            bus=kind, balance=imu is not None,
+            keyframes=layer.as_json() if layer else None))
+        engine = RecordingEngine(robot, params, sink=recorder.event, keyframes=layer)
+    else:
+        if args.record:
+            recorder = Recorder(args.record, robot.joint_names, robot.ids)
+        engine = LayeredEngine(robot, params, keyframes=layer) if layer else \
+            GaitEngine(robot, params)
     smap = ServoMap(robot)
     monitor = None
     effort: Any = None
@@ -86,7 +110,6 @@ def run(args: argparse.Namespace) -> int:
         observers.append(recorder.open())    # an unwritable path fails before the bus opens
     latch = SignalLatch()
     stats: LoopStats | None = None
-    imu = imu_for(args, robot, bus)
     wall0 = time.perf_counter()
     try:
         bus.open()

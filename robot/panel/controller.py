@@ -23,11 +23,15 @@ from robot.engine import GaitEngine
 from robot.errors import BipedError
 from robot.panel.figure import views
 from robot.panel.idle_pose import IdlePose
+from robot.panel.labels import LABELS, SIMPLE
 from robot.panel.presets import PresetStore
 from robot.panel.sim_monitor import sim_monitor_factory
 from robot.params import GROUPS, SPECS, GaitParams
 from robot.servo_map import ServoMap
-from robot.streamer import Feedback, LoopStats, Streamer, Telemetry
+from robot.streamer import Feedback, LoopStats, Streamer, Telemetry, TickObserver
+
+#: Builds a run's engine from the current parameters (a recording, a replay, keyframes).
+EngineFactory = Callable[[GaitParams], GaitEngine]
 
 log = logging.getLogger(__name__)
 
@@ -81,6 +85,8 @@ class PanelController:
         self._holding = False  # torque left on by the last run (hold, no fault or estop)
         self._estop_requested = False  # during the current run
         self._closing = False
+        self.driver: str | None = None  # what drives the run instead of the sliders
+        self._on_end: Callable[[], None] | None = None
 
     # -- parameters --------------------------------------------------------------------
     @property
@@ -95,6 +101,8 @@ class PanelController:
         """Validate all of ``changes`` (ConfigError, nothing changes) and apply them: at the
         loop's next tick when running, else to the next run."""
         with self._lock:
+            if self.running and self.driver is not None:
+                raise PanelStateError(f"{self.driver} is playing; stop it to drive by hand")
             if self.running and self._streamer is not None:
                 new = self._streamer.set_params(changes, where="panel")
             else:
@@ -116,8 +124,14 @@ class PanelController:
     def running(self) -> bool:
         return self._thread is not None and self._thread.is_alive()
 
-    def start(self) -> None:
-        """Start a new run with the current parameters (PanelStateError if one runs)."""
+    def start(self, *, engine: EngineFactory | None = None,
+              observer: TickObserver | None = None, driver: str | None = None,
+              on_end: Callable[[], None] | None = None) -> None:
+        """Start a new run with the current parameters (PanelStateError if one runs).
+
+        engine: builds the run's engine (default: the plain gait); observer: also called
+        every tick; driver: names what drives the run (a take): the sliders are refused
+        meanwhile; on_end: called in the run's thread when it has ended."""
         with self._lock:
             if self._closing:
                 raise PanelStateError("the panel is shutting down")
@@ -125,7 +139,8 @@ class PanelController:
                 raise PanelStateError("the gait is already running; stop it first")
             if not self.bus.is_open:
                 self.bus.open()
-            engine = GaitEngine(self.robot, self._params)
+            gait = engine(self._params) if engine is not None else \
+                GaitEngine(self.robot, self._params)
             monitor = self._monitor_factory() if self._monitor_factory else None
             self._ticks.clear()
             self._sim = {}
@@ -133,11 +148,14 @@ class PanelController:
 
             def observe(tel: Telemetry) -> None:
                 self._observe(tel, monitor)
+                if observer is not None:
+                    observer(tel)
             o = self.options
-            self._streamer = Streamer(self._map, self.bus, engine, rate_hz=o.rate_hz,
+            self._streamer = Streamer(self._map, self.bus, gait, rate_hz=o.rate_hz,
                                       read_every=o.read_every, hold_at_end=o.hold,
                                       observer=observe,
-                                      feedback=o.feedback(engine) if o.feedback else None)
+                                      feedback=o.feedback(gait) if o.feedback else None)
+            self.driver, self._on_end = driver, on_end
             self._tel = {"state": "starting"}
             self.runs += 1
             self._holding = self._estop_requested = False
@@ -160,6 +178,12 @@ class PanelController:
             log.exception("run crashed")
         finally:
             self._observe(streamer.telemetry, None)
+            end, self._on_end = self._on_end, None
+            if end is not None:
+                try:
+                    end()
+                except Exception:
+                    log.exception("panel: ending the run's recording failed")
 
     def stop(self) -> None:
         """Safe stop: ramp the gait out, go to rest, torque off (or hold)."""
@@ -302,7 +326,8 @@ class PanelController:
             "params": p, "preset": self.preset,
             "groups": [{"name": g, "params": [
                 {"name": n, "value": p[n], "lo": s.lo, "hi": s.hi, "unit": s.unit,
-                 "default": s.default, "doc": s.doc, "paper": s.paper}
+                 "default": s.default, "doc": s.doc, "paper": s.paper,
+                 "label": LABELS.get(n, n), "simple": n in SIMPLE}
                 for n, s in SPECS.items() if s.group == g]} for g in GROUPS],
         }
 

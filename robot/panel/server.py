@@ -10,10 +10,17 @@ Endpoints (JSON in and out; errors are ``{"error": "..."}``, never an empty repl
                      preset (a bundled preset is never replaced: 409)
   POST /api/start | /api/stop | /api/estop    run, safe ramp-out, torque off at once
   POST /api/reset    simulation only, while stopped: robot back on its feet
+  GET  /api/live     WebSocket (robot.panel.live): the state, parameters and studio status
+                     pushed 20 times a second; the page uses it instead of polling
+  GET  /api/takes | /api/sequences        recorded takes, saved keyframe sequences
+  POST /api/record {"name"?} | /api/play {"name"}   record a take (ends with stop), replay
+  POST /api/pose/release {"limb"} | /api/pose/capture | /api/pose/clear | /api/pose/save
+       {"name"} | /api/sequence/play {"name", "layer": bool}: posing by hand (panel.studio)
 
 Every request passes ``robot.panel.guard`` first (Host, Origin, JSON content type, body
-length). With a token, every /api request needs ``Authorization: Bearer <token>`` or
-``?token=<token>`` (401 otherwise); the page and its assets are public (they hold no
+length), the WebSocket handshake too (browsers always send Origin on it). With a token,
+every /api request needs ``Authorization: Bearer <token>`` or ``?token=<token>`` (401
+otherwise; a browser's WebSocket can only send the query); the page and its assets are public (they hold no
 secret) and the page sends the token from its own URL with each API call. Serving beyond
 loopback requires a token.
 """
@@ -35,14 +42,18 @@ from urllib.parse import parse_qs, urlsplit
 from robot.errors import BipedError, ConfigError
 from robot.panel.controller import PanelController, PanelStateError
 from robot.panel.guard import WILDCARD, Guard, Refused, is_loopback, lan_address
+from robot.panel.live import LiveHub
 from robot.panel.presets import PresetExistsError
+from robot.panel.studio import Studio
 
 log = logging.getLogger(__name__)
 
 STATIC = {"/": ("index.html", "text/html; charset=utf-8"),
           "/index.html": ("index.html", "text/html; charset=utf-8"),
           "/panel.js": ("panel.js", "text/javascript; charset=utf-8"),
-          "/panel.css": ("panel.css", "text/css; charset=utf-8")}
+          "/panel.css": ("panel.css", "text/css; charset=utf-8"),
+          "/input.js": ("input.js", "text/javascript; charset=utf-8"),
+          "/studio.js": ("studio.js", "text/javascript; charset=utf-8")}
 ACTIONS = {"/api/start": "start", "/api/stop": "stop", "/api/estop": "emergency_stop",
            "/api/reset": "reset_sim"}
 READ_TIMEOUT_S = 10.0  # a client that stalls mid-request is dropped after this
@@ -59,15 +70,30 @@ def static_file(name: str) -> bytes:
     return resources.files("robot").joinpath("panel_static", name).read_bytes()
 
 
+def live_snapshot(controller: PanelController, studio: Studio) -> dict[str, Any]:
+    """What the WebSocket pushes: the state, the parameters in effect, the studio."""
+    streamer = controller.streamer
+    params = streamer.engine.params if controller.running and streamer is not None \
+        else controller.params
+    return {**controller.state(), "params": params.as_dict(), "preset": controller.preset,
+            "driver": controller.driver if controller.running else None,
+            "studio": studio.status()}
+
+
 def build_server(controller: PanelController, *, host: str = "127.0.0.1", port: int = 0,
-                 token: str | None = None, read_timeout_s: float = READ_TIMEOUT_S
-                 ) -> ThreadingHTTPServer:
+                 token: str | None = None, read_timeout_s: float = READ_TIMEOUT_S,
+                 studio: Studio | None = None) -> ThreadingHTTPServer:
     """A ThreadingHTTPServer bound to (host, port) (port 0: ephemeral) serving the panel for
-    ``controller``. Call ``serve_forever()`` (e.g. in a thread) and ``shutdown()``.
-    read_timeout_s: a client silent this long mid-request is answered 408 or dropped."""
+    ``controller``. Call ``serve_forever()`` (e.g. in a thread) and ``shutdown()``, then
+    ``server_close()`` (which also closes the WebSockets).
+    read_timeout_s: a client silent this long mid-request is answered 408 or dropped;
+    studio: takes and keyframes (default: in the user's data directory)."""
     if not is_loopback(host) and not token:
         raise ConfigError(f"--host {host}: serving beyond loopback needs a token (--token)")
     guard = Guard.for_bind(host)
+    room = studio or Studio(controller)
+    hub = LiveHub(lambda: live_snapshot(controller, room))
+    posts = _studio_posts(room)
 
     class Handler(BaseHTTPRequestHandler):
         server_version = "biped-panel/1"
@@ -173,11 +199,33 @@ def build_server(controller: PanelController, *, host: str = "127.0.0.1", port: 
                 self._json(HTTPStatus.OK, c.describe())
             elif path == "/api/presets":
                 self._json(HTTPStatus.OK, {"presets": c.presets.names()})
+            elif path == "/api/live":
+                self._upgrade()
+            elif path == "/api/takes":
+                self._json(HTTPStatus.OK, {"takes": room.takes(), "dir": str(room.takes_dir)})
+            elif path == "/api/sequences":
+                self._json(HTTPStatus.OK, {"sequences": room.sequences(),
+                                           "dir": str(room.keys_dir), **room.status()})
             else:
                 self._json(HTTPStatus.NOT_FOUND, {"error": f"no such page: {path}"})
 
+        def _upgrade(self) -> None:
+            """Hand the connection to the live hub (a WebSocket handshake), or refuse."""
+            if self.headers.get("Upgrade", "").lower() != "websocket":
+                raise Refused(HTTPStatus.BAD_REQUEST, "/api/live is a WebSocket: send "
+                              "Upgrade: websocket")
+            if hub.full():
+                raise Refused(HTTPStatus.SERVICE_UNAVAILABLE, f"{hub.max_clients} live "
+                              "clients already; close one")
+            self.close_connection = True
+            hub.serve(self.connection, self.requestline, list(self.headers.items()))
+
         def _post(self, path: str, body: dict[str, Any]) -> None:
             c = controller
+            if path in posts:
+                self._json(HTTPStatus.OK, {"ok": True, **posts[path](body),
+                                           "studio": room.status()})
+                return
             if path == "/api/params":
                 self._json(HTTPStatus.OK, {"params": c.set_params(body).as_dict()})
             elif path == "/api/preset":
@@ -201,7 +249,24 @@ def build_server(controller: PanelController, *, host: str = "127.0.0.1", port: 
             self._route("POST")
 
     server_class = _Server6 if ":" in host else _Server
-    return server_class((host, port), Handler)
+    server = server_class((host, port), Handler)
+    server.hub = hub
+    return server
+
+
+def _studio_posts(room: Studio) -> dict[str, Any]:
+    """POST path → handler(body) → reply fields, for the studio's actions."""
+    return {
+        "/api/record": lambda b: {"take": room.record(b.get("name"))},
+        "/api/play": lambda b: room.play(b.get("name")),
+        "/api/pose/release": lambda b: room.release(b.get("limb")),
+        "/api/pose/capture": lambda b: room.capture(b.get("t")),
+        "/api/pose/clear": lambda b: room.clear(),
+        "/api/pose/save": lambda b: {"saved": room.save(b.get("name")),
+                                     "sequences": room.sequences()},
+        "/api/sequence/play": lambda b: room.play_sequence(b.get("name"),
+                                                           layer=b.get("layer") is True),
+    }
 
 
 def serve_in_thread(server: ThreadingHTTPServer) -> tuple[threading.Thread, str]:
@@ -233,6 +298,12 @@ def panel_url(host: str, port: int) -> str:
 
 class _Server(ThreadingHTTPServer):
     daemon_threads = True
+    hub: LiveHub | None = None
+
+    def server_close(self) -> None:
+        if self.hub is not None:
+            self.hub.close()
+        super().server_close()
 
     def handle_error(self, request: Any, client_address: Any) -> None:
         """A failed connection is one log line, never a traceback on stderr."""

@@ -1,5 +1,7 @@
-// biped panel: sliders and number boxes for every gait parameter, presets, start/stop/estop,
-// a live stick figure (side and front views, points computed by the server) and telemetry.
+// biped panel: a slider and number box for every gait parameter (labels in words, the
+// paper's symbol beside them), presets, start/stop/estop, a live stick figure and telemetry
+// pushed over a WebSocket (/api/live; polling /api/state only if the socket cannot open).
+// input.js adds the gamepad and keyboard, studio.js recording, replay and keyframes.
 "use strict";
 
 const TOKEN = new URLSearchParams(location.search).get("token");
@@ -7,6 +9,8 @@ const $ = (id) => document.getElementById(id);
 const inputs = {};      // name -> {range, number, row, spec}
 let busy = false;       // one parameter request in flight at a time
 let queued = null;      // latest changes waiting for it
+let last = null;        // the last state pushed
+const listeners = [];   // called with every state
 
 async function api(method, path, body) {
   const headers = { "Content-Type": "application/json" };
@@ -54,32 +58,32 @@ async function sendParams(changes) {
   }
 }
 
+function el(tag, props, ...children) {
+  const e = Object.assign(document.createElement(tag), props || {});
+  e.append(...children);
+  return e;
+}
+
 function buildParams(desc) {
   const box = $("params");
   box.textContent = "";
   for (const group of desc.groups) {
-    const fs = document.createElement("fieldset");
-    const lg = document.createElement("legend");
-    lg.textContent = group.name;
-    fs.appendChild(lg);
+    const title = group.name.charAt(0).toUpperCase() + group.name.slice(1);
+    const fs = el("fieldset", {}, el("legend", { textContent: title }));
+    fs.dataset.group = group.name;
     for (const s of group.params) {
-      const row = document.createElement("div");
-      row.className = "param";
-      row.title = s.doc + " [" + s.lo + ", " + s.hi + "] " + s.unit;
-      const label = document.createElement("label");
-      label.textContent = s.name;
-      label.htmlFor = "num-" + s.name;
-      const range = document.createElement("input");
-      Object.assign(range, { type: "range", min: s.lo, max: s.hi, step: (s.hi - s.lo) / 1000,
-                             value: s.value, id: "range-" + s.name });
-      range.dataset.param = s.name;
-      const number = document.createElement("input");
-      Object.assign(number, { type: "number", min: s.lo, max: s.hi, step: "any",
-                              value: s.value, id: "num-" + s.name });
-      number.dataset.param = s.name;
-      const unit = document.createElement("span");
-      unit.className = "unit";
-      unit.textContent = s.unit;
+      const row = el("div", { className: "param" + (s.simple ? " simple" : "") });
+      if (s.simple) fs.classList.add("has-simple");
+      const label = el("label", { htmlFor: "num-" + s.name }, s.label + " ",
+                       el("code", { textContent: s.name }));
+      const range = el("input", { type: "range", min: s.lo, max: s.hi, step: (s.hi - s.lo) / 1000,
+                                  value: s.value, id: "range-" + s.name });
+      range.setAttribute("aria-label", s.label);
+      const number = el("input", { type: "number", min: s.lo, max: s.hi, step: "any",
+                                   value: s.value, id: "num-" + s.name });
+      const unit = s.unit && s.unit !== "-" ? " " + s.unit : "";
+      const doc = el("div", { className: "doc",
+                              textContent: s.doc + " [" + s.lo + ", " + s.hi + "]" + unit });
       range.addEventListener("input", () => {
         number.value = +(+range.value).toPrecision(6);
         sendParams({ [s.name]: +range.value });
@@ -88,7 +92,7 @@ function buildParams(desc) {
         const v = number.value.trim() === "" ? number.value : Number(number.value);
         sendParams({ [s.name]: Number.isNaN(v) ? number.value : v });
       });
-      row.append(label, range, number, unit);
+      row.append(label, number, range, doc);
       fs.appendChild(row);
       inputs[s.name] = { range, number, row, spec: s };
     }
@@ -114,15 +118,15 @@ function drawView(canvas, cmd, present, horizontal) {
   const ox = W / 2, oy = H - 24;            // ground line and centre
   g.strokeStyle = "#3b4658"; g.lineWidth = 1;
   g.beginPath(); g.moveTo(0, oy); g.lineTo(W, oy); g.stroke();
-  g.fillStyle = "#8b95a7"; g.font = "11px sans-serif";
-  g.fillText(horizontal, W - 90, oy + 16);
+  g.fillStyle = "#8b95a7"; g.font = "16px sans-serif";
+  g.fillText(horizontal, W - 150, oy + 18);
   const draw = (fig, dashed, alpha) => {
     if (!fig) return;
     g.globalAlpha = alpha;
     g.setLineDash(dashed ? [3, 4] : []);
     for (const [name, pts] of Object.entries(fig)) {
       g.strokeStyle = COLORS[name] || "#fff";
-      g.lineWidth = name === "torso" ? 4 : 3;
+      g.lineWidth = name === "torso" ? 5 : 4;
       g.beginPath();
       pts.forEach(([x, z], i) => {
         const px = ox + x * scale, py = oy - z * scale;
@@ -139,6 +143,7 @@ function drawView(canvas, cmd, present, horizontal) {
 function row(k, v) { return "<tr><td>" + k + "</td><td>" + v + "</td></tr>"; }
 
 function showState(s) {
+  last = s;
   const st = $("state");
   st.textContent = s.state + (s.running ? "" : " (not running)");
   st.className = "state " + s.state;
@@ -158,24 +163,56 @@ function showState(s) {
   $("servos").tBodies[0].innerHTML = s.servos.map((v) => "<tr><td>" + v.id + "</td><td>" +
     v.joint + "</td><td>" + fmt(v.temperature, 1) + "</td><td>" + fmt(v.load, 1) + "</td><td>" +
     v.errors.join(" ") + "</td></tr>").join("");
+  if (s.params && !busy && !queued) showParams(s.params);
+  for (const f2 of listeners) f2(s);
 }
 
 async function poll() {
   try { showState(await api("GET", "/api/state")); } catch (e) { say(e.message, true); }
-  setTimeout(poll, 100);
+  setTimeout(poll, 500);
+}
+
+function live(failures = 0) {
+  // The server pushes the state; reconnect after a drop, fall back to polling if it
+  // cannot open at all (e.g. a proxy without WebSockets).
+  const scheme = location.protocol === "https:" ? "wss://" : "ws://";
+  const ws = new WebSocket(scheme + location.host + "/api/live" +
+                           (TOKEN ? "?token=" + encodeURIComponent(TOKEN) : ""));
+  let opened = false;
+  ws.onopen = () => { opened = true; failures = 0; };
+  ws.onmessage = (ev) => showState(JSON.parse(ev.data));
+  ws.onclose = () => {
+    if (!opened && failures >= 2) { say("live updates unavailable: polling", true); poll(); return; }
+    setTimeout(() => live(opened ? 0 : failures + 1), 1000);
+  };
 }
 
 function action(id, path, body, after) {
-  $(id).addEventListener("click", async () => {
-    try {
-      const r = await api("POST", path, body ? body() : undefined);
-      say(id + ": " + (r.state || r.saved || r.preset || "ok"));
-      if (after) await after(r);
-    } catch (e) { say(e.message, true); }
-  });
+  $(id).addEventListener("click", () => run(id, path, body ? body() : undefined, after));
+}
+
+async function run(id, path, body, after) {
+  try {
+    const r = await api("POST", path, body);
+    say(id + ": " + (r.state || r.saved || r.preset || r.take || r.sequence || "ok"));
+    if (after) await after(r);
+    return r;
+  } catch (e) { say(e.message, true); return null; }
+}
+
+function setView(view) {
+  document.body.classList.toggle("simple", view === "simple");
+  $("view-simple").classList.toggle("on", view === "simple");
+  $("view-full").classList.toggle("on", view !== "simple");
+  try { localStorage.setItem("biped-view", view); } catch (e) { /* private mode */ }
 }
 
 async function main() {
+  let view = null;
+  try { view = localStorage.getItem("biped-view"); } catch (e) { /* private mode */ }
+  setView(view || (window.innerWidth < 720 ? "simple" : "full"));
+  $("view-simple").addEventListener("click", () => setView("simple"));
+  $("view-full").addEventListener("click", () => setView("full"));
   const desc = await api("GET", "/api/params");
   buildParams(desc);
   await loadPresets(desc.preset);
@@ -186,7 +223,9 @@ async function main() {
   action("load", "/api/preset", () => ({ name: $("preset").value }), (r) => showParams(r.params));
   action("save", "/api/save", () => ({ name: $("save-name").value, overwrite: $("overwrite").checked }),
          () => loadPresets($("save-name").value));
-  poll();
+  live();
+  document.dispatchEvent(new Event("panel-ready"));
 }
 
+window.panel = { api, say, run, sendParams, inputs, listeners, state: () => last };
 main().catch((e) => say(e.message, true));

@@ -1,0 +1,84 @@
+"""`biped export`: the motion as BVH for Blender, Maya or any previs tool.
+
+``--gait NAME --seconds S``: the gait at constant parameters (the paper's steady cycle,
+evaluated directly, no ramp), ``--take FILE``: a recorded take's joint stream (as it went
+to the servos, ramps and rest included). Skeleton, axes and units: robot/bvh.py.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from robot.bvh import UNITS, resample, write_bvh
+from robot.commands.common import (
+    add_robot_args,
+    bounded_float,
+    checked,
+    gait_from,
+    input_file,
+    one_line_errors,
+    output_file,
+    robot_from,
+    seconds,
+)
+from robot.config import DEFAULT_ROBOT_NAME, load_robot
+from robot.engine import GaitEngine
+from robot.errors import ConfigError
+from robot.takes import SUFFIX, is_take, read_take
+
+#: Most frames written (an hour at 60 fps).
+MAX_FRAMES = 216_000
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
+    p = sub.add_parser("export", help="write the gait or a take as BVH (previs)",
+                       description=__doc__.split("\n\n")[0])
+    add_robot_args(p)
+    p.add_argument("--take", default=None, metavar=f"FILE{SUFFIX}",
+                   help="export a recorded take instead of the gait")
+    p.add_argument("--seconds", type=seconds, default=10.0, help="gait duration [s]")
+    p.add_argument("--fps", type=bounded_float(1.0, 240.0, "frame/s", what="a frame rate"),
+                   default=30.0, help="frames per second (default: %(default)s)")
+    p.add_argument("--units", choices=sorted(UNITS), default="cm",
+                   help="length unit of the skeleton (default: %(default)s)")
+    p.add_argument("--out", required=True, type=output_file, metavar="FILE.bvh")
+    return one_line_errors(p)
+
+
+def run(args: argparse.Namespace) -> int:
+    if not args.out.endswith(".bvh"):
+        raise ConfigError(f"--out {args.out}: expected a .bvh file")
+    if args.take:
+        checked("--take", input_file, args.take)
+        if not is_take(args.take):
+            raise ConfigError(f"--take {args.take}: expected a take (NAME{SUFFIX})")
+        take = read_take(args.take)
+        own = take.header.robot_file if Path(take.header.robot_file).is_file() \
+            else take.header.robot
+        robot = load_robot(own if args.robot == DEFAULT_ROBOT_NAME else args.robot)
+        if robot.joint_names != take.header.joints:
+            raise ConfigError(f"--take {args.take}: recorded on {take.header.robot}, not "
+                              f"{robot.name}")
+        if len(take.t) < 2:
+            raise ConfigError(f"--take {args.take}: fewer than two ticks recorded")
+        t = np.arange(len(take.t)) / take.header.rate_hz
+        q = resample(t, take.q, args.fps)
+        what = f"take {args.take}"
+    else:
+        n = int(round(args.seconds * args.fps)) + 1
+        if n > MAX_FRAMES:
+            raise ConfigError(f"--seconds {args.seconds:g} x --fps {args.fps:g}: {n} frames; "
+                              f"expected at most {MAX_FRAMES}")
+        robot = robot_from(args)
+        gait = gait_from(args)
+        _, qt = GaitEngine(robot, gait.params).curves(np.arange(n) / args.fps,
+                                                      with_channels=False)
+        q = qt.T
+        what = f"gait {gait.name}"
+    frames = write_bvh(args.out, robot, q, 1.0 / args.fps, units=args.units)
+    print(f"wrote {args.out}: {frames} frames at {args.fps:g} fps of {what} on {robot.name} "
+          f"({args.units})")
+    return 0

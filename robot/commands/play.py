@@ -1,0 +1,163 @@
+"""`biped play FILE`: replay a take (NAME.take.jsonl) or play a keyframe sequence
+(.toml/.json) on any bus, through the same streaming loop and safety as `biped walk`.
+
+A take replays its parameter timeline on the take's robot at the take's rate (with the
+balance feedback if it was on), so in the simulation it reproduces the recorded joint
+stream. A keyframe sequence plays on its own: the joints it names follow it, the others
+hold the standing pose. Either way: ramp in from the present pose, clamp, slew, then ramp
+to rest and torque off (``--hold``: stay on). Ctrl-C / SIGTERM as for `biped walk`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+from robot.commands.balance_args import add_balance_args, balance_for, imu_for
+from robot.commands.common import (
+    add_bus_args,
+    bus_from,
+    checked,
+    input_file,
+    output_file,
+    params_from,
+    rate_hz,
+    seconds,
+)
+from robot.commands.signals import SignalLatch, stop_on_signals
+from robot.config import DEFAULT_GAIT, RobotConfig, load_robot
+from robot.engine import GaitEngine
+from robot.errors import ConfigError
+from robot.keyframes import SUFFIXES, load_sequence, parse_sequence
+from robot.layered import LayeredEngine
+from robot.recorder import Recorder
+from robot.scripted import PlaybackEngine
+from robot.servo_map import ServoMap
+from robot.streamer import LoopStats, Streamer
+from robot.takes import SUFFIX, Take, TakeHeader, TakeWriter, is_take, read_take
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
+    p = sub.add_parser("play", help="replay a take or play a keyframe sequence (any bus)",
+                       description=__doc__.split("\n\n")[0])
+    p.add_argument("file", metavar="FILE", help=f"a take (NAME{SUFFIX}) or a keyframe "
+                   "sequence (.toml/.json)")
+    p.add_argument("--robot", default=None, metavar="NAME|PATH",
+                   help="robot (default: the take's; for a sequence the default robot)")
+    p.add_argument("--gait", default=DEFAULT_GAIT, help="sequence only: the standing pose's "
+                   "gait preset (default: %(default)s)")
+    add_bus_args(p, default="sim")
+    p.add_argument("--rate", type=rate_hz, default=None,
+                   help="sequence only: control rate [Hz] (a take plays at its own rate)")
+    p.add_argument("--seconds", type=seconds, default=None,
+                   help="sequence only: play this long (a looping sequence repeats)")
+    p.add_argument("--hold", action="store_true", help="hold the rest pose with torque on")
+    p.add_argument("--realtime", action="store_true", help="pace the simulation to the wall clock")
+    p.add_argument("--view", action="store_true", help="open the MuJoCo viewer (needs a display)")
+    p.add_argument("--record", default=None, metavar="PATH",
+                   help=f"record the replay (.csv, .jsonl or NAME{SUFFIX})")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    add_balance_args(p)
+    p.set_defaults(set=[])
+    return p
+
+
+def _take_robot(args: argparse.Namespace, take: Take) -> RobotConfig:
+    h = take.header
+    robot = load_robot(args.robot or (h.robot_file if Path(h.robot_file).is_file()
+                                      else h.robot))
+    if robot.joint_names != h.joints:
+        raise ConfigError(f"{take.source}: recorded on {h.robot} with joints "
+                          f"{', '.join(h.joints)}; {robot.source} has "
+                          f"{', '.join(robot.joint_names)}")
+    return robot
+
+
+def run(args: argparse.Namespace) -> int:
+    checked("FILE", input_file, args.file)
+    if args.record:
+        checked("--record", output_file, args.record)
+    kind = args.bus or "sim"
+    if kind != "sim" and (args.view or args.realtime):
+        raise ConfigError("--view and --realtime apply to --bus sim only")
+    engine: GaitEngine
+    if is_take(args.file):
+        if args.rate is not None or args.seconds is not None:
+            raise ConfigError("--rate and --seconds apply to keyframe sequences; a take "
+                              "plays at its own rate for its own length")
+        take = read_take(args.file)
+        robot = _take_robot(args, take)
+        h = take.header
+        layer = (parse_sequence(h.keyframes, robot, source=f"{take.source}: keyframes")
+                 if h.keyframes else None)
+        stop = take.stop_tick if take.stop_tick is not None else len(take.t)
+        args.no_balance = args.no_balance or not h.balance
+        engine = PlaybackEngine(robot, h.params, changes=take.changes, stop_tick=stop,
+                                keyframes=layer)
+        rate, read_every, limit = h.rate_hz, h.read_every, None
+        header = h
+    elif Path(args.file).suffix in SUFFIXES:
+        if args.record and is_take(args.record):
+            raise ConfigError(f"--record {args.record}: a take records a walk's timeline; "
+                              "record a sequence's playback as .csv or .jsonl (the sequence "
+                              "file itself is what replays it)")
+        robot = load_robot(args.robot) if args.robot else load_robot()
+        seq = load_sequence(args.file, robot)
+        gait, params = params_from(args)
+        engine = LayeredEngine(robot, params, keyframes=seq, walk=False)
+        args.no_balance = True  # standing still: nothing to balance with the gait's loop
+        rate, read_every, limit = args.rate or 200.0, 10, args.seconds
+        header = TakeHeader(robot=robot.name, robot_file=robot.source,
+                            joints=robot.joint_names, rate_hz=rate, read_every=read_every,
+                            gait=gait.name, params=params, bus=kind)
+    else:
+        raise ConfigError(f"FILE {args.file}: expected a take (NAME{SUFFIX}) or a keyframe "
+                          f"sequence ({', '.join(SUFFIXES)})")
+    options: dict[str, Any] = (
+        {"realtime": args.realtime, "view": args.view} if kind == "sim" else {})
+    bus = bus_from(args, robot, kind=kind, **options)
+    imu = imu_for(args, robot, bus)
+    writer: TakeWriter | Recorder | None = None
+    if args.record:
+        writer = (TakeWriter(args.record, header) if is_take(args.record)
+                  else Recorder(args.record, robot.joint_names, robot.ids))
+        writer.open()
+        if isinstance(writer, TakeWriter) and isinstance(engine, PlaybackEngine):
+            for k, step in sorted(take.changes.items()):
+                writer.event(k, set=dict(step))
+            writer.event(stop, stop=True)
+    latch = SignalLatch()
+    stats: LoopStats | None = None
+    try:
+        bus.open()
+        if imu is not None:
+            imu.open()
+        streamer = Streamer(ServoMap(robot), bus, engine, rate_hz=rate,
+                            read_every=read_every, hold_at_end=args.hold, observer=writer,
+                            feedback=balance_for(imu, engine))
+        with stop_on_signals(streamer, latch):
+            stats = streamer.run(seconds=limit)
+    finally:
+        bus.close(torque_off=False)  # the streamer left the servos as the end requires
+        if imu is not None:
+            imu.close()
+        record_error = writer.close_quietly() if writer is not None else None
+    assert stats is not None
+    code = latch.exit_code(stats) or (1 if record_error else 0)
+    result = {"file": args.file, "robot": robot.name, "bus": kind, "ticks": stats.ticks,
+              "rate_hz": rate, "gait_seconds": engine.time, "overruns": stats.overruns,
+              "stop_reason": stats.stop_reason, "fault": stats.fault,
+              "holding": stats.holding, "balance": imu is not None,
+              "record_error": record_error, "exit_code": code}
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(f"played {args.file} on {robot.name} ({kind} bus): {stats.ticks} ticks at "
+              f"{rate:g} Hz, {engine.time:.2f} s of motion, {stats.overruns} overruns; "
+              f"stopped: {stats.stop_reason}; servos "
+              f"{'holding the rest pose, torque ON' if stats.holding else 'torque off'}")
+        if record_error:
+            print(f"record FAILED: {record_error}")
+    return code

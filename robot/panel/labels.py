@@ -28,8 +28,12 @@ LABELS: dict[str, str] = {
     "ramp_cycles": "Start and stop smoothness",
     "bal_ankle_pd": "Ankle damping", "bal_hip_pd": "Hip damping",
     "bal_ankle_pp": "Ankle stiffness", "bal_lean_i": "Slope learning",
-    "bal_lean_max": "Largest learned lean", "bal_step_pd": "Step toward a fall",
-    "bal_step_max": "Largest catch step", "bal_heading_p": "Heading hold",
+    "bal_lean_max": "Largest learned lean", "bal_step_gain": "Step toward a fall",
+    "bal_step_max": "Largest catch step", "bal_step_dead": "Ignore small wobbles",
+    "bal_brace_xi": "Put the foot down at", "bal_brace_s": "Stand still for",
+    "bal_hold_xi": "Don't lift a loaded foot", "bal_tempo_gain": "Hurry the next step",
+    "bal_tempo_max": "Largest hurry", "bal_learn_cycles": "Learn the walk's rhythm",
+    "bal_heading_p": "Heading hold",
     "bal_heading_i": "Heading hold, slow part", "bal_turn_max": "Largest heading trim",
 }
 

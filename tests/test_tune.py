@@ -117,7 +117,7 @@ def test_a_detuned_legs_only_preset_is_tuned_back_to_walking(tmp_path: Path) -> 
     out = tmp_path / "tuned.toml"
     r = biped("tune", "--robot", "biped12-legs", "--gait", str(start), "--out", str(out),
               "--param", "Slgt=0.3:0.9", "--param", "sway=0.005:0.04", "--skip", "push*",
-              "--trials", "3", "--jobs", "1", "--json")
+              "--seconds", "8", "--trials", "3", "--jobs", "1", "--json")
     assert r.returncode == 0, r.stderr[-2000:]
     result = json.loads(r.stdout)
     assert result["start_survived"] == 0

@@ -197,8 +197,13 @@ def test_gamepad_drives_and_its_disconnect_stops(panel: tuple[PanelController, s
     controller, base = panel
     page, errors = open_page(browser, base, PHONE, init=FAKE_PAD)
     try:
+        controller.set_params({"speed": 0.5})
         pad_event(page, "gamepadconnected")
         expect(page.locator("#pad")).to_contain_text("Test pad")
+        # The page ignores buttons held when the pad connects until it has polled them
+        # released; its first poll also sends the centred sticks (speed 0): wait for that,
+        # or a busy machine can put the press before the first poll and it is swallowed.
+        assert wait_for(lambda: controller.params.speed == 0, 5.0), controller.params.speed
         set_pad(page, [0, 0, 0, 0], buttons=(0,))  # A: start
         assert wait_for(lambda: controller.running and controller.state()["state"]
                         == "walking", 10.0)

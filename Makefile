@@ -29,8 +29,10 @@ system-deps:
 	  if [ "$$(id -u)" = 0 ]; then apt-get update -q && apt-get install -y -q $(SYSTEM_PKGS); \
 	  else sudo apt-get update -q && sudo apt-get install -y -q $(SYSTEM_PKGS); fi; }
 
+# Two workers (the machine's two cores), a test file per worker at a time: module fixtures
+# (a panel, a browser) are built once, and half the tests wait on a pty or a socket.
 unit: $(STAMP) system-deps
-	MUJOCO_GL=egl $(BIN)/python -m pytest
+	MUJOCO_GL=egl $(BIN)/python -m pytest -n 2 --dist loadfile
 
 # The wheel, installed (not editable) into a fresh venv and run from a directory outside
 # the checkout: proves the package ships everything it needs (configs, panel files, the

@@ -1,8 +1,10 @@
-"""`biped export`: the motion as BVH for Blender, Maya or any previs tool.
+"""`biped export`: the motion as BVH or glTF for Blender, Maya or any previs tool.
 
 ``--gait NAME --seconds S``: the gait at constant parameters (the paper's steady cycle,
 evaluated directly, no ramp), ``--take FILE``: a recorded take's joint stream (as it went
-to the servos, ramps and rest included). Skeleton, axes and units: robot/bvh.py.
+to the servos, ramps and rest included). The format follows ``--out``: ``.bvh``, or
+``.glb`` / ``.gltf`` (a skinned glTF 2.0 animation, metres). Skeleton, axes and units:
+robot/bvh.py and robot/gltf.py.
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ from robot.commands.common import (
 from robot.config import DEFAULT_ROBOT_NAME, load_robot
 from robot.engine import GaitEngine
 from robot.errors import ConfigError
+from robot.gltf import SUFFIXES as GLTF_SUFFIXES
+from robot.gltf import write_gltf
 from robot.takes import SUFFIX, is_take, read_take
 
 #: Most frames written (an hour at 60 fps).
@@ -34,7 +38,7 @@ MAX_FRAMES = 216_000
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
-    p = sub.add_parser("export", help="write the gait or a take as BVH (previs)",
+    p = sub.add_parser("export", help="write the gait or a take as BVH or glTF (previs)",
                        description=__doc__.split("\n\n")[0])
     add_robot_args(p)
     p.add_argument("--take", default=None, metavar=f"FILE{SUFFIX}",
@@ -42,15 +46,19 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--seconds", type=seconds, default=10.0, help="gait duration [s]")
     p.add_argument("--fps", type=bounded_float(1.0, 240.0, "frame/s", what="a frame rate"),
                    default=30.0, help="frames per second (default: %(default)s)")
-    p.add_argument("--units", choices=sorted(UNITS), default="cm",
-                   help="length unit of the skeleton (default: %(default)s)")
-    p.add_argument("--out", required=True, type=output_file, metavar="FILE.bvh")
+    p.add_argument("--units", choices=sorted(UNITS), default=None,
+                   help="length unit of a BVH skeleton (default: cm; glTF is always m)")
+    p.add_argument("--out", required=True, type=output_file, metavar="FILE.bvh|.glb|.gltf")
     return one_line_errors(p)
 
 
 def run(args: argparse.Namespace) -> int:
-    if not args.out.endswith(".bvh"):
-        raise ConfigError(f"--out {args.out}: expected a .bvh file")
+    suffix = Path(args.out).suffix
+    if suffix not in (".bvh", *GLTF_SUFFIXES):
+        raise ConfigError(f"--out {args.out}: expected a .bvh, .glb or .gltf file")
+    if suffix != ".bvh" and args.units not in (None, "m"):
+        raise ConfigError(f"--units {args.units}: glTF lengths are metres; leave --units out "
+                          f"for {args.out}")
     if args.take:
         checked("--take", input_file, args.take)
         if not is_take(args.take):
@@ -66,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
             raise ConfigError(f"--take {args.take}: fewer than two ticks recorded")
         t = np.arange(len(take.t)) / take.header.rate_hz
         q = resample(t, take.q, args.fps)
-        what = f"take {args.take}"
+        what, label = f"take {args.take}", Path(args.take).name.removesuffix(SUFFIX)
     else:
         n = int(round(args.seconds * args.fps)) + 1
         if n > MAX_FRAMES:
@@ -77,8 +85,13 @@ def run(args: argparse.Namespace) -> int:
         _, qt = GaitEngine(robot, gait.params).curves(np.arange(n) / args.fps,
                                                       with_channels=False)
         q = qt.T
-        what = f"gait {gait.name}"
-    frames = write_bvh(args.out, robot, q, 1.0 / args.fps, units=args.units)
+        what, label = f"gait {gait.name}", gait.name
+    if suffix == ".bvh":
+        units = args.units or "cm"
+        frames = write_bvh(args.out, robot, q, 1.0 / args.fps, units=units)
+    else:
+        units = "m"
+        frames = write_gltf(args.out, robot, q, 1.0 / args.fps, name=label)
     print(f"wrote {args.out}: {frames} frames at {args.fps:g} fps of {what} on {robot.name} "
-          f"({args.units})")
+          f"({units})")
     return 0

@@ -304,17 +304,19 @@ def test_reboot_clears_a_latched_hardware_error(dlink: Link) -> None:
 
 
 def test_return_delay_slows_the_answer(dlink: Link) -> None:
-    def median_ping_s(n: int = 15) -> float:
+    # The fastest of many pings: a busy machine only ever adds time, so the minimum is the
+    # floor with and without the delay (a median moved with the load of other tests).
+    def fastest_ping_s(n: int = 30) -> float:
         times = []
         for _ in range(n):
             t = time.perf_counter()
             assert dlink.ping(5)[1] == 0
             times.append(time.perf_counter() - t)
-        return sorted(times)[n // 2]
+        return min(times)
 
-    fast = median_ping_s()
+    fast = fastest_ping_s()
     dlink.emu.set_register(5, "return_delay_time", 250)  # 500 µs
-    assert median_ping_s() - fast > 0.0003
+    assert fastest_ping_s() - fast > 0.0003
 
 
 def test_status_return_level_zero_answers_ping_only(dlink: Link) -> None:

@@ -168,3 +168,23 @@ def test_gltf_refuses_centimetres(tmp_path: Path, capsys: pytest.CaptureFixture[
     assert not out.exists()
     assert cli.main(["export", "--out", str(tmp_path / "x.fbx")]) == 2
     assert "expected a .bvh, .glb or .gltf" in capsys.readouterr().err
+
+
+def test_legs_only_robot_has_no_arm_nodes_and_matches_its_bvh(tmp_path: Path) -> None:
+    glb, bvh = tmp_path / "legs.glb", tmp_path / "legs.bvh"
+    for out in (glb, bvh):
+        assert cli.main(["export", "--robot", "biped12-legs", "--gait", "walk", "--seconds",
+                         "1", "--out", str(out)]) == 0
+    doc = gl.GLTF2().load(str(glb))
+    assert doc is not None
+    names = {n.name for n in doc.nodes}
+    assert not names & {"chest", "r_shoulder", "l_elbow"}
+    rotated = {doc.nodes[c.target.node].name for c in doc.animations[0].channels
+               if c.target.path == "rotation"}
+    assert rotated == {n for n in ROTATIONS if n[2:] in ("hip", "knee", "ankle")}
+    tree = bvhio.readAsHierarchy(str(bvh))
+    for f in (0, 10, 30):
+        tree.loadPose(f)
+        got = world_positions(doc, f)
+        for j, _, _ in tree.layout():
+            assert got[j.Name] == pytest.approx(np.array(j.PositionWorld) / 100, abs=2e-5)

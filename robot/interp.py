@@ -17,6 +17,8 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from robot import ramp
+
 Array = npt.NDArray[np.float64]
 METHODS = ("min_jerk", "smooth")
 
@@ -33,9 +35,7 @@ def min_jerk(times: Array, values: Array, t: Array) -> Array:
     if len(times) == 1:
         return np.repeat(values[:1], len(t), axis=0)
     i, t0, h = _segment(times, t)
-    s = np.clip((t - t0) / h, 0.0, 1.0)[:, None]
-    blend = s * s * s * (10.0 + s * (-15.0 + 6.0 * s))
-    return values[i] + (values[i + 1] - values[i]) * blend
+    return values[i] + (values[i + 1] - values[i]) * ramp.min_jerk((t - t0) / h)[:, None]
 
 
 def _slopes(times: Array, values: Array) -> Array:

@@ -35,7 +35,7 @@ import numpy.typing as npt
 from robot.config import RobotConfig
 from robot.errors import ConfigError
 from robot.interp import METHODS, interpolate
-from robot.toml_io import read_toml, show
+from robot.toml_io import number, read_toml, show
 
 SUFFIXES = (".toml", ".json")
 #: Sampling step [s] of the speed check.
@@ -76,12 +76,6 @@ class Sequence:
                         self.times, self.poses, strict=True)]}
 
 
-def _number(where: str, v: Any) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise ConfigError(f"{where}: expected a number, got {show(v)}")
-    return float(v)
-
-
 def parse_sequence(data: Mapping[str, Any], robot: RobotConfig, *,
                    source: str = "<memory>") -> Sequence:
     """A validated Sequence for ``robot`` (ConfigError, one line, on any problem)."""
@@ -116,7 +110,7 @@ def parse_sequence(data: Mapping[str, Any], robot: RobotConfig, *,
             raise ConfigError(f"{where}: expected a table of t and joint angles")
         if "t" not in frame:
             raise ConfigError(f"{where}: t: missing (seconds from the start)")
-        t = _number(f"{where}.t", frame["t"])
+        t = number(src, f"keyframe[{i}].t", frame["t"])
         if not 0.0 <= t <= MAX_SECONDS:
             raise ConfigError(f"{where}.t: {t:g} is outside [0, {MAX_SECONDS:g}] s")
         if times and t <= times[-1]:
@@ -138,7 +132,7 @@ def parse_sequence(data: Mapping[str, Any], robot: RobotConfig, *,
                               f"same joints ({', '.join(joints)})")
         pose = []
         for n in joints:
-            q = _number(f"{where}.{n}", frame[n])
+            q = number(src, f"keyframe[{i}].{n}", frame[n])
             j = valid[n]
             if not j.min_rad <= q <= j.max_rad:
                 raise ConfigError(f"{where}.{n}: {q:g} rad is outside the joint limits "

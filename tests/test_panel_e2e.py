@@ -8,54 +8,26 @@ from __future__ import annotations
 
 import re
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 
 import numpy as np
 import pytest
-from playwright.sync_api import Browser, Page, expect, sync_playwright
+from panel_harness import served_panel, wait_for
+from playwright.sync_api import Browser, Page, expect
 
 from robot.config import DEFAULT_ROBOT, load_gait, load_robot
 from robot.panel.controller import LoopOptions, PanelController, make_controller
 from robot.panel.server import build_server, panel_url, serve_in_thread
 from sim.mujoco_bus import MujocoBus
 
-CHROMIUM = "/usr/bin/chromium"
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-        "--disable-background-networking", "--disable-component-update", "--disable-sync"]
-
-
-def wait_for(pred: Callable[[], bool], timeout: float = 10.0) -> bool:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if pred():
-            return True
-        time.sleep(0.02)
-    return False
+pytest_plugins = ("panel_harness",)  # the browser fixture
 
 
 @pytest.fixture(scope="module")
 def running() -> Iterator[tuple[PanelController, str]]:
-    robot = load_robot(DEFAULT_ROBOT)
-    controller = make_controller(robot, MujocoBus(robot, realtime=True),
-                                 load_gait("walk").params,
-                                 options=LoopOptions(rate_hz=100.0, read_every=5),
-                                 preset="walk")
-    server = build_server(controller, port=0)
-    _, base = serve_in_thread(server)
-    controller.start()
-    yield controller, base
-    server.shutdown()
-    server.server_close()
-    controller.emergency_stop()
-    controller.shutdown()
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Browser]:
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        yield b
-        b.close()
+    with served_panel() as (controller, base):
+        controller.start()
+        yield controller, base
 
 
 @pytest.fixture(scope="module")

@@ -7,24 +7,18 @@ the keyboard drive the running loop, and a gamepad that disconnects stops the wa
 from __future__ import annotations
 
 import re
-import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from playwright.sync_api import Browser, Page, expect, sync_playwright
+from panel_harness import served_panel, wait_for
+from playwright.sync_api import Browser, Page, expect
 
-from robot.config import DEFAULT_ROBOT, load_gait, load_robot
-from robot.panel.controller import LoopOptions, PanelController, make_controller
+from robot.panel.controller import PanelController
 from robot.panel.labels import LABELS
-from robot.panel.server import build_server, serve_in_thread
-from robot.panel.studio import Studio
 from robot.params import SPECS
 from sim.mujoco_bus import MujocoBus
 
-CHROMIUM = "/usr/bin/chromium"
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-        "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 PHONE = {"width": 390, "height": 844}
 DESKTOP = {"width": 1400, "height": 950}
 MIN_TOUCH_PX = 48
@@ -38,40 +32,13 @@ window.__pads = [];
 navigator.getGamepads = () => window.__pads;
 """
 
-
-def wait_for(pred: Callable[[], bool], timeout: float = 10.0) -> bool:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if pred():
-            return True
-        time.sleep(0.02)
-    return False
+pytest_plugins = ("panel_harness",)  # the browser fixture
 
 
 @pytest.fixture(scope="module")
 def panel(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[PanelController, str]]:
-    robot = load_robot(DEFAULT_ROBOT)
-    controller = make_controller(robot, MujocoBus(robot, realtime=True),
-                                 load_gait("walk").params,
-                                 options=LoopOptions(rate_hz=100.0, read_every=5),
-                                 preset="walk")
-    tmp = tmp_path_factory.mktemp("studio")
-    server = build_server(controller, port=0, studio=Studio(
-        controller, takes_dir=tmp / "takes", keys_dir=tmp / "keys"))
-    _, base = serve_in_thread(server)
-    yield controller, base
-    server.shutdown()
-    server.server_close()
-    controller.emergency_stop()
-    controller.shutdown()
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Browser]:
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        yield b
-        b.close()
+    with served_panel(studio_dir=tmp_path_factory.mktemp("studio")) as served:
+        yield served
 
 
 def open_page(browser: Browser, base: str, viewport: dict[str, int], *,

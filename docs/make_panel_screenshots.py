@@ -14,11 +14,11 @@ from pathlib import Path
 
 from playwright.sync_api import sync_playwright
 
-from robot.config import DEFAULT_ROBOT, load_gait, load_robot
+from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
 from robot.panel.controller import LoopOptions, make_controller
 from robot.panel.server import build_server, serve_in_thread
 from robot.panel.studio import Studio
-from sim.mujoco_bus import MujocoBus
+from sim.mujoco.bus import MujocoBus
 
 CHROMIUM = "/usr/bin/chromium"
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu"]

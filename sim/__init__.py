@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from robot.bus.base import Bus
-    from robot.config import RobotConfig
+    from robot.config.robot_file import RobotConfig
 
 if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
     os.environ.setdefault("MUJOCO_GL", "egl")
@@ -21,6 +21,6 @@ def open_bus(robot: RobotConfig, *, port: str | None = None, baud: int | None = 
              **options: Any) -> Bus:
     """The ``sim`` bus plugin (entry point group ``biped.buses``, see pyproject.toml): a
     MuJoCo bus for ``robot``; ``port`` and ``baud`` do not apply to it and are ignored."""
-    from sim.mujoco_bus import MujocoBus
+    from sim.mujoco.bus import MujocoBus
 
     return MujocoBus(robot, **options)

@@ -14,8 +14,8 @@ import pytest
 
 from robot.bus.factory import make_bus
 from robot.bus.sdk_bus import SdkBus
-from robot.config import ROBOTS_DIR, RobotConfig, load_robot
-from sim.emulator import Emulator
+from robot.config.robot_file import ROBOTS_DIR, RobotConfig, load_robot
+from sim.emulator.chain import Emulator
 
 PROTOCOLS = ("dynamixel", "feetech")
 HANG_LIMIT_S = 30

@@ -8,7 +8,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")  # headless: before anything imports m
 
 import pytest
 
-from robot.config import GAITS_DIR, ROBOTS_DIR, Gait, RobotConfig, load_gait, load_robot
+from robot.config.robot_file import GAITS_DIR, ROBOTS_DIR, Gait, RobotConfig, load_gait, load_robot
 
 ROBOT_FILES = sorted(p.name for p in ROBOTS_DIR.glob("*.toml"))
 GAIT_FILES = sorted(p.stem for p in GAITS_DIR.glob("*.toml"))

@@ -1,7 +1,7 @@
 """Arm IK at and near its singularities (issue 8, item 7), tested by invariants.
 
 The arm is shoulder pitch (y), roll (x), elbow (y); u = upper arm, f = forearm [m]. Facts
-used here, derived by hand (not taken from robot.ik): the hand is Ry(pitch) Rx(roll) h
+used here, derived by hand (not taken from robot.gait.ik): the hand is Ry(pitch) Rx(roll) h
 with h = (-f sin e, 0, -u - f cos e) in the elbow's plane, so |hand| = |h| = d and the
 roll can move the hand out of the xz-plane by at most |h_z|. With the law of cosines
 that bounds the lateral reach at distance d to |y| <= |d^2 + u^2 - f^2| / (2u), which is
@@ -22,11 +22,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_engine import DT, cycles
 
-from robot import gait
-from robot.config import Gait, Geometry, RobotConfig, load_gait, load_robot
-from robot.engine import GaitEngine, solve
-from robot.ik import arm_fk_local, arm_ik
-from robot.targets import HAND_OUT, body_targets
+from robot.config.robot_file import Gait, Geometry, RobotConfig, load_gait, load_robot
+from robot.gait import expressions as gait
+from robot.gait.engine import GaitEngine, solve
+from robot.gait.ik import arm_fk_local, arm_ik
+from robot.gait.targets import HAND_OUT, body_targets
 
 BASE = load_robot().geometry          # upper_arm 0.08 < forearm 0.09, like both shipped
 EXACT = 1e-9                          # FK(IK(x)) == x on the workspace [m]

@@ -22,10 +22,10 @@ import numpy as np
 import pytest
 
 import robot.cli as cli
-from robot.config import ROBOTS_DIR, load_robot
+from robot.config.robot_file import ROBOTS_DIR, load_robot
 from robot.errors import ConfigError
-from robot.ramp import ramp, ramp_duration
-from sim.emulator import Emulator
+from robot.motion.ramp import ramp, ramp_duration
+from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
 

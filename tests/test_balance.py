@@ -1,5 +1,5 @@
 """The balance loop's sign conventions and state, checked against forward kinematics
-(robot.ik.leg_fk_full) and hand computations, not against the loop itself."""
+(robot.gait.ik.leg_fk_full) and hand computations, not against the loop itself."""
 
 from __future__ import annotations
 
@@ -8,8 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from robot import xmath as xm
-from robot.balance import (
+from robot.balance.stage import (
     Attitude,
     Balance,
     BalanceState,
@@ -19,11 +18,12 @@ from robot.balance import (
     balance_step,
     wrap,
 )
-from robot.config import load_gait, load_robot
-from robot.engine import GaitEngine
-from robot.ik import leg_fk_full
-from robot.params import BALANCE, SPECS, GaitParams
-from robot.targets import BodyTrim
+from robot.config.params import BALANCE, SPECS, GaitParams
+from robot.config.robot_file import load_gait, load_robot
+from robot.gait import xmath as xm
+from robot.gait.engine import GaitEngine
+from robot.gait.ik import leg_fk_full
+from robot.gait.targets import BodyTrim
 
 DT = 0.005
 LEVEL = Attitude(roll=0.0, pitch=0.0, roll_rate=0.0, pitch_rate=0.0, yaw_rate=0.0, heading=0.0)

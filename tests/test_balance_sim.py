@@ -7,13 +7,13 @@ import math
 
 import pytest
 
-from robot.balance import Balance, attitude_reader
-from robot.config import load_gait, load_robot
-from robot.engine import GaitEngine
+from robot.balance.stage import Balance, attitude_reader
+from robot.bus.servo_map import ServoMap
+from robot.config.robot_file import load_gait, load_robot
+from robot.gait.engine import GaitEngine
 from robot.imu import open_imu
-from robot.servo_map import ServoMap
-from robot.streamer import Streamer, Telemetry
-from sim.mujoco_bus import MujocoBus
+from robot.loop.streamer import Streamer, Telemetry
+from sim.mujoco.bus import MujocoBus
 
 YAW_TORQUE_NM = 1.2      # about the torso's z axis, for YAW_PUSH_S [N*m]
 YAW_PUSH_S = 0.1

@@ -1,5 +1,5 @@
-"""Capture-point stepping and the brace of the balance law (robot.balance_law), and the
-learned gait rhythm (robot.rhythm): signs and sizes computed by hand from the inverted
+"""Capture-point stepping and the brace of the balance law (robot.balance.law), and the
+learned gait rhythm (robot.balance.rhythm): signs and sizes computed by hand from the inverted
 pendulum (capture point = h * (tilt + tilt rate / sqrt(g / h))), not by the law."""
 
 from __future__ import annotations
@@ -9,19 +9,19 @@ import math
 import numpy as np
 import pytest
 
-from robot.balance import Balance
-from robot.balance_law import (
+from robot.balance.law import (
     LEARNED,
     Attitude,
     BalanceState,
     GaitPhase,
     balance_step,
 )
-from robot.config import load_gait, load_robot
-from robot.engine import GaitEngine
-from robot.ik import leg_fk_full
-from robot.params import GaitParams
-from robot.rhythm import BINS, Rhythm
+from robot.balance.rhythm import BINS, Rhythm
+from robot.balance.stage import Balance
+from robot.config.params import GaitParams
+from robot.config.robot_file import load_gait, load_robot
+from robot.gait.engine import GaitEngine
+from robot.gait.ik import leg_fk_full
 
 DT = 0.005
 H = 0.23                       # pendulum length of the test [m]
@@ -146,7 +146,7 @@ def test_a_forward_step_puts_the_foot_ahead_in_the_leg_fk() -> None:
     robot = load_robot("biped18-dynamixel")
     engine = GaitEngine(robot, load_gait("walk").params)
     q0 = np.array(engine.start_pose())
-    from robot.targets import BodyTrim
+    from robot.gait.targets import BodyTrim
     engine.trim = BodyTrim(r_dx=0.02)
     q1 = np.array(engine.start_pose())
     names = robot.joint_names
@@ -198,8 +198,8 @@ def test_braced_the_engine_holds_its_phase_with_both_feet_down() -> None:
 
 
 def _sole_heights(engine: GaitEngine) -> tuple[float, float]:
-    from robot import gait
-    from robot.targets import body_targets
+    from robot.gait import expressions as gait
+    from robot.gait.targets import body_targets
     ch = gait.channels(engine.phase, engine.live_params, amplitude=engine.amplitude)
     t = body_targets(ch, engine.live_params, engine.robot.geometry,
                      amplitude=engine.amplitude, trim=engine.trim)

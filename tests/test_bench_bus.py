@@ -1,8 +1,8 @@
-"""robot.bench_bus runs end to end and counts wire bytes exactly (no timing assertions)."""
+"""robot.bench.bus runs end to end and counts wire bytes exactly (no timing assertions)."""
 
 from __future__ import annotations
 
-from robot.bench_bus import run_bus_bench
+from robot.bench.bus import run_bus_bench
 
 pytest_plugins = ("bus_harness",)
 

@@ -3,7 +3,7 @@ for both robots, open loop and with balance (values are measured, never asserted
 
 from __future__ import annotations
 
-from robot.bench_sim import run_sim_bench
+from robot.bench.sim import run_sim_bench
 
 
 def test_the_sim_bench_reports_every_configuration() -> None:

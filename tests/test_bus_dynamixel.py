@@ -8,7 +8,7 @@ import pytest
 from robot.bus.sdk_bus import SdkBus
 from robot.bus.tables import DYNAMIXEL_X
 from robot.errors import BusError
-from sim.emulator import Emulator
+from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
 

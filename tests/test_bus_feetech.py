@@ -8,7 +8,7 @@ import scservo_sdk
 
 from robot.bus.sdk_bus import SdkBus
 from robot.bus.tables import MODELS
-from sim.emulator import Emulator
+from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
 

@@ -9,11 +9,11 @@ import pytest
 
 from robot.bus import health
 from robot.bus.sdk_bus import SdkBus
+from robot.bus.servo_map import ServoMap
 from robot.bus.tables import MODELS, TABLES
-from robot.config import RobotConfig
+from robot.config.robot_file import RobotConfig
 from robot.errors import BusError
-from robot.servo_map import ServoMap
-from sim.emulator import Emulator
+from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
 Factory = Callable[..., SdkBus]

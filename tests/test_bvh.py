@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 import robot.cli as cli
-from robot.config import DEFAULT_ROBOT, load_gait, load_robot
-from robot.engine import GaitEngine
-from robot.ik import arm_fk_local, leg_fk_full, shoulder_centre
-from robot.takes import read_take
+from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
+from robot.gait.engine import GaitEngine
+from robot.gait.ik import arm_fk_local, leg_fk_full, shoulder_centre
+from robot.motion.takes import read_take
 
 FPS = 30.0
 

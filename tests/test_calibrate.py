@@ -11,7 +11,11 @@ from pathlib import Path
 import pytest
 
 import robot.cli as cli
-from robot.calibration import (
+from robot.commands import calibrate
+from robot.config.robot_file import RobotConfig, load_robot
+from robot.config.toml_edit import edit_joints
+from robot.errors import ConfigError
+from robot.setup.calibration import (
     detect_sign,
     direction_words,
     hardware_range,
@@ -20,11 +24,7 @@ from robot.calibration import (
     wrapped_delta,
     zero_ticks,
 )
-from robot.commands import calibrate
-from robot.config import RobotConfig, load_robot
-from robot.errors import ConfigError
-from robot.robot_toml_edit import edit_joints
-from sim.emulator import Emulator
+from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
 

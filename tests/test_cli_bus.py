@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 import robot.cli as cli
-from robot.config import RobotConfig, load_robot
-from robot.servo_map import ServoMap
-from sim.emulator import Emulator
+from robot.bus.servo_map import ServoMap
+from robot.config.robot_file import RobotConfig, load_robot
+from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
 

@@ -16,7 +16,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from robot.bus.limits import TickLimits
-from robot.config import (
+from robot.bus.servo_map import ServoMap
+from robot.config.params import ALIASES, SPECS, GaitParams
+from robot.config.robot_file import (
     ARM_NAMES,
     ROBOTS_DIR,
     Gait,
@@ -28,8 +30,6 @@ from robot.config import (
     parse_robot,
 )
 from robot.errors import BipedError, BusError, ConfigError
-from robot.params import ALIASES, SPECS, GaitParams
-from robot.servo_map import ServoMap
 
 BASE_ROBOT = (ROBOTS_DIR / "biped18-dynamixel.toml").read_text()
 BASE = load_robot(ROBOTS_DIR / "biped18-dynamixel.toml")

@@ -13,8 +13,8 @@ import pytest
 from test_gait import CHANNEL_NAMES, close, printed
 
 from robot.cli import main
-from robot.config import DEFAULT_ROBOT, ROBOTS_DIR, gait_names, load_gait, load_robot
-from robot.engine import GaitEngine
+from robot.config.robot_file import DEFAULT_ROBOT, ROBOTS_DIR, gait_names, load_gait, load_robot
+from robot.gait.engine import GaitEngine
 
 
 def read_csv(path: Path) -> tuple[list[str], np.ndarray]:

@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 from test_gait import EQUATIONS
 
-from robot import docs_gen
-from robot.config import gait_names
-from robot.params import ALIASES, SPECS
+from robot.config import docs_gen
+from robot.config.params import ALIASES, SPECS
+from robot.config.robot_file import gait_names
 
 DOC = docs_gen.DOC
 TEXT = DOC.read_text()
@@ -22,7 +22,7 @@ def section(begin: str, end: str) -> str:
 
 
 def test_parameter_table_is_generated_from_specs() -> None:
-    assert docs_gen.render(TEXT) == TEXT, "run: python -m robot.docs_gen"
+    assert docs_gen.render(TEXT) == TEXT, "run: python -m robot.config.docs_gen"
 
 
 def test_parameter_table_has_every_parameter_once() -> None:

@@ -1,4 +1,4 @@
-"""sim.effort: energy and knee load from actuator forces and joint rates, checked against
+"""sim.mujoco.effort: energy and knee load from actuator forces and joint rates, checked against
 hand-computed sums on set values, and on the real walk's summary."""
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from robot import cli
-from robot.config import load_robot
-from sim.effort import EffortMonitor
-from sim.mjcf import build_mjcf
+from robot.config.robot_file import load_robot
+from sim.mujoco.effort import EffortMonitor
+from sim.mujoco.mjcf import build_mjcf
 
 
 def test_energy_and_knee_load_are_the_hand_sums() -> None:

@@ -25,9 +25,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from robot.bus.tables import DYNAMIXEL_X, ERROR_BITS, FEETECH_STS
-from robot.config import load_robot
-from sim import dxl_protocol, sts_protocol
-from sim.emulator import Emulator, EmulatorError
+from robot.config.robot_file import load_robot
+from sim.emulator import dxl_protocol, sts_protocol
+from sim.emulator.chain import Emulator, EmulatorError
 
 ROOT = Path(__file__).resolve().parent.parent
 TEST_TIMEOUT_S = 20.0

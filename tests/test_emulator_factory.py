@@ -21,7 +21,7 @@ import dynamixel_sdk as dxl
 import pytest
 import scservo_sdk as scs
 
-from sim.emulator import Emulator, EmulatorError
+from sim.emulator.chain import Emulator, EmulatorError
 
 ROOT = Path(__file__).resolve().parent.parent
 X_ID, X_BAUD, X_DELAY, X_TORQUE = 7, 8, 9, 64

@@ -1,5 +1,5 @@
 """The driver's control tables (robot/bus/tables.py) against the emulator's own
-transcription of the manuals (sim/control_tables.py): every register the driver uses has
+transcription of the manuals (sim/emulator/control_tables.py): every register the driver uses has
 the same address and size in both, and the manuals' initial values are served."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ from __future__ import annotations
 import pytest
 
 from robot.bus import tables as driver
-from sim import control_tables as manual
-from sim.emulated_servo import EmulatedServo, ServoSpec
+from sim.emulator import control_tables as manual
+from sim.emulator.servo import EmulatedServo, ServoSpec
 
 
 @pytest.mark.parametrize("family", sorted(driver.TABLES))

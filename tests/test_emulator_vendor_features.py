@@ -19,7 +19,7 @@ import dynamixel_sdk as dxl
 import pytest
 import scservo_sdk as scs
 
-from sim.emulator import Emulator
+from sim.emulator.chain import Emulator
 
 BAUD = 1_000_000
 IDS = [1, 2, 3]

@@ -13,12 +13,12 @@ import pytest
 from bus_harness import open_bus
 
 import robot.cli as cli
-from robot.config import RobotConfig, load_gait
-from robot.engine import GaitEngine
-from robot.latency import SampleStats
-from robot.servo_map import ServoMap
-from robot.streamer import Streamer
-from sim.emulator import Emulator
+from robot.bus.servo_map import ServoMap
+from robot.config.robot_file import RobotConfig, load_gait
+from robot.gait.engine import GaitEngine
+from robot.loop.latency import SampleStats
+from robot.loop.streamer import Streamer
+from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
 

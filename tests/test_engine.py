@@ -10,12 +10,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robot import gait
-from robot.config import Gait, RobotConfig, load_gait, load_robot
-from robot.engine import GaitEngine, solve
-from robot.ik import leg_fk_full
-from robot.params import SPECS, GaitParams
-from robot.targets import BodyTargets, body_targets, scale
+from robot.config.params import SPECS, GaitParams
+from robot.config.robot_file import Gait, RobotConfig, load_gait, load_robot
+from robot.gait import expressions as gait
+from robot.gait.engine import GaitEngine, solve
+from robot.gait.ik import leg_fk_full
+from robot.gait.targets import BodyTargets, body_targets, scale
 
 RATE = 200.0
 DT = 1.0 / RATE
@@ -286,7 +286,7 @@ def test_steering_follows_a_live_change_at_a_bounded_rate() -> None:
     """A live speed reversal -1 -> +0.3 passes through zero at STEER_RATE, not in one
     first-order step; turn and side_step likewise; other parameters keep PARAM_TAU_S.
     (0.3 / 1.5 + 0.2 / 0.5 + 0.015 / 0.025 = 1.2: inside the steering budget.)"""
-    from robot.engine import STEER_RATE
+    from robot.gait.engine import STEER_RATE
 
     robot = load_robot("biped18-dynamixel")
     engine = GaitEngine(robot, load_gait("walk").params.replace({"speed": -1.0}))

@@ -24,9 +24,9 @@ import pytest
 from robot.bus.base import Bus
 from robot.bus.sdk_bus import SdkBus
 from robot.bus.tables import TABLES
-from robot.config import RobotConfig
+from robot.config.robot_file import RobotConfig
 from robot.errors import BusError, ConfigError
-from sim.emulator import Emulator, Packet
+from sim.emulator.chain import Emulator, Packet
 
 pytest_plugins = ("bus_harness",)
 Factory = Callable[..., SdkBus]
@@ -124,7 +124,7 @@ def test_invalid_timeouts_are_refused_before_anything_is_written(
 
 
 def test_sim_bus_has_no_failsafe(robot: RobotConfig) -> None:
-    from sim.mujoco_bus import MujocoBus
+    from sim.mujoco.bus import MujocoBus
 
     sim: Bus = MujocoBus(robot)
     assert sim.arm_failsafe(robot.ids, timeout_s=TIMEOUT_S) is None
@@ -151,7 +151,7 @@ class Child:
     SCRIPT = """
 import sys, time
 from robot.bus.factory import make_bus
-from robot.config import ROBOTS_DIR, load_robot
+from robot.config.robot_file import ROBOTS_DIR, load_robot
 protocol, port, timeout_s, knee_id, knee = sys.argv[1:6]
 robot = load_robot(ROBOTS_DIR / f"biped18-{protocol}.toml")
 bus = make_bus(protocol, robot=robot, port=port, timeout_ms=50.0)

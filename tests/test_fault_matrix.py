@@ -29,8 +29,8 @@ import numpy as np
 import pytest
 
 import robot.cli as cli
-from robot.config import RobotConfig
-from sim.emulator import Emulator, Packet
+from robot.config.robot_file import RobotConfig
+from sim.emulator.chain import Emulator, Packet
 
 pytest_plugins = ("bus_harness",)
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from robot.commands.find_port import run
-from robot.serial_ports import (
+from robot.setup.serial_ports import (
     FAKE_PORTS_ENV,
     PortSearchError,
     SerialPort,

@@ -18,8 +18,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robot import gait
-from robot.params import SPECS, GaitParams
+from robot.config.params import SPECS, GaitParams
+from robot.gait import expressions as gait
 
 # (eq, channel, expression) exactly as in equations.md, in table order.
 EQUATIONS: tuple[tuple[str, str, str], ...] = (

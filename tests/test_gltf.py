@@ -16,9 +16,9 @@ import pytest
 from test_bvh import ROTATIONS  # glTF's axes are BVH's: X left, Y up, Z forward
 
 import robot.cli as cli
-from robot.config import DEFAULT_ROBOT, load_gait, load_robot
-from robot.engine import GaitEngine
-from robot.takes import read_take
+from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
+from robot.gait.engine import GaitEngine
+from robot.motion.takes import read_take
 
 FPS = 30.0
 #: Components per element, by accessor type (glTF 2.0, 3.6.2.1).

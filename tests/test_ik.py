@@ -16,10 +16,10 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robot import xmath as xm
-from robot.config import Geometry, load_robot
-from robot.ik import arm_fk, arm_fk_local, arm_ik, hip_centre, leg_fk, leg_fk_full, leg_ik
-from robot.xmath import Rot, Vec
+from robot.config.robot_file import Geometry, load_robot
+from robot.gait import xmath as xm
+from robot.gait.ik import arm_fk, arm_fk_local, arm_ik, hip_centre, leg_fk, leg_fk_full, leg_ik
+from robot.gait.xmath import Rot, Vec
 
 BASE = load_robot().geometry
 LEG_LO = np.array([-0.6, -0.5, -1.7, 0.15, -1.2, -0.5])   # knee > 0: away from straight

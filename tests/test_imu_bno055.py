@@ -1,5 +1,5 @@
 """The BNO055 driver through the real adafruit library, at the wire: a fake BNO055 on a
-pty (sim/bno055_emulator.py, written from the datasheet) holds values the tests set, the
+pty (sim/emulator/bno055.py, written from the datasheet) holds values the tests set, the
 driver must read them back within one LSB; faults end in one ImuError line naming the
 port, never a hang."""
 
@@ -13,7 +13,7 @@ import pytest
 
 from robot.imu import ImuConfig, ImuError, open_imu
 from robot.imu.frames import quat_from_rpy
-from sim.bno055_emulator import P0, FakeBno055
+from sim.emulator.bno055 import P0, FakeBno055
 
 GYRO_LSB = math.radians(1 / 16)   # 16 LSB per dps (datasheet Table 3-22)
 ACCEL_LSB = 1 / 100               # 100 LSB per m/s^2 (Table 3-17)

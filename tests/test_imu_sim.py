@@ -9,12 +9,12 @@ import mujoco
 import numpy as np
 import pytest
 
-from robot.config import RobotConfig, load_robot
+from robot.config.robot_file import RobotConfig, load_robot
 from robot.errors import ConfigError
 from robot.imu import ImuConfig, ImuError, TiltEstimator, open_imu, tilt_from_accel, tilt_from_quat
 from robot.imu.frames import quat_conj, quat_from_rpy, quat_rotate
-from sim.imu import ACCEL_SIGMA, GYRO_SIGMA, SimImu
-from sim.mujoco_bus import MujocoBus
+from sim.mujoco.bus import MujocoBus
+from sim.mujoco.imu import ACCEL_SIGMA, GYRO_SIGMA, SimImu
 
 EXACT = ImuConfig(kind="sim", noise=0.0, bias=0.0, latency_ms=0.0)
 

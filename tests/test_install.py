@@ -20,7 +20,7 @@ import pytest
 from robot.bus.base import Bus
 from robot.bus.factory import ENTRY_POINT_GROUP, bus_kinds, make_bus, register_bus
 from robot.cli import main
-from robot.config import (
+from robot.config.robot_file import (
     DEFAULT_ROBOT,
     GAITS_DIR,
     ROBOTS_DIR,
@@ -72,9 +72,9 @@ def test_wheel_ships_bundled_robots_and_presets(wheel_files: set[str]) -> None:
 
 
 def test_wheel_ships_panel_static_files_and_typing_marker(wheel_files: set[str]) -> None:
-    static = REPO / "robot" / "panel_static"
+    static = REPO / "robot" / "panel" / "static"
     for p in sorted(static.iterdir()):
-        assert f"robot/panel_static/{p.name}" in wheel_files, p.name
+        assert f"robot/panel/static/{p.name}" in wheel_files, p.name
     assert {"robot/py.typed", "sim/py.typed"} <= wheel_files
 
 
@@ -155,7 +155,7 @@ def test_unknown_bus_lists_the_kinds() -> None:
 
 def test_sim_bus_comes_from_the_entry_point() -> None:
     bus = make_bus("sim", robot=load_robot())
-    assert type(bus).__module__ == "sim.mujoco_bus"
+    assert type(bus).__module__ == "sim.mujoco.bus"
     source = (REPO / "robot" / "bus" / "factory.py").read_text()
     assert "import sim" not in source and "from sim" not in source
 

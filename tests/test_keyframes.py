@@ -17,13 +17,13 @@ from hypothesis import strategies as st
 import robot.cli as cli
 from robot.bus.tables import MODELS
 from robot.commands import capture as capture_cmd
-from robot.config import DEFAULT_ROBOT, RobotConfig, load_gait, load_robot
+from robot.config.robot_file import DEFAULT_ROBOT, RobotConfig, load_gait, load_robot
 from robot.errors import ConfigError
-from robot.interp import min_jerk, smooth
-from robot.keyframes import load_sequence
-from robot.plotting import read_table
-from robot.takes import read_take
-from sim.emulator import Emulator
+from robot.motion.interp import min_jerk, smooth
+from robot.motion.keyframes import load_sequence
+from robot.motion.takes import read_take
+from robot.previs.plots import read_table
+from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
 

@@ -1,4 +1,4 @@
-"""RobotConfig → MJCF: it compiles, matches the config, stands, and agrees with robot.ik FK."""
+"""RobotConfig → MJCF: it compiles, matches the config, stands, and agrees with robot.gait.ik FK."""
 
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ import pytest  # noqa: E402
 from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
-from robot import ik  # noqa: E402
 from robot.cli import main  # noqa: E402
-from robot.config import ARM_JOINTS, LEG_JOINTS, ROBOTS_DIR, RobotConfig, load_robot  # noqa: E402
-from sim.mjcf import build_mjcf, standing_qpos  # noqa: E402
+from robot.config.robot_file import ARM_JOINTS, LEG_JOINTS, ROBOTS_DIR, RobotConfig, load_robot  # noqa: E402
+from robot.gait import ik  # noqa: E402
+from sim.mujoco.mjcf import build_mjcf, standing_qpos  # noqa: E402
 
 ROBOTS = sorted(p.name for p in ROBOTS_DIR.glob("*.toml"))
 ROBOT = load_robot()
@@ -123,7 +123,7 @@ def test_legs_collide_with_each_other_but_not_within_a_leg() -> None:
 @settings(max_examples=60, deadline=None)
 @given(st.data())
 def test_sites_match_the_analytic_fk(data: st.DataObject) -> None:
-    """MuJoCo's sole and hand sites, in the pelvis frame, equal robot.ik's FK to 1e-9 m."""
+    """MuJoCo's sole and hand sites, in the pelvis frame, equal robot.gait.ik's FK to 1e-9 m."""
     g = ROBOT.geometry
     d = mujoco.MjData(MODEL)
     pos = data.draw(st.tuples(*[st.floats(-1, 1)] * 3))

@@ -19,8 +19,8 @@ import pytest
 
 import robot.cli as cli
 from robot.commands.monitor import next_deadline
-from robot.config import RobotConfig
-from sim.emulator import Emulator
+from robot.config.robot_file import RobotConfig
+from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
 

@@ -13,10 +13,10 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 from robot.bus.factory import make_bus  # noqa: E402
-from robot.config import ROBOTS_DIR, load_robot  # noqa: E402
+from robot.bus.servo_map import ServoMap  # noqa: E402
+from robot.config.robot_file import ROBOTS_DIR, load_robot  # noqa: E402
 from robot.errors import BusError  # noqa: E402
-from robot.servo_map import ServoMap  # noqa: E402
-from sim.mujoco_bus import AMBIENT_C, MujocoBus  # noqa: E402
+from sim.mujoco.bus import AMBIENT_C, MujocoBus  # noqa: E402
 
 ROBOT = load_robot()
 SM = ServoMap(ROBOT)

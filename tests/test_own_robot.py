@@ -10,16 +10,16 @@ import mujoco
 import numpy as np
 import pytest
 
-from robot import gait as gaitmod
-from robot.config import ROBOTS_DIR, RobotConfig, load_gait, load_robot
-from robot.engine import GaitEngine
+from robot.bus.servo_map import ServoMap
+from robot.config.robot_file import ROBOTS_DIR, RobotConfig, load_gait, load_robot
 from robot.errors import ConfigError
-from robot.ik import leg_fk_full
-from robot.servo_map import ServoMap
-from robot.streamer import Streamer, Telemetry
-from robot.targets import body_targets
-from sim.mjcf import build_mjcf
-from sim.mujoco_bus import MujocoBus
+from robot.gait import expressions as gaitmod
+from robot.gait.engine import GaitEngine
+from robot.gait.ik import leg_fk_full
+from robot.gait.targets import body_targets
+from robot.loop.streamer import Streamer, Telemetry
+from sim.mujoco.bus import MujocoBus
+from sim.mujoco.mjcf import build_mjcf
 
 LEGS = ROBOTS_DIR / "biped12-legs.toml"
 HEAD_RAD = 0.3
@@ -164,7 +164,7 @@ def test_mixed_models_on_the_emulated_chain(five: RobotConfig, tmp_path: Path) -
     """The pty emulator serves each joint's own model: a scan with the real SDK reports the
     XM430 knees (model number 1020, ROBOTIS e-Manual) among XL430s (1060)."""
     from robot.bus.factory import make_bus
-    from sim.emulator import Emulator
+    from sim.emulator.chain import Emulator
 
     with Emulator("dynamixel", five) as emu:
         bus = make_bus("dynamixel", robot=five, port=emu.port, timeout_ms=50.0)

@@ -15,10 +15,10 @@ import pytest
 from panel_harness import served_panel, wait_for
 from playwright.sync_api import Browser, Page, expect
 
-from robot.config import DEFAULT_ROBOT, load_gait, load_robot
+from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
 from robot.panel.controller import LoopOptions, PanelController, make_controller
 from robot.panel.server import build_server, panel_url, serve_in_thread
-from sim.mujoco_bus import MujocoBus
+from sim.mujoco.bus import MujocoBus
 
 pytest_plugins = ("panel_harness",)  # the browser fixture
 

@@ -16,12 +16,12 @@ from collections.abc import Callable, Iterator
 import pytest
 from websockets.sync.client import ClientConnection, connect
 
-from robot.config import DEFAULT_ROBOT, load_gait, load_robot
+from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
 from robot.panel.controller import LoopOptions, PanelController, make_controller
 from robot.panel.live import RATE_HZ, LiveHub
 from robot.panel.server import build_server, serve_in_thread
 from robot.panel.studio import Studio
-from sim.mujoco_bus import MujocoBus
+from sim.mujoco.bus import MujocoBus
 
 
 @pytest.fixture(scope="module")

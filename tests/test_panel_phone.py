@@ -14,10 +14,10 @@ import pytest
 from panel_harness import served_panel, wait_for
 from playwright.sync_api import Browser, Page, expect
 
+from robot.config.params import SPECS
 from robot.panel.controller import PanelController
 from robot.panel.labels import LABELS
-from robot.params import SPECS
-from sim.mujoco_bus import MujocoBus
+from sim.mujoco.bus import MujocoBus
 
 PHONE = {"width": 390, "height": 844}
 DESKTOP = {"width": 1400, "height": 950}

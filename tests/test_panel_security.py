@@ -15,12 +15,12 @@ from typing import Any
 
 import pytest
 
-from robot.config import DEFAULT_ROBOT, GAITS_DIR, load_gait, load_robot
+from robot.config.robot_file import DEFAULT_ROBOT, GAITS_DIR, load_gait, load_robot
 from robot.panel.controller import LoopOptions, PanelController, make_controller
 from robot.panel.guard import MAX_BODY
 from robot.panel.presets import PresetStore
 from robot.panel.server import build_server, panel_url, serve_in_thread
-from sim.mujoco_bus import MujocoBus
+from sim.mujoco.bus import MujocoBus
 
 EVIL = "http://evil.example"
 READ_TIMEOUT_S = 1.5  # the served panel's; a stalled body must be answered after it

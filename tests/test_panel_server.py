@@ -19,14 +19,14 @@ from typing import Any
 import pytest
 
 from robot.bus.factory import make_bus
-from robot.config import DEFAULT_ROBOT, GAITS_DIR, ROBOTS_DIR, load_gait, load_robot
+from robot.config.params import GROUPS, SPECS
+from robot.config.robot_file import DEFAULT_ROBOT, GAITS_DIR, ROBOTS_DIR, load_gait, load_robot
 from robot.errors import ConfigError
 from robot.panel.controller import LoopOptions, PanelController, make_controller
 from robot.panel.presets import PresetStore
 from robot.panel.server import build_server, serve_in_thread
-from robot.params import GROUPS, SPECS
-from sim.emulator import Emulator
-from sim.mujoco_bus import MujocoBus
+from sim.emulator.chain import Emulator
+from sim.mujoco.bus import MujocoBus
 
 Call = Callable[..., tuple[int, Any]]
 

@@ -16,9 +16,9 @@ from pathlib import Path
 import pytest
 
 import robot.cli as cli
-from robot.config import ROBOTS_DIR, RobotConfig
-from robot.servo_map import ServoMap
-from sim.emulator import Emulator
+from robot.bus.servo_map import ServoMap
+from robot.config.robot_file import ROBOTS_DIR, RobotConfig
+from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
 

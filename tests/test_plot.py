@@ -10,7 +10,7 @@ from matplotlib.image import imread
 
 from robot.cli import main
 from robot.errors import ConfigError
-from robot.plotting import kind_of, read_table
+from robot.previs.plots import kind_of, read_table
 
 
 @pytest.fixture(scope="module")

@@ -13,10 +13,10 @@ import pytest
 from matplotlib.colors import to_hex
 
 import robot.cli as cli
-from robot.config import load_gait, load_robot
-from robot.curves_io import curves_figure
-from robot.engine import GaitEngine
-from robot.plotting import read_table, record_figure
+from robot.config.robot_file import load_gait, load_robot
+from robot.gait.engine import GaitEngine
+from robot.previs.curves import curves_figure
+from robot.previs.plots import read_table, record_figure
 
 UNIT = re.compile(r"\[[^\]]+\]")
 

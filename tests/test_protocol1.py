@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from robot.bus.tables import MODELS, TABLES
-from sim.emulator import Emulator
+from sim.emulator.chain import Emulator
 
 # e-Manual AX-12A: (address, size)
 MANUAL = {"id": (3, 1), "baud_rate": (4, 1), "return_delay_time": (5, 1),
@@ -55,7 +55,7 @@ def test_the_protocol1_bus_uses_packet_handler_1_0() -> None:
 def test_the_emulator_answers_the_sdk_in_protocol_1() -> None:
     import dynamixel_sdk as sdk
 
-    from sim.emulator import Emulator
+    from sim.emulator.chain import Emulator
 
     with Emulator("dynamixel1", ids=[1, 2]) as emu:
         port = sdk.PortHandler(emu.port)
@@ -80,8 +80,8 @@ def test_the_emulator_answers_the_sdk_in_protocol_1() -> None:
 
 # ---------------------------------------------------------------------- the kit's robot
 def test_the_ax12_humanoid_loads_inside_the_ax_range() -> None:
-    from robot.config import ROBOTS_DIR, load_robot
-    from robot.servo_map import ServoMap
+    from robot.bus.servo_map import ServoMap
+    from robot.config.robot_file import ROBOTS_DIR, load_robot
 
     robot = load_robot(ROBOTS_DIR / "biped18-ax12.toml")
     assert (robot.bus.kind, robot.bus.model, robot.bus.baud) == ("dynamixel1", "AX-12A",
@@ -108,7 +108,7 @@ TORQUE_ENABLE, GOAL_POSITION = 24, 30      # e-Manual AX-12A addresses
 
 @pytest.fixture
 def ax_emu() -> Iterator[Emulator]:
-    from robot.config import ROBOTS_DIR, load_robot
+    from robot.config.robot_file import ROBOTS_DIR, load_robot
 
     with Emulator("dynamixel1", load_robot(ROBOTS_DIR / f"{AX_TOML}.toml")) as emu:
         yield emu
@@ -199,7 +199,7 @@ def test_setup_motors_gives_a_factory_new_ax12_its_joint_id(
 def test_calibrate_zero_on_the_ax12_writes_no_goal(ax_emu: Emulator, tmp_path: Path,
                                                    capsys: pytest.CaptureFixture[str]) -> None:
     from robot.cli import main
-    from robot.config import load_robot
+    from robot.config.robot_file import load_robot
 
     for sid in range(1, 19):        # the user holds the robot in its zero pose
         ax_emu.set_register(sid, "goal_position", 500 + sid)

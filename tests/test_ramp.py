@@ -1,4 +1,4 @@
-"""robot.ramp: invariants, not examples."""
+"""robot.motion.ramp: invariants, not examples."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from robot.errors import ConfigError
-from robot.ramp import min_jerk, ramp, ramp_duration, slew_limit
+from robot.motion.ramp import min_jerk, ramp, ramp_duration, slew_limit
 
 angle = st.floats(-3.0, 3.0, allow_nan=False)
 speed = st.floats(0.05, 10.0, allow_nan=False)

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from robot.cli import main
-from robot.config import DEFAULT_ROBOT, load_gait, load_robot
+from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
 from robot.errors import ConfigError
-from sim.render import ClipSpec, check_output, render_walk
+from sim.mujoco.render import ClipSpec, check_output, render_walk
 
 SECONDS, FPS = 1.5, 10
 

@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 
 from robot.commands.common import params_from
-from robot.config import ROBOTS_DIR, Gait, gait_to_toml, load_robot, parse_gait, parse_robot
+from robot.config.params import SPECS
+from robot.config.robot_file import ROBOTS_DIR, Gait, gait_to_toml, load_robot, parse_gait, parse_robot
 from robot.errors import ConfigError
-from robot.params import SPECS
 
 BASE = tomllib.loads((ROBOTS_DIR / "biped18-dynamixel.toml").read_text())
 

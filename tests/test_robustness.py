@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from robot.config import load_gait
-from robot.params import SPECS
-from robot.robustness import (
+from robot.config.params import SPECS
+from robot.config.robot_file import load_gait
+from robot.tuning.robustness import (
     PUSH_AT_S,
     STRAIGHT_S,
     Condition,

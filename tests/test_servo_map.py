@@ -10,9 +10,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robot.config import ROBOTS_DIR, RobotConfig, load_robot
+from robot.bus.servo_map import ServoMap
+from robot.config.robot_file import ROBOTS_DIR, RobotConfig, load_robot
 from robot.errors import BipedError
-from robot.servo_map import ServoMap
 
 # The 18-joint robots (the property tests draw one vector length for all of them; the
 # 12-joint robot's map is a subset of the Dynamixel one's).

@@ -12,9 +12,9 @@ import pytest
 import robot.cli as cli
 from robot.bus.tables import BAUD_CODES, BUS_FAMILIES
 from robot.commands import setup_motors
-from robot.config import RobotConfig
-from robot.motor_setup import FACTORY_BAUD, baud_order
-from sim.emulator import Emulator
+from robot.config.robot_file import RobotConfig
+from robot.setup.motor_setup import FACTORY_BAUD, baud_order
+from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
 
@@ -120,8 +120,8 @@ def test_wrong_model_is_refused(protocol: str, robot_toml: Path,
 def test_nothing_connected_says_check_power(fresh: Emulator, robot_toml: Path,
                                             capsys: pytest.CaptureFixture[str],
                                             monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr("robot.motor_setup.ALL_IDS", range(0, 3))   # keep the sweep short
-    monkeypatch.setattr("robot.motor_setup.baud_order",
+    monkeypatch.setattr("robot.setup.motor_setup.ALL_IDS", range(0, 3))   # keep the sweep short
+    monkeypatch.setattr("robot.setup.motor_setup.baud_order",
                         lambda family, baud: sorted({FACTORY_BAUD[family], baud}))
     assert setup(fresh, robot_toml, "--joint", "r_knee", "--yes") == 2
     assert "no servo answers" in capsys.readouterr().err
@@ -168,8 +168,8 @@ def test_a_servo_at_an_odd_id_and_baud_is_found_by_the_sweep(
         monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
     family = BUS_FAMILIES[protocol]
     odd_baud = 115_200
-    monkeypatch.setattr("robot.motor_setup.ALL_IDS", range(25, 36))   # per-id pings: short
-    monkeypatch.setattr("robot.motor_setup.baud_order",
+    monkeypatch.setattr("robot.setup.motor_setup.ALL_IDS", range(25, 36))   # per-id pings: short
+    monkeypatch.setattr("robot.setup.motor_setup.baud_order",
                         lambda fam, baud: [FACTORY_BAUD[fam], baud, odd_baud])
     with Emulator.factory_new(protocol, 1) as emu:
         emu.plug(0)

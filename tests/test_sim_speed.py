@@ -13,9 +13,9 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from robot.config import load_robot  # noqa: E402
-from robot.servo_map import ServoMap  # noqa: E402
-from sim.mujoco_bus import MujocoBus  # noqa: E402
+from robot.bus.servo_map import ServoMap  # noqa: E402
+from robot.config.robot_file import load_robot  # noqa: E402
+from sim.mujoco.bus import MujocoBus  # noqa: E402
 
 ROBOT = load_robot()
 SM = ServoMap(ROBOT)

@@ -1,5 +1,5 @@
 """Live steering within the documented ranges keeps the robot up: the joint steering
-budget (robot.engine.STEER_BUDGET) and a seeded random sequence of panel-style changes
+budget (robot.gait.engine.STEER_BUDGET) and a seeded random sequence of panel-style changes
 walked in MuJoCo with balance on."""
 
 from __future__ import annotations
@@ -8,15 +8,15 @@ import random
 
 import pytest
 
-from robot.balance import Balance, attitude_reader
-from robot.config import load_gait, load_robot
-from robot.engine import STEER_BUDGET, GaitEngine, within_steering_budget
+from robot.balance.stage import Balance, attitude_reader
+from robot.bus.servo_map import ServoMap
+from robot.config.params import SPECS, GaitParams
+from robot.config.robot_file import load_gait, load_robot
+from robot.gait.engine import STEER_BUDGET, GaitEngine, within_steering_budget
 from robot.imu import open_imu
-from robot.params import SPECS, GaitParams
-from robot.servo_map import ServoMap
-from robot.streamer import Streamer, Telemetry
-from sim.metrics import WalkMonitor
-from sim.mujoco_bus import MujocoBus
+from robot.loop.streamer import Streamer, Telemetry
+from sim.mujoco.bus import MujocoBus
+from sim.mujoco.metrics import WalkMonitor
 
 WALK = load_gait("walk").params
 

@@ -13,13 +13,13 @@ import numpy as np
 import pytest
 from bus_harness import open_bus
 
+from robot.bus.servo_map import ServoMap
 from robot.bus.tables import TABLES
-from robot.config import RobotConfig, load_gait
-from robot.engine import GaitEngine
-from robot.servo_map import ServoMap
-from robot.streamer import Streamer, Telemetry
-from robot.watchdog import WatchdogConfig
-from sim.emulator import Emulator, Packet
+from robot.config.robot_file import RobotConfig, load_gait
+from robot.gait.engine import GaitEngine
+from robot.loop.streamer import Streamer, Telemetry
+from robot.loop.watchdog import WatchdogConfig
+from sim.emulator.chain import Emulator, Packet
 
 pytest_plugins = ("bus_harness",)
 
@@ -162,7 +162,7 @@ def test_sigint_ramps_out_and_leaves_torque_off(emu: Emulator, robot: RobotConfi
 def test_watchdog_follow_error_unit(robot: RobotConfig) -> None:
     from robot.bus.base import ServoState
     from robot.errors import SafetyStop
-    from robot.watchdog import Watchdog
+    from robot.loop.watchdog import Watchdog
 
     smap = ServoMap(robot)
     wd = Watchdog(WatchdogConfig(follow_reads=3), smap, robot=robot)

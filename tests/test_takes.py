@@ -19,12 +19,12 @@ import pytest
 
 import robot.cli as cli
 from robot.bus.tables import MODELS
-from robot.config import DEFAULT_ROBOT, load_gait, load_robot
+from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
+from robot.motion.takes import read_take
 from robot.panel.controller import LoopOptions, make_controller
 from robot.panel.studio import Studio
-from robot.takes import read_take
-from sim.emulator import Emulator
-from sim.mujoco_bus import MujocoBus
+from sim.emulator.chain import Emulator
+from sim.mujoco.bus import MujocoBus
 
 pytest_plugins = ("bus_harness",)
 TOL = 1e-6  # [rad]

@@ -12,9 +12,9 @@ from pathlib import Path
 import optuna
 import pytest
 
-from robot.config import Gait, gait_to_toml, load_gait
+from robot.config.params import SPECS
+from robot.config.robot_file import Gait, gait_to_toml, load_gait
 from robot.errors import ConfigError
-from robot.params import SPECS
 from robot.tuning.objective import Setup, combined, quality
 from robot.tuning.space import DEFAULT_KNOBS, apply, parse_knob, search_space
 

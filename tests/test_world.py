@@ -1,4 +1,4 @@
-"""Perturbed worlds on the sim bus (sim.world): slope, bumps, pushes, latency, friction,
+"""Perturbed worlds on the sim bus (sim.mujoco.world): slope, bumps, pushes, latency, friction,
 mass; each checked on the compiled model or the running physics, against an independent
 computation (ray casts, momentum, sensors)."""
 
@@ -13,14 +13,14 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from robot.config import load_robot  # noqa: E402
+from robot.bus.servo_map import ServoMap  # noqa: E402
+from robot.config.robot_file import load_robot  # noqa: E402
 from robot.errors import ConfigError  # noqa: E402
-from robot.servo_map import ServoMap  # noqa: E402
-from robot.telemetry import Telemetry  # noqa: E402
-from sim.mjcf import build_mjcf  # noqa: E402
-from sim.mujoco_bus import MujocoBus  # noqa: E402
-from sim.world import PUSH_WINDOW_S, Push, PushScheduler, World  # noqa: E402
-from sim.world_scene import (  # noqa: E402
+from robot.loop.telemetry import Telemetry  # noqa: E402
+from sim.mujoco.bus import MujocoBus  # noqa: E402
+from sim.mujoco.mjcf import build_mjcf  # noqa: E402
+from sim.mujoco.world import PUSH_WINDOW_S, Push, PushScheduler, World  # noqa: E402
+from sim.mujoco.world_scene import (  # noqa: E402
     BUMP_COVER,
     BUMP_PREFIX,
     BUMPS_HALF_WIDTH_M,

@@ -1,6 +1,6 @@
 """The servo-bus interface every backend implements (Dynamixel, Feetech, MuJoCo).
 
-Buses speak ticks and servo ids only; radians live in ``robot.servo_map``.
+Buses speak ticks and servo ids only; radians live in ``robot.bus.servo_map``.
 Backends do no I/O in their constructor: ``open()`` (or ``with bus:``) connects.
 """
 

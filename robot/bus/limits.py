@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from robot.config import RobotConfig
+from robot.config.robot_file import RobotConfig
 from robot.errors import BusError
 
 
@@ -14,7 +14,7 @@ class TickLimits:
         self.robot = robot
         self.by_id: dict[int, tuple[int, int]] = {}
         if robot is not None:
-            from robot.servo_map import ServoMap
+            from robot.bus.servo_map import ServoMap
 
             sm = ServoMap(robot)
             for sid, lo, hi, res in zip(sm.ids, sm.tick_min.tolist(), sm.tick_max.tolist(),

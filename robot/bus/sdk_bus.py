@@ -30,7 +30,7 @@ from robot.bus.tables import (
     Register,
     model_name,
 )
-from robot.config import RobotConfig
+from robot.config.robot_file import RobotConfig
 from robot.errors import BusError
 
 log = logging.getLogger(__name__)

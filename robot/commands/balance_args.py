@@ -9,12 +9,12 @@ import dataclasses
 import logging
 from collections.abc import Callable
 
-from robot.balance import Balance, attitude_reader
+from robot.balance.stage import Balance, attitude_reader
 from robot.bus.base import Bus
 from robot.commands.common import bounded_float
-from robot.config import RobotConfig
-from robot.engine import GaitEngine
+from robot.config.robot_file import RobotConfig
 from robot.errors import ConfigError
+from robot.gait.engine import GaitEngine
 from robot.imu import Imu, open_imu
 
 log = logging.getLogger(__name__)

@@ -8,11 +8,11 @@ import json
 from typing import Any
 
 SECTIONS: dict[str, str] = {
-    "core": "robot.bench:run_core_bench",
-    "bus": "robot.bench:run_bus_section",
-    "loop": "robot.bench_loop:run_loop_bench",
-    "sim": "robot.bench_sim:run_sim_bench",
-    "panel": "robot.bench_panel:run_panel_bench",
+    "core": "robot.bench.core:run_core_bench",
+    "bus": "robot.bench.core:run_bus_section",
+    "loop": "robot.bench.loop:run_loop_bench",
+    "sim": "robot.bench.sim:run_sim_bench",
+    "panel": "robot.bench.panel:run_panel_bench",
 }
 
 

@@ -17,14 +17,6 @@ from collections.abc import Callable
 from pathlib import Path
 
 from robot.bus.base import Bus
-from robot.calibration import (
-    MOVE_THRESHOLD_RAD,
-    detect_sign,
-    direction_words,
-    limits_from_ends,
-    probe_direction,
-    zero_ticks,
-)
 from robot.commands.common import (
     HARDWARE_BUSES,
     add_bus_args,
@@ -34,10 +26,18 @@ from robot.commands.common import (
     output_file,
     robot_from,
 )
-from robot.config import JointConfig, RobotConfig
+from robot.config.robot_file import JointConfig, RobotConfig
+from robot.config.toml_edit import same_path, write_validated
 from robot.errors import ConfigError
-from robot.motor_setup import answered
-from robot.robot_toml_edit import same_path, write_validated
+from robot.setup.calibration import (
+    MOVE_THRESHOLD_RAD,
+    detect_sign,
+    direction_words,
+    limits_from_ends,
+    probe_direction,
+    zero_ticks,
+)
+from robot.setup.motor_setup import answered
 
 Ask = Callable[[str], str]
 #: Prompts per joint in step 2 before its sign is kept as it was.

@@ -24,8 +24,8 @@ from robot.commands.common import (
     robot_from,
 )
 from robot.errors import ConfigError
-from robot.keyframes import SUFFIXES, load_sequence, sequence_to_toml
-from robot.posing import Capture, limb_joints, release
+from robot.motion.keyframes import SUFFIXES, load_sequence, sequence_to_toml
+from robot.motion.posing import Capture, limb_joints, release
 
 Ask = Callable[[str], str]
 

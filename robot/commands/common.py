@@ -14,10 +14,12 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NoReturn, TypeVar
 
-from robot.bundled import user_gaits_dir
 from robot.bus.base import Bus
 from robot.bus.factory import make_bus
-from robot.config import (
+from robot.config.bundled import user_gaits_dir
+from robot.config.checks import standard_bauds
+from robot.config.params import GaitParams
+from robot.config.robot_file import (
     DEFAULT_GAIT,
     DEFAULT_ROBOT_NAME,
     SERVO_ID,
@@ -29,9 +31,7 @@ from robot.config import (
     load_robot,
     robot_names,
 )
-from robot.config_checks import standard_bauds
 from robot.errors import ConfigError
-from robot.params import GaitParams
 
 T = TypeVar("T")
 

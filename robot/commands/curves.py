@@ -16,9 +16,9 @@ from robot.commands.common import (
     robot_from,
     seconds,
 )
-from robot.curves_io import plot_curves, write_csv
-from robot.engine import GaitEngine
 from robot.errors import ConfigError
+from robot.gait.engine import GaitEngine
+from robot.previs.curves import plot_curves, write_csv
 
 log = logging.getLogger(__name__)
 

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 from robot.commands.common import add_robot_args, positive_int, robot_from
 
 if TYPE_CHECKING:
-    from sim.emulator import Emulator
+    from sim.emulator.chain import Emulator
 
 PROTOCOLS = ("dynamixel", "dynamixel1", "feetech")
 ALIVE_CHECK_S = 0.5          # how often the emulator process is checked [s]
@@ -63,7 +63,7 @@ def _plug_from_stdin(emu: Emulator, count: int, stop: threading.Event) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim.emulator import Emulator
+    from sim.emulator.chain import Emulator
 
     if args.factory_new and args.baud:
         print("biped emulate: error: --baud: factory-new servos listen at their factory "

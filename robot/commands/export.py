@@ -4,7 +4,7 @@
 evaluated directly, no ramp), ``--take FILE``: a recorded take's joint stream (as it went
 to the servos, ramps and rest included). The format follows ``--out``: ``.bvh``, or
 ``.glb`` / ``.gltf`` (a skinned glTF 2.0 animation, metres). Skeleton, axes and units:
-robot/bvh.py and robot/gltf.py.
+robot/previs/bvh.py and robot/previs/gltf.py.
 """
 
 from __future__ import annotations
@@ -14,7 +14,6 @@ from pathlib import Path
 
 import numpy as np
 
-from robot.bvh import UNITS, resample, write_bvh
 from robot.commands.common import (
     add_robot_args,
     bounded_float,
@@ -26,12 +25,13 @@ from robot.commands.common import (
     robot_from,
     seconds,
 )
-from robot.config import DEFAULT_ROBOT_NAME, load_robot
-from robot.engine import GaitEngine
+from robot.config.robot_file import DEFAULT_ROBOT_NAME, load_robot
 from robot.errors import ConfigError
-from robot.gltf import SUFFIXES as GLTF_SUFFIXES
-from robot.gltf import write_gltf
-from robot.takes import SUFFIX, is_take, read_take
+from robot.gait.engine import GaitEngine
+from robot.motion.takes import SUFFIX, is_take, read_take
+from robot.previs.bvh import UNITS, resample, write_bvh
+from robot.previs.gltf import SUFFIXES as GLTF_SUFFIXES
+from robot.previs.gltf import write_gltf
 
 #: Most frames written (an hour at 60 fps).
 MAX_FRAMES = 216_000

@@ -5,7 +5,7 @@ again (the one that went away is the robot's), ask you to plug it back in (Enter
 the name it came back under, which is the one to pass as ``--port``. ``--list`` only lists.
 ``--json``: one JSON value on stdout (the list, or the found port); prompts go to stderr.
 
-Test hook: ``BIPED_FAKE_PORTS`` (see ``robot.serial_ports``) replaces the real device list.
+Test hook: ``BIPED_FAKE_PORTS`` (see ``robot.setup.serial_ports``) replaces the real device list.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TextIO
 
 from robot.commands.common import one_line_errors
-from robot.serial_ports import (
+from robot.setup.serial_ports import (
     PortLister,
     PortSearchError,
     SerialPort,

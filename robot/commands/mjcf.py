@@ -24,7 +24,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     add_robot_args(p, gait=False)
     p.add_argument("--out", required=True, metavar="DIR",
                    help="output directory (created if missing)")
-    # sim.mjcf accepts (0, 0.01] s: coarser steps make the contacts unstable.
+    # sim.mujoco.mjcf accepts (0, 0.01] s: coarser steps make the contacts unstable.
     p.add_argument("--timestep", type=bounded_float(0.0, 0.01, "s", what="a timestep",
                                                     lo_open=True),
                    default=None, metavar="S", help="physics timestep [s] (default: 0.002)")
@@ -32,7 +32,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim.mjcf import build_mjcf
+    from sim.mujoco.mjcf import build_mjcf
 
     checked("--out", output_dir, args.out)  # before any work (returns 2, not argparse's exit)
     robot = robot_from(args)

@@ -17,6 +17,7 @@ import time
 from typing import Any
 
 from robot.bus.base import Bus
+from robot.bus.servo_map import ServoMap
 from robot.commands.common import (
     HARDWARE_BUSES,
     add_bus_args,
@@ -27,10 +28,9 @@ from robot.commands.common import (
     robot_from,
 )
 from robot.commands.signals import SignalLatch, stop_on_signals
-from robot.config import RobotConfig
+from robot.config.robot_file import RobotConfig
 from robot.errors import BusError
-from robot.monitor_table import format_table, rows
-from robot.servo_map import ServoMap
+from robot.setup.monitor_table import format_table, rows
 
 #: --rate: a terminal table faster than 50 Hz is unreadable; slower than 0.1 Hz is not live.
 monitor_rate = bounded_float(0.1, 50.0, "Hz", what="a rate")

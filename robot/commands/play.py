@@ -15,6 +15,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from robot.bus.servo_map import ServoMap
 from robot.commands.balance_args import add_balance_args, balance_for, imu_for
 from robot.commands.common import (
     add_bus_args,
@@ -27,16 +28,15 @@ from robot.commands.common import (
     seconds,
 )
 from robot.commands.signals import SignalLatch, stop_on_signals
-from robot.config import DEFAULT_GAIT, RobotConfig, load_robot
-from robot.engine import GaitEngine
+from robot.config.robot_file import DEFAULT_GAIT, RobotConfig, load_robot
 from robot.errors import ConfigError
-from robot.keyframes import SUFFIXES, load_sequence, parse_sequence
-from robot.layered import LayeredEngine
-from robot.recorder import Recorder
-from robot.scripted import PlaybackEngine
-from robot.servo_map import ServoMap
-from robot.streamer import LoopStats, Streamer
-from robot.takes import SUFFIX, Take, TakeHeader, TakeWriter, is_take, read_take
+from robot.gait.engine import GaitEngine
+from robot.loop.recorder import Recorder
+from robot.loop.streamer import LoopStats, Streamer
+from robot.motion.keyframes import SUFFIXES, load_sequence, parse_sequence
+from robot.motion.layered import LayeredEngine
+from robot.motion.scripted import PlaybackEngine
+from robot.motion.takes import SUFFIX, Take, TakeHeader, TakeWriter, is_take, read_take
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]

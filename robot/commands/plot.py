@@ -19,7 +19,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
 
 
 def run(args: argparse.Namespace) -> int:
-    from robot.plotting import plot_file
+    from robot.previs.plots import plot_file
 
     # Checked here rather than as argparse types so that main() returns 2 like for a bad file.
     checked("FILE", input_file, args.file)

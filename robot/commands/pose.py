@@ -15,6 +15,7 @@ import logging
 import numpy as np
 import numpy.typing as npt
 
+from robot.bus.servo_map import ServoMap
 from robot.commands.common import (
     add_bus_args,
     add_robot_args,
@@ -24,11 +25,10 @@ from robot.commands.common import (
     robot_from,
 )
 from robot.commands.signals import SignalLatch, stop_on_signals
-from robot.config import RobotConfig
-from robot.engine import GaitEngine
-from robot.params import GaitParams
-from robot.servo_map import ServoMap
-from robot.streamer import LoopStats, Streamer
+from robot.config.params import GaitParams
+from robot.config.robot_file import RobotConfig
+from robot.gait.engine import GaitEngine
+from robot.loop.streamer import LoopStats, Streamer
 
 log = logging.getLogger(__name__)
 

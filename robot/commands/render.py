@@ -23,7 +23,7 @@ log = logging.getLogger(__name__)
 
 #: A previs clip lasts at most an hour.
 clip_seconds = bounded_float(0.0, 3600.0, "s", what="a clip length", lo_open=True)
-#: Frame sizes parse up to this; sim.render.check_output enforces the real limits.
+#: Frame sizes parse up to this; sim.mujoco.render.check_output enforces the real limits.
 frame_px = bounded_int(1, 100_000, "px", what="a frame size")
 #: A GIF is assembled in memory: at most this many bytes of RGB frames.
 MAX_GIF_BYTES = 1 << 30
@@ -50,7 +50,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim.render import ClipSpec, check_output, render_walk
+    from sim.mujoco.render import ClipSpec, check_output, render_walk
 
     spec = ClipSpec(seconds=args.seconds, width=args.width, height=args.height, fps=args.fps,
                     rate_hz=args.rate, camera=args.camera)

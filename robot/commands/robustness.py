@@ -1,4 +1,4 @@
-"""`biped robustness`: the perturbation suite (robot.robustness) in parallel processes, a
+"""`biped robustness`: the perturbation suite (robot.tuning.robustness) in parallel processes, a
 survival table with and without balance, and a PNG of it."""
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from robot.commands.common import (
     robot_from,
     seconds,
 )
-from robot.robustness import (
+from robot.tuning.robustness import (
     STRAIGHT_DEG,
     STRAIGHT_DRIFT,
     STRAIGHT_S,

@@ -11,7 +11,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any, Protocol
 
-from robot.telemetry import LoopStats
+from robot.loop.telemetry import LoopStats
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 

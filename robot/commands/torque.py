@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 
+from robot.bus.servo_map import ServoMap
 from robot.commands.common import (
     add_bus_args,
     add_robot_args,
@@ -15,10 +16,9 @@ from robot.commands.common import (
     one_line_errors,
     robot_from,
 )
-from robot.engine import GaitEngine
-from robot.params import GaitParams
-from robot.servo_map import ServoMap
-from robot.streamer import Streamer
+from robot.config.params import GaitParams
+from robot.gait.engine import GaitEngine
+from robot.loop.streamer import Streamer
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

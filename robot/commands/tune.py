@@ -69,9 +69,9 @@ def run(args: argparse.Namespace) -> int:
     import optuna
     from tqdm import tqdm
 
-    from robot.robustness import check_seconds
     from robot.tuning.objective import Setup, check_skip, suite_for
     from robot.tuning.report import format_report, group_survival, plot_study, write_preset
+    from robot.tuning.robustness import check_seconds
     from robot.tuning.space import search_space
     from robot.tuning.study import Plan, best_params, best_trial, references, run_study
 
@@ -158,8 +158,8 @@ def run(args: argparse.Namespace) -> int:
 def sensitivity(args: argparse.Namespace, start: Any) -> int:
     from tqdm import tqdm
 
-    from robot.robustness import check_seconds
     from robot.tuning.objective import Setup, check_skip, suite_for
+    from robot.tuning.robustness import check_seconds
     from robot.tuning.sensitivity import format_sensitivity, study
 
     check_skip(tuple(args.skip), start, args.suite)

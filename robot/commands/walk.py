@@ -10,6 +10,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from robot.bus.servo_map import ServoMap
 from robot.commands.balance_args import add_balance_args, balance_for, imu_for
 from robot.commands.common import (
     add_bus_args,
@@ -26,15 +27,14 @@ from robot.commands.common import (
 )
 from robot.commands.signals import SignalLatch, stop_on_signals
 from robot.commands.world_args import add_world_args, describe_world, world_from, world_summary
-from robot.engine import GaitEngine
 from robot.errors import ConfigError
-from robot.keyframes import load_sequence
-from robot.layered import LayeredEngine
-from robot.recorder import Recorder
-from robot.scripted import RecordingEngine
-from robot.servo_map import ServoMap
-from robot.streamer import LoopStats, Streamer, Telemetry
-from robot.takes import TakeHeader, TakeWriter, is_take
+from robot.gait.engine import GaitEngine
+from robot.loop.recorder import Recorder
+from robot.loop.streamer import LoopStats, Streamer, Telemetry
+from robot.motion.keyframes import load_sequence
+from robot.motion.layered import LayeredEngine
+from robot.motion.scripted import RecordingEngine
+from robot.motion.takes import TakeHeader, TakeWriter, is_take
 
 log = logging.getLogger(__name__)
 
@@ -114,8 +114,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         bus.open()
         if kind == "sim":
-            from sim.effort import EffortMonitor
-            from sim.metrics import WalkMonitor
+            from sim.mujoco.effort import EffortMonitor
+            from sim.mujoco.metrics import WalkMonitor
 
             sim_bus: Any = bus
             monitor = WalkMonitor(standing_height=sim_bus.standing_height,
@@ -130,7 +130,7 @@ def run(args: argparse.Namespace) -> int:
                     streamer.emergency_stop("fell")
             observers.insert(0, watch)
             if world is not None and world.pushes:
-                from sim.world import PushScheduler
+                from sim.mujoco.world import PushScheduler
 
                 pushes = PushScheduler(sim_bus, world.pushes)
                 observers.insert(1, pushes)

@@ -1,7 +1,7 @@
 """`biped walk` perturbation options (sim only): slope, bumps, pushes, latency, friction,
 mass. Parsed and range-checked here at parse time (one line, exit 2); turned into a
-``sim.world.World`` by ``world_from`` (sim imported lazily, robot/ never imports sim at
-module level). Units and sign conventions: ``sim.world`` and docs/robustness.md."""
+``sim.mujoco.world.World`` by ``world_from`` (sim imported lazily, robot/ never imports sim at
+module level). Units and sign conventions: ``sim.mujoco.world`` and docs/robustness.md."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import argparse
 from typing import Any
 
 from robot.commands.common import bounded_float, bounded_int
+from robot.config.world_ranges import RANGES
 from robot.errors import ConfigError
-from robot.world_ranges import RANGES
 
 #: Option → (argparse dest, value of "not given").
 DEFAULTS: dict[str, tuple[str, Any]] = {
@@ -76,14 +76,14 @@ def given(args: argparse.Namespace) -> list[str]:
 
 
 def world_from(args: argparse.Namespace, kind: str) -> Any:
-    """The ``sim.world.World`` of the options, None if none is given; ConfigError (nothing
+    """The ``sim.mujoco.world.World`` of the options, None if none is given; ConfigError (nothing
     opened) if one is given for a bus other than sim."""
     options = given(args)
     if not options:
         return None
     if kind != "sim":
         raise ConfigError(f"{options[0]} applies to --bus sim only, not --bus {kind}")
-    from sim.world import Push, World
+    from sim.mujoco.world import Push, World
 
     return World(slope_deg=args.slope, cross_slope_deg=args.cross_slope,
                  bumps_mm=args.bumps, terrain_seed=args.terrain_seed,
@@ -93,10 +93,10 @@ def world_from(args: argparse.Namespace, kind: str) -> Any:
 
 
 def world_summary(world: Any, pushes: Any = None) -> dict[str, Any]:
-    """The "world" object of the JSON summary: ``sim.world.World.as_dict()`` (the defaults
+    """The "world" object of the JSON summary: ``sim.mujoco.world.World.as_dict()`` (the defaults
     when ``world`` is None) and each applied push with its sim start time
     (``PushScheduler.as_list()``)."""
-    from sim.world import World
+    from sim.mujoco.world import World
 
     out: dict[str, Any] = (world or World()).as_dict()
     out["pushes_applied"] = [] if pushes is None else pushes.as_list()

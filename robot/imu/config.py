@@ -1,5 +1,5 @@
 """The optional ``[imu]`` table of a robot file → ``ImuConfig`` (one-line errors naming the
-file, the field and the valid range, like the rest of ``robot.config``).
+file, the field and the valid range, like the rest of ``robot.config.robot_file``).
 
 ```toml
 [imu]
@@ -20,9 +20,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from robot.config.toml_io import Range, build, number, show, spec, table
 from robot.errors import ConfigError
 from robot.imu.frames import Mount
-from robot.toml_io import Range, build, number, show, spec, table
 
 #: noise / bias: a scale of the BNO055 datasheet figures; 0 turns it off, 100 is absurd.
 SCALE = Range(0.0, 100.0)

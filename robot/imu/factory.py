@@ -2,7 +2,7 @@
 
 ``bno055`` (robot.imu.bno055, BNO055 over UART) is built in. Other kinds are plugins: a
 distribution declares an entry point in the group ``biped.imus`` (biped's own
-pyproject.toml declares ``sim = "sim.imu:open_sim_imu"``), naming a callable
+pyproject.toml declares ``sim = "sim.mujoco.imu:open_sim_imu"``), naming a callable
 ``(config: ImuConfig, *, bus: Bus | None) -> Imu``; ``register_imu`` adds one at run time.
 So ``robot/`` never imports ``sim/``.
 """

@@ -18,17 +18,17 @@ from dataclasses import dataclass
 from typing import Any
 
 from robot.bus.base import Bus
-from robot.config import RobotConfig
-from robot.engine import GaitEngine
+from robot.bus.servo_map import ServoMap
+from robot.config.params import GROUPS, SPECS, GaitParams
+from robot.config.robot_file import RobotConfig
 from robot.errors import BipedError
+from robot.gait.engine import GaitEngine
+from robot.loop.streamer import Feedback, LoopStats, Streamer, Telemetry, TickObserver
 from robot.panel.figure import views
 from robot.panel.idle_pose import IdlePose
 from robot.panel.labels import LABELS, SIMPLE
 from robot.panel.presets import PresetStore
 from robot.panel.sim_monitor import sim_monitor_factory
-from robot.params import GROUPS, SPECS, GaitParams
-from robot.servo_map import ServoMap
-from robot.streamer import Feedback, LoopStats, Streamer, Telemetry, TickObserver
 
 #: Builds a run's engine from the current parameters (a recording, a replay, keyframes).
 EngineFactory = Callable[[GaitParams], GaitEngine]

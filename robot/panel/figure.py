@@ -1,6 +1,6 @@
 """Stick figure of the robot from joint angles, as 2-D polylines for the panel's canvases.
 
-Forward kinematics (robot.ik) in the pelvis frame (REP-103: x forward, y left, z up) [m].
+Forward kinematics (robot.gait.ik) in the pelvis frame (REP-103: x forward, y left, z up) [m].
 The side view looks at the robot's right side (screen x = x forward, screen y = z up);
 the front view faces the robot (screen x = y, the robot's left on the viewer's right).
 """
@@ -11,9 +11,9 @@ import dataclasses
 from collections.abc import Sequence
 from typing import Any
 
-from robot.config import ARM_JOINTS, LEG_JOINTS, Geometry, RobotConfig
-from robot.ik import arm_fk_local, hip_centre, leg_fk_full, shoulder_centre
-from robot.xmath import Vec
+from robot.config.robot_file import ARM_JOINTS, LEG_JOINTS, Geometry, RobotConfig
+from robot.gait.ik import arm_fk_local, hip_centre, leg_fk_full, shoulder_centre
+from robot.gait.xmath import Vec
 
 Point = tuple[float, float, float]
 

@@ -13,8 +13,8 @@ import time
 from collections.abc import Callable
 
 from robot.bus.base import Bus, ServoState
+from robot.bus.servo_map import ServoMap
 from robot.errors import BipedError
-from robot.servo_map import ServoMap
 
 log = logging.getLogger(__name__)
 

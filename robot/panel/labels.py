@@ -1,5 +1,5 @@
 """What the panel calls each gait parameter, in words (the paper's symbol shows beside it,
-``robot.params.SPECS`` gives the one-line meaning and range), and the "simple" view's set.
+``robot.config.params.SPECS`` gives the one-line meaning and range), and the "simple" view's set.
 
 Kept with the panel (rather than in SPECS) because only the page shows them; a test checks
 that every parameter has a label.

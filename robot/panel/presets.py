@@ -3,7 +3,7 @@
 Bundled presets ship inside the package (``robot/configs/gaits``) and are read-only here:
 saving under a bundled name is refused whatever ``overwrite`` says, and a user file with a
 bundled name is ignored (the bundled one wins). The panel saves into ``presets_dir``: by
-default the user's config directory (``robot.bundled.user_gaits_dir``, platformdirs:
+default the user's config directory (``robot.config.bundled.user_gaits_dir``, platformdirs:
 ``~/.config/biped/gaits`` on Linux), never the package or the repository; ``biped walk
 --gait NAME`` finds presets saved there too.
 """
@@ -16,10 +16,10 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from robot.bundled import user_gaits_dir
-from robot.config import GAITS_DIR, Gait, gait_names, gait_to_toml, load_gait, parse_gait
+from robot.config.bundled import user_gaits_dir
+from robot.config.params import GaitParams
+from robot.config.robot_file import GAITS_DIR, Gait, gait_names, gait_to_toml, load_gait, parse_gait
 from robot.errors import ConfigError
-from robot.params import GaitParams
 
 log = logging.getLogger(__name__)
 

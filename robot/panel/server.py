@@ -67,7 +67,7 @@ __all__ = ["build_server", "is_loopback", "panel_url", "serve_in_thread"]
 
 
 def static_file(name: str) -> bytes:
-    return resources.files("robot").joinpath("panel_static", name).read_bytes()
+    return resources.files("robot.panel").joinpath("static", name).read_bytes()
 
 
 def live_snapshot(controller: PanelController, studio: Studio) -> dict[str, Any]:

@@ -5,12 +5,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from robot.streamer import Telemetry
+from robot.loop.streamer import Telemetry
 
 
 def sim_monitor_factory(bus: Any) -> Callable[[], Callable[[Telemetry], dict[str, Any]]]:
     """Per-run WalkMonitor on a MujocoBus: fell or not, torso height, tilt, distance."""
-    from sim.metrics import WalkMonitor
+    from sim.mujoco.metrics import WalkMonitor
 
     def factory() -> Callable[[Telemetry], dict[str, Any]]:
         monitor = WalkMonitor(standing_height=bus.standing_height)

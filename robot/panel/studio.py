@@ -1,7 +1,7 @@
 """The panel's studio: record takes, list and replay them, pose by hand and keyframe.
 
-Takes live in ``takes_dir`` (NAME.take.jsonl, robot.takes), keyframe sequences in
-``keys_dir`` (NAME.toml, robot.keyframes); by default under the user's data directory
+Takes live in ``takes_dir`` (NAME.take.jsonl, robot.motion.takes), keyframe sequences in
+``keys_dir`` (NAME.toml, robot.motion.keyframes); by default under the user's data directory
 (platformdirs: ``~/.local/share/biped``). Every run starts through the controller, so it
 is the one streaming loop with its ramps and limits; a replayed take drives the run by
 itself (the sliders are refused until it ends or is stopped).
@@ -20,16 +20,16 @@ from typing import Any
 
 import platformdirs
 
-from robot.config import RobotConfig
-from robot.engine import GaitEngine
+from robot.config.params import GaitParams
+from robot.config.robot_file import RobotConfig
 from robot.errors import ConfigError
-from robot.keyframes import Sequence, load_sequence, parse_sequence, sequence_to_toml
-from robot.layered import LayeredEngine
+from robot.gait.engine import GaitEngine
+from robot.motion.keyframes import Sequence, load_sequence, parse_sequence, sequence_to_toml
+from robot.motion.layered import LayeredEngine
+from robot.motion.posing import Capture, limb_joints, limbs, release
+from robot.motion.scripted import PlaybackEngine, RecordingEngine
+from robot.motion.takes import SUFFIX, TakeHeader, TakeWriter, read_take
 from robot.panel.controller import PanelController, PanelStateError
-from robot.params import GaitParams
-from robot.posing import Capture, limb_joints, limbs, release
-from robot.scripted import PlaybackEngine, RecordingEngine
-from robot.takes import SUFFIX, TakeHeader, TakeWriter, read_take
 
 log = logging.getLogger(__name__)
 

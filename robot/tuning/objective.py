@@ -1,7 +1,7 @@
 """How good a parameter set is for `biped tune`: survive the perturbation set first, then
 walk at the requested speed, straight, with low knee load and little energy.
 
-``evaluate`` walks every condition of the robustness suite (robot.robustness: `--quick`
+``evaluate`` walks every condition of the robustness suite (robot.tuning.robustness: `--quick`
 or the full one) in this process, one after the other, through ``robot.cli.main`` (the
 same `biped walk --stop-on-fall` a user runs), with balance on, and scores
 
@@ -25,10 +25,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from robot.config import Gait, gait_to_toml
+from robot.config.params import GaitParams
+from robot.config.robot_file import Gait, gait_to_toml
 from robot.errors import ConfigError
-from robot.params import GaitParams
-from robot.robustness import Condition, Outcome, conditions, outcome, run_walk
+from robot.tuning.robustness import Condition, Outcome, conditions, outcome, run_walk
 
 QUALITY_WEIGHT = 0.9
 

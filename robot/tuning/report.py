@@ -12,9 +12,9 @@ from typing import Any
 
 import optuna
 
-from robot.config import Gait, gait_to_toml, load_gait
+from robot.config.params import SPECS, GaitParams
+from robot.config.robot_file import Gait, gait_to_toml, load_gait
 from robot.errors import ConfigError
-from robot.params import SPECS, GaitParams
 from robot.tuning.space import Knob
 
 

@@ -10,9 +10,9 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from typing import NamedTuple
 
-from robot.params import BALANCE, SPECS, GaitParams
-from robot.robustness import worker_init
+from robot.config.params import BALANCE, SPECS, GaitParams
 from robot.tuning.objective import QUALITY_WEIGHT, Setup, combined, evaluate, quality
+from robot.tuning.robustness import worker_init
 from robot.tuning.space import FIXED, PAIRS, Knob, apply, targets_of
 
 STEP = 0.2

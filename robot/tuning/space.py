@@ -3,7 +3,7 @@
 A ``Knob`` is one searched value; it may drive a pair of parameters (``Slgt`` sets
 ``Slgt_R`` and ``Slgt_L``: a walk stays symmetric and the search has half the
 dimensions). Ranges default to the preset's value x [1 - SPAN, 1 + SPAN], inside the
-parameter's documented range (robot/params.py SPECS); a parameter the preset leaves at 0
+parameter's documented range (robot/config/params.py SPECS); a parameter the preset leaves at 0
 gets SPAN of its documented span around 0. ``--param NAME=LO:HI`` sets one by hand.
 
 ``DEFAULT_KNOBS`` are the ones that matter, from the sensitivity study in docs/tuning.md
@@ -16,8 +16,8 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from typing import NamedTuple
 
+from robot.config.params import ALIASES, SPECS, GaitParams
 from robot.errors import ConfigError
-from robot.params import ALIASES, SPECS, GaitParams
 
 #: Default half-width of a knob's range, as a share of the preset's value.
 SPAN = 0.5

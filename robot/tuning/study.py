@@ -26,8 +26,8 @@ from typing import Any
 
 import optuna
 
+from robot.config.params import GaitParams
 from robot.errors import ConfigError
-from robot.params import GaitParams
 from robot.tuning.objective import (
     QUALITY_WEIGHT,
     Evaluation,

@@ -1,0 +1,138 @@
+"""Checks of a robot config that need more than one field: the bus settings of a servo
+family, and joint limits that must map onto ticks the bus accepts.
+
+The tick check uses ``ServoMap`` and ``TickLimits`` themselves, so "the config loads" and
+"every goal the map can produce is one the bus accepts" cannot drift apart.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from robot.bus.tables import BAUD_CODES, BUS_FAMILIES, MODELS
+from robot.config.joint_names import ARM_NAMES, EXTRA_NAME, HIP_YAW_NAMES, JOINT_NAMES, LEG_NAMES
+from robot.config.toml_io import show
+from robot.errors import ConfigError
+
+if TYPE_CHECKING:
+    from robot.config.robot_file import BusConfig, JointConfig, RobotConfig
+
+#: Decimal places of the radian ranges printed in messages (rounded inward, so a value
+#: copied from the message fits).
+RAD_DIGITS = 4
+
+
+def standard_bauds(kind: str) -> list[int]:
+    """The baud rates [bit/s] the servos of bus ``kind`` ("dynamixel" | "feetech") offer."""
+    return sorted(BAUD_CODES[BUS_FAMILIES[kind]].values())
+
+
+def check_bus(src: str, bus: BusConfig) -> None:
+    """kind, model and baud agree with each other (tables.py)."""
+    if bus.kind not in BUS_FAMILIES:
+        raise ConfigError(f"{src}: bus.kind: expected one of {', '.join(BUS_FAMILIES)}, "
+                          f"got {bus.kind!r}")
+    if bus.model not in MODELS:
+        raise ConfigError(f"{src}: bus.model: unknown servo model {bus.model!r}; valid: "
+                          f"{', '.join(MODELS)}")
+    if MODELS[bus.model].family != BUS_FAMILIES[bus.kind]:
+        raise ConfigError(f"{src}: bus.model: {bus.model} is not a {bus.kind} servo")
+    rates = standard_bauds(bus.kind)
+    if bus.baud not in rates:
+        raise ConfigError(f"{src}: bus.baud: expected a {bus.kind} baud rate (one of "
+                          f"{', '.join(map(str, rates))}), got {show(bus.baud)}")
+
+
+def _inward(lo: float, hi: float) -> tuple[float, float]:
+    k = 10 ** RAD_DIGITS
+    return math.ceil(lo * k) / k, math.floor(hi * k) / k
+
+
+def check_ticks(robot: RobotConfig) -> None:
+    """Every joint's [min_rad, max_rad] maps (after ServoMap's rounding) onto a non-empty
+    tick range that the bus's TickLimits accept whole; else ConfigError naming the joint's
+    field and the radian range that fits its zero_ticks and sign."""
+    from robot.bus.limits import TickLimits
+    from robot.bus.servo_map import ServoMap
+
+    sm = ServoMap(robot)
+    allowed = TickLimits(robot).by_id
+    n = len(robot.joints)
+    q_at_0, q_at_top = sm.to_rad(np.zeros(n)), sm.to_rad(sm.resolution - 1.0)
+    for i, j in enumerate(robot.joints):
+        res = int(sm.resolution[i])
+        lo, hi = int(sm.tick_min[i]), int(sm.tick_max[i])
+        if lo <= hi and allowed[j.servo_id] == (lo, hi):
+            continue
+        jp = f"joints.{j.name}"
+        if lo > hi:
+            raise ConfigError(f"{robot.source}: {jp}.min_rad/max_rad: [{j.min_rad:g}, "
+                              f"{j.max_rad:g}] rad holds no whole servo tick; expected limits "
+                              f"at least one tick ({1 / sm.ticks_per_rad[i]:.5f} rad) apart")
+        ends = sorted((float(q_at_0[i]), float(q_at_top[i])))
+        fit_lo, fit_hi = _inward(max(ends[0], -math.pi), min(ends[1], math.pi))
+        # The low tick end is min_rad's for sign +1, max_rad's for sign -1.
+        low_bad, high_bad = lo < 0, hi > res - 1
+        if low_bad and high_bad:
+            field = "min_rad/max_rad"
+        else:
+            field = "min_rad" if low_bad == (j.sign > 0) else "max_rad"
+        q = j.min_rad if field == "min_rad" else j.max_rad
+        tick = lo if low_bad else hi
+        raise ConfigError(
+            f"{robot.source}: {jp}.{field}: {q:g} rad is tick {tick}, outside the servo's "
+            f"0..{res - 1} (zero_ticks {j.zero_ticks}, sign {j.sign:+d}); expected min_rad "
+            f"and max_rad within [{fit_lo:.{RAD_DIGITS}f}, {fit_hi:.{RAD_DIGITS}f}] rad, "
+            "or another zero_ticks")
+
+
+def check_joint_set(src: str, jtab: Mapping[str, Any]) -> None:
+    """Every leg joint (hip yaw on both sides or neither), all arm joints or none; any
+    other name is an extra joint and needs ``fixed_rad``."""
+    for name, entry in jtab.items():
+        if name in JOINT_NAMES:
+            continue
+        if not EXTRA_NAME.match(name):
+            raise ConfigError(f"{src}: joints.{name}: not a joint name; use lowercase letters, "
+                              "digits and '_' (an extra joint, e.g. head_pan)")
+        if not isinstance(entry, Mapping) or "fixed_rad" not in entry:
+            raise ConfigError(f"{src}: joints.{name}: unknown joint; the gait drives "
+                              f"{', '.join(JOINT_NAMES)}; an extra joint (e.g. head_pan) "
+                              "needs fixed_rad, the angle it is held at [rad]")
+    legs = [n for n in LEG_NAMES if n not in HIP_YAW_NAMES]
+    missing = [n for n in legs if n not in jtab]
+    if missing:
+        raise ConfigError(f"{src}: joints.{missing[0]}: missing (every leg joint is required; "
+                          "only hip yaw may be left out, on both sides)")
+    yaws = [n for n in HIP_YAW_NAMES if n in jtab]
+    if len(yaws) == 1:
+        absent = next(n for n in HIP_YAW_NAMES if n not in jtab)
+        raise ConfigError(f"{src}: joints.{absent}: missing (hip yaw on both legs, or neither "
+                          "for 5-DoF legs)")
+    arms = [n for n in ARM_NAMES if n in jtab]
+    if arms and len(arms) != len(ARM_NAMES):
+        absent = next(n for n in ARM_NAMES if n not in jtab)
+        raise ConfigError(f"{src}: joints.{absent}: missing (arms need all of "
+                          f"{', '.join(ARM_NAMES)}, or none)")
+
+
+def check_joint_extras(src: str, jp: str, j: JointConfig, bus: BusConfig, *,
+                       extra: bool) -> None:
+    """``model`` is a servo of the bus's family; ``fixed_rad`` only on extra joints and
+    inside the joint's limits."""
+    if j.model is not None:
+        family = BUS_FAMILIES[bus.kind]
+        valid = [m for m, s in MODELS.items() if s.family == family]
+        if j.model not in valid:
+            raise ConfigError(f"{src}: {jp}.model: {show(j.model)} is not a {bus.kind} servo "
+                              f"model; valid: {', '.join(valid)}")
+    if j.fixed_rad is not None and not extra:
+        raise ConfigError(f"{src}: {jp}.fixed_rad: the gait drives {j.name}; fixed_rad is for "
+                          "extra joints only (e.g. head_pan)")
+    if j.fixed_rad is not None and not j.min_rad <= j.fixed_rad <= j.max_rad:
+        raise ConfigError(f"{src}: {jp}.fixed_rad: {j.fixed_rad:g} is outside the joint "
+                          f"limits [{j.min_rad:g}, {j.max_rad:g}]")

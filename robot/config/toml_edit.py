@@ -1,0 +1,68 @@
+"""Change a few joint values of a robot TOML file, keeping its comments and layout (tomlkit).
+
+``edit_joints(text, {joint: {field: value}})`` returns the new text; the caller validates it
+with ``robot.config.robot_file.parse_robot`` before writing. ``write_validated`` does both: nothing is
+written unless the result loads.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import tomllib
+from collections.abc import Mapping
+from pathlib import Path
+
+import tomlkit
+from tomlkit.exceptions import TOMLKitError
+
+from robot.config.robot_file import RobotConfig, parse_robot
+from robot.errors import ConfigError
+
+EDITABLE = ("sign", "zero_ticks", "min_rad", "max_rad")
+
+
+def edit_joints(text: str, changes: Mapping[str, Mapping[str, int | float]], *,
+                source: str = "<robot>") -> str:
+    """``text`` with ``joints.<joint>.<field>`` set for every entry of ``changes``."""
+    try:
+        doc = tomlkit.parse(text)
+    except TOMLKitError as e:
+        raise ConfigError(f"{source}: not valid TOML: {e}") from e
+    joints = doc.get("joints")
+    for joint, fields in changes.items():
+        table = joints.get(joint) if joints is not None else None
+        if table is None:
+            raise ConfigError(f"{source}: joints.{joint}: missing; cannot set "
+                              f"{', '.join(fields)}")
+        for name, value in fields.items():
+            if name not in EDITABLE:
+                raise ValueError(f"edit_joints: {name!r} is not one of {EDITABLE}")
+            table[name] = value
+    return tomlkit.dumps(doc)
+
+
+def same_path(a: str | Path, b: str | Path) -> bool:
+    """Whether ``a`` and ``b`` name the same file (symlinks and relative paths resolved)."""
+    pa, pb = Path(a), Path(b)
+    if pa.exists() and pb.exists():
+        return os.path.samefile(pa, pb)
+    return pa.resolve() == pb.resolve()
+
+
+def write_validated(source: Path, out: Path,
+                    changes: Mapping[str, Mapping[str, int | float]]) -> RobotConfig:
+    """Write ``source`` with ``changes`` to ``out`` (atomically) if the result is a valid
+    robot file; ConfigError naming ``out``, its field and the fix otherwise (nothing written)."""
+    text = edit_joints(source.read_text(encoding="utf-8"), changes, source=str(source))
+    robot = parse_robot(tomllib.loads(text), source=str(out))
+    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", dir=out.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, out)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return robot

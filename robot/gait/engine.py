@@ -1,0 +1,250 @@
+"""Gait engine: params + phase + envelope → channels → targets → IK → joint angles.
+
+Pure (no I/O). ``tick(dt)`` serves the control loop on floats; ``curves(times)`` serves
+previs on numpy arrays. Joint angles come out in ``robot.joints`` order, clamped to the
+joint limits; unreachable targets are clamped by the IK and counted, never NaN.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robot.config.params import SPECS, GaitParams
+from robot.config.robot_file import JOINT_NAMES, RobotConfig
+from robot.gait import expressions as gait
+from robot.gait.ik import arm_ik, leg_ik
+from robot.gait.targets import NO_TRIM, BodyTargets, body_targets
+from robot.gait.xmath import Num
+
+log = logging.getLogger(__name__)
+
+#: Time constant [s] with which live parameter changes are followed while the gait runs.
+#: Phase rates are integrated, but amplitudes (stride, foot height, ...) would otherwise
+#: step the targets within one tick.
+PARAM_TAU_S = 0.1
+#: Steering parameters follow a live change at most this fast [unit/s]: a reversal or a
+#: sudden side step or turn would otherwise change the step under a foot that stands.
+#: (speed: stride multiplier per s; turn: rad/step per s; side_step: m/step per s)
+STEER_RATE: dict[str, float] = {"speed": 0.5, "turn": 0.25, "side_step": 0.02}
+#: Steering is limited jointly: each of speed, turn and side step may reach the end of
+#: its range alone, but |speed| / its end + |turn| / its end + |side_step| / its end
+#: may not exceed this; a combination beyond it is scaled down (all three alike). Measured
+#: in MuJoCo with balance on: 1.25 walked every combination tried on both 18-joint robots
+#: (30 s each), 1.5 fell on the Feetech one (speed 1.125 with turn 0.375, and backward
+#: -0.75 with turn 0.375).
+STEER_BUDGET = 1.25
+
+
+def within_steering_budget(p: GaitParams) -> GaitParams:
+    """``p`` with speed, turn and side_step scaled down together to ``STEER_BUDGET``
+    (``p`` itself when inside it)."""
+    used = 0.0
+    for name in ("speed", "turn", "side_step"):
+        v, spec = getattr(p, name), SPECS[name]
+        end = spec.hi if v > 0 else -spec.lo
+        used += abs(v) / end if end > 0 else 0.0
+    if used <= STEER_BUDGET:
+        return p
+    k = STEER_BUDGET / used
+    return dataclasses.replace(p, speed=p.speed * k, turn=p.turn * k, side_step=p.side_step * k)
+
+
+def solve(t: BodyTargets, robot: RobotConfig) -> tuple[list[Num], Num]:
+    """IK for every joint of ``robot`` (its joint order) and a reachable flag."""
+    g = robot.geometry
+    r = leg_ik(g, "r", t.r_sole, t.r_foot)
+    lft = leg_ik(g, "l", t.l_sole, t.l_foot)
+    q: list[Num] = [*r.q, *lft.q]
+    ok = r.reachable & lft.reachable
+    if robot.has_arms:
+        ra = arm_ik(g, t.r_hand)
+        la = arm_ik(g, t.l_hand)
+        q += [*ra.q, *la.q]
+        ok = ok & ra.reachable & la.reachable
+    layout = robot.layout
+    if layout is not None:   # 5-DoF legs, extra joints held at fixed angles
+        q = [q[i] if i >= 0 else fixed for i, fixed in layout]
+    return q, ok
+
+
+def _smoothstep(x: float) -> float:
+    x = min(max(x, 0.0), 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+class GaitEngine:
+    """Live gait state for one robot.
+
+    The envelope ramps the gait amplitude in after ``start()`` and out after ``stop()``,
+    over ``ramp_cycles`` gait cycles; the phase starts at 0 (start of the right swing).
+    Parameter changes while the gait moves are followed smoothly (``PARAM_TAU_S``):
+    ``params`` is what was set, ``live_params`` what the last tick used.
+    """
+
+    def __init__(self, robot: RobotConfig, params: GaitParams) -> None:
+        driven = tuple(n for n in robot.joint_names if n in JOINT_NAMES)
+        if driven != tuple(n for n in JOINT_NAMES if n in driven):
+            raise ValueError("robot joints must be in canonical order")
+        self.robot = robot
+        self._leg_yaw = robot.has_hip_yaw
+        if not self._leg_yaw and params.turn != 0.0:
+            log.warning("%s has no hip yaw (5-DoF legs): turn = %g is ignored", robot.name,
+                        params.turn)
+        self._params = params
+        self._target = within_steering_budget(params)
+        self._live = self._target
+        self.phase = gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0)
+        self.time = 0.0
+        self._ramp = 0.0          # linear ramp variable in [0, 1]
+        self._running = False
+        self.unreachable_ticks = 0
+        #: Posture change relative to the feet, set by a feedback loop (robot.balance).
+        self.trim = NO_TRIM
+        #: Lift of the right and left foot [m] at the last ``pose`` (> 0: swinging).
+        self.lift = (0.0, 0.0)
+        self._lo = [j.min_rad for j in robot.joints]
+        self._hi = [j.max_rad for j in robot.joints]
+
+    # -- parameters -------------------------------------------------------------------
+    @property
+    def params(self) -> GaitParams:
+        return self._params
+
+    def set_params(self, changes: Mapping[str, Any], *, where: str = "parameter") -> GaitParams:
+        """Validate and apply ``changes``; on error nothing changes (ConfigError)."""
+        self.replace_params(self._params.replace(changes, where=where))
+        return self._params
+
+    def replace_params(self, params: GaitParams) -> None:
+        """Set new parameters: at once while stopped, else followed smoothly by ``tick``
+        (steering within ``STEER_BUDGET``)."""
+        self._params = params
+        self._target = within_steering_budget(params)
+        if self.stopped:
+            self._live = self._target
+
+    @property
+    def live_params(self) -> GaitParams:
+        """The parameters in effect now (approaching ``params`` after a live change)."""
+        return self._live
+
+    def _follow(self, dt: float) -> None:
+        """Move the live parameters towards the set ones (first order, ``PARAM_TAU_S``)."""
+        live, target = self._live, self._target
+        if live is target:
+            return
+        a = 1.0 - math.exp(-dt / PARAM_TAU_S)
+        moved: dict[str, float] = {}
+        for name, spec in SPECS.items():
+            cur, goal = getattr(live, name), getattr(target, name)
+            if cur != goal:
+                rate = STEER_RATE.get(name)
+                if rate is not None:
+                    step = rate * dt
+                    v = goal if abs(goal - cur) <= step else cur + math.copysign(step, goal - cur)
+                    moved[name] = v
+                    continue
+                v = cur + a * (goal - cur)
+                moved[name] = goal if abs(goal - v) <= 1e-9 * (spec.hi - spec.lo) else v
+        self._live = target if all(moved[n] == getattr(target, n) for n in moved) \
+            else dataclasses.replace(live, **moved)
+
+    # -- envelope ---------------------------------------------------------------------
+    def start(self) -> None:
+        self._running = True
+
+    def stop(self) -> None:
+        self._running = False
+
+    @property
+    def amplitude(self) -> float:
+        """Current envelope value in [0, 1]."""
+        return _smoothstep(self._ramp)
+
+    @property
+    def stopped(self) -> bool:
+        """True once a stop has fully ramped out."""
+        return not self._running and self._ramp <= 0.0
+
+    @property
+    def running(self) -> bool:
+        return self._running
+
+    # -- evaluation -------------------------------------------------------------------
+    def pose(self, *, amplitude: float | None = None) -> list[float]:
+        """Joint angles [rad] at the current phase (default: the current envelope)."""
+        a = self.amplitude if amplitude is None else amplitude
+        p = self._live
+        ch = gait.channels(self.phase, p, amplitude=a)
+        targets = body_targets(ch, p, self.robot.geometry, amplitude=a,
+                               leg_yaw=self._leg_yaw, trim=self.trim)
+        self.lift = (float(targets.lift_r), float(targets.lift_l))
+        q, ok = solve(targets, self.robot)
+        if not ok:
+            self.unreachable_ticks += 1
+            if self.unreachable_ticks in (1, 10, 100) or self.unreachable_ticks % 1000 == 0:
+                log.warning("gait target out of reach (%d ticks so far): clamped to the "
+                            "nearest reachable pose; reduce stride, foot height or crouch",
+                            self.unreachable_ticks)
+        lo, hi = self._lo, self._hi
+        return [lo[i] if v < lo[i] else hi[i] if v > hi[i] else float(v)
+                for i, v in enumerate(q)]
+
+    def start_pose(self) -> list[float]:
+        """The pose at phase 0 with the envelope at 0 (where a walk starts and ends)."""
+        saved = self.phase
+        self.phase = gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0)
+        try:
+            return self.pose(amplitude=0.0)
+        finally:
+            self.phase = saved
+
+    def tick(self, dt: float) -> list[float]:
+        """Advance by ``dt`` [s] (parameters, phase and envelope) and return the joint
+        angles [rad]."""
+        self._follow(dt)
+        p = self._live
+        ramp_s = p.ramp_cycles * p.cycle_s
+        step = 1.0 if not math.isfinite(ramp_s) or ramp_s <= 0 else dt / ramp_s
+        if self._running:
+            self._ramp = min(1.0, self._ramp + step)
+        else:
+            self._ramp = max(0.0, self._ramp - step)
+        if self._ramp > 0.0:
+            self.phase = gait.advance(self.phase, p, dt * (1.0 + self.trim.tempo))
+        else:
+            # Fully ramped out: at zero amplitude the pose does not depend on the phase, so
+            # resetting it is invisible and the next start begins a fresh stride.
+            self.phase = gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0)
+        self.time += dt
+        return self.pose()
+
+    def curves(self, times: npt.NDArray[np.float64], *, chunk: int = 16384,
+               with_channels: bool = True
+               ) -> tuple[dict[str, npt.NDArray[np.float64]], npt.NDArray[np.float64]]:
+        """Channels and joint angles (n_joints, n) over ``times`` [s] at full amplitude and
+        constant parameters (vectorised, in cache-sized chunks). ``with_channels=False``
+        returns an empty channel dict and only the joint angles."""
+        times = np.asarray(times, dtype=float)
+        n = times.shape[0]
+        names = gait.CHANNELS if with_channels else ()
+        out_ch = {name: np.empty(n) for name in names}
+        out_q = np.empty((len(self.robot.joints), n))
+        for i in range(0, n, chunk):
+            sl = slice(i, min(i + chunk, n))
+            ch = gait.curves(times[sl], self._target)
+            q, _ = solve(body_targets(ch, self._target, self.robot.geometry,
+                                      leg_yaw=self._leg_yaw), self.robot)
+            for name in names:
+                out_ch[name][sl] = ch[name]
+            for j, v in enumerate(q):
+                out_q[j, sl] = v
+        np.clip(out_q, np.array(self._lo)[:, None], np.array(self._hi)[:, None], out=out_q)
+        return out_ch, out_q

@@ -1,0 +1,94 @@
+"""Per-tick recording of a run to CSV or JSON Lines (chosen by the file extension)."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+from typing import IO, Any
+
+from robot.errors import ConfigError
+from robot.loop.streamer import Telemetry
+
+FORMATS = (".csv", ".jsonl")
+
+
+class Recorder:
+    """Writes time since the first tick [s], commanded and present joint positions, loop
+    timing, temperatures and loads (present values only on read-back ticks, blank / null
+    otherwise)."""
+
+    def __init__(self, path: str | Path, joint_names: tuple[str, ...],
+                 ids: tuple[int, ...]) -> None:
+        self.path = Path(path)
+        if self.path.suffix not in FORMATS:
+            raise ConfigError(f"--record {path}: unknown format {self.path.suffix!r}; "
+                              f"valid: {', '.join(FORMATS)}, or .take.jsonl (a take for biped play)")
+        self.names = joint_names
+        self.ids = ids
+        self._file: IO[str] | None = None
+        self._csv: Any = None
+        self._last_tick = -1
+        self._t0: float | None = None
+        self.error: str | None = None  # the first failed write, one line (e.g. disk full)
+
+    def header(self) -> list[str]:
+        cols = ["t", "state", "tick", "period_error_ms", "overruns", "amplitude"]
+        cols += [f"cmd_{n}" for n in self.names] + [f"present_{n}" for n in self.names]
+        cols += [f"temp_{n}" for n in self.names] + [f"load_{n}" for n in self.names]
+        return cols
+
+    def open(self) -> Recorder:
+        """Create the file (ConfigError naming the path if it cannot be written)."""
+        try:
+            self._file = self.path.open("w", newline="")
+        except OSError as e:
+            raise ConfigError(f"--record {self.path}: cannot write it: "
+                              f"{e.strerror or e}") from None
+        if self.path.suffix == ".csv":
+            self._csv = csv.writer(self._file)
+            self._csv.writerow(self.header())
+        return self
+
+    def close(self) -> None:
+        if self._file is not None:
+            file, self._file = self._file, None
+            file.close()
+
+    def close_quietly(self) -> str | None:
+        """Close; the error as one line if the last writes failed (e.g. disk full)."""
+        try:
+            self.close()
+        except OSError as e:
+            self.error = self.error or f"{self.path}: {e.strerror or e}"
+        return self.error
+
+    def __call__(self, tel: Telemetry) -> None:
+        if self._file is None or tel.tick == self._last_tick:
+            return
+        try:
+            self._write(tel)
+        except OSError as e:
+            self.error = self.error or f"{self.path}: {e.strerror or e}"
+            raise
+
+    def _write(self, tel: Telemetry) -> None:
+        assert self._file is not None
+        self._last_tick = tel.tick
+        if self._t0 is None:
+            self._t0 = tel.t
+        fresh = tel.fresh and tel.q_present is not None
+        present = tel.q_present if fresh and tel.q_present else [math.nan] * len(self.names)
+        servo = tel.servo if fresh else {}
+        temps = [servo[i].temperature if i in servo else None for i in self.ids]
+        loads = [servo[i].load if i in servo else None for i in self.ids]
+        row = [tel.t - self._t0, tel.state, tel.tick, tel.period_error_ms, tel.overruns, tel.amplitude,
+               *tel.q_cmd, *present, *temps, *loads]
+        if self._csv is not None:
+            self._csv.writerow(["" if v is None or (isinstance(v, float) and math.isnan(v))
+                                else v for v in row])
+        else:
+            rec = {k: (None if isinstance(v, float) and math.isnan(v) else v)
+                   for k, v in zip(self.header(), row, strict=True)}
+            self._file.write(json.dumps(rec) + "\n")

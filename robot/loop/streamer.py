@@ -1,0 +1,339 @@
+"""The fixed-rate control loop: absolute deadlines, ramps, safety, watchdog, telemetry.
+
+There is one loop: ``_send`` (clamp to the joint limits, limit the slew rate to each
+servo's max speed, wait for the next absolute deadline, ONE sync write, every
+``read_every`` ticks a read-back for the watchdog). A walk (``run``) and a move to a pose
+(``move_to``) are sequences of ``_send``; both start and end the same way:
+
+start: read the present pose → refuse (nothing moves, torque untouched) if a joint is
+  outside its limits by more than one slew step → goal := present → torque on → arm the
+  servos' own bus watchdog where they have one.
+end, by cause (docs/hardware.md, "What happens when"):
+  completed / operator stop (``request_stop``, first Ctrl-C or SIGTERM): ramp the gait out,
+    ramp to rest, then torque off, or hold with ``hold_at_end``;
+  emergency stop (second signal, panel E-stop): torque off at once;
+  a fault the robot can still be driven through (an observer raised, e.g. a full disk
+    under ``--record``; the loop cannot keep its rate): ramp out, rest, torque off;
+  an exception in the gait engine: ramp straight to rest, torque off;
+  a fault that makes driving unsafe or impossible (hardware error flag, over-temperature,
+    a servo not following, a dead bus, any other exception): torque off at once.
+A fault always ends with torque off, ``hold_at_end`` or not.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable, Mapping
+from typing import Any, Protocol
+
+import numpy as np
+
+from robot.bus.base import Bus
+from robot.bus.servo_map import ServoMap
+from robot.config.params import GaitParams
+from robot.errors import BusDead, BusError, SafetyStop
+from robot.gait.engine import GaitEngine
+from robot.loop.clock import Clock, MonotonicClock
+from robot.loop.latency import SampleStats
+from robot.loop.start_check import check_inside_limits
+from robot.loop.telemetry import LoopStats, Telemetry, TickObserver
+from robot.loop.watchdog import FAILSAFE_MARGIN, Watchdog, WatchdogConfig
+from robot.motion.ramp import ramp
+
+__all__ = ["Feedback", "LoopStats", "Streamer", "Telemetry", "TickObserver",
+           "check_inside_limits"]
+
+
+class Feedback(Protocol):
+    """A stage between the engine and safety (robot.balance.Balance): ``start`` when the
+    gait starts, then called every tick with the joints [rad] and the tick [s]."""
+
+    def start(self) -> None: ...
+    def stop(self) -> None: ...
+    def __call__(self, q: np.ndarray, dt: float) -> np.ndarray: ...
+
+log = logging.getLogger(__name__)
+
+
+class Streamer:
+    """Streams an engine's joint angles to a bus at ``rate_hz`` [Hz]."""
+
+    def __init__(self, robot_map: ServoMap, bus: Bus, engine: GaitEngine, *,
+                 rate_hz: float = 200.0, read_every: int = 10, clock: Clock | None = None,
+                 hold_at_end: bool = False, watchdog: WatchdogConfig | None = None,
+                 observer: TickObserver | None = None,
+                 feedback: Feedback | None = None) -> None:
+        self.map = robot_map
+        self.bus = bus
+        self.engine = engine
+        self.rate_hz = rate_hz
+        self.dt = 1.0 / rate_hz
+        self._step = robot_map.max_speed * self.dt  # slew limit per tick [rad]
+        self.read_every = max(1, read_every)
+        self.clock: Clock = clock or getattr(bus, "clock", None) or MonotonicClock()
+        self.hold_at_end = hold_at_end
+        self.watchdog_config = watchdog or WatchdogConfig()
+        self.watchdog = Watchdog(self.watchdog_config, robot_map, robot=engine.robot)
+        self.observer = observer
+        self.feedback = feedback
+        self._feedback_on = False
+        self.telemetry = Telemetry()
+        self._lock = threading.Lock()
+        self._pending: dict[str, float] = {}
+        self._stop = threading.Event()
+        self._estop = threading.Event()
+        self._fault: str | None = None
+        self._bus_dead = False
+        self._q_last: np.ndarray = np.zeros(len(robot_map.ids))
+        self._lateness = SampleStats()
+        self._overruns = 0
+        self._bus_errors = 0
+        self._next = 0.0
+        self._ticks = 0
+
+    # -- control from other threads ------------------------------------------------------
+    def set_params(self, changes: Mapping[str, Any], *, where: str = "parameter") -> GaitParams:
+        """Validate ``changes`` now (ConfigError, nothing changes) and apply them at the next
+        tick. Returns the parameters as they will be."""
+        with self._lock:
+            merged = {**self._pending, **changes}
+            new = self.engine.params.replace(merged, where=where)
+            self._pending = {k: float(v) for k, v in merged.items()}
+        return new
+
+    def request_stop(self, reason: str = "stop requested") -> None:
+        """Ramp the gait out, go to rest, then torque off (or hold)."""
+        if not self._stop.is_set():
+            self.telemetry.stop_reason = self.telemetry.stop_reason or reason
+        self._stop.set()
+
+    def emergency_stop(self, reason: str = "emergency stop") -> None:
+        """Torque off at once (the loop ends within one tick)."""
+        self.telemetry.stop_reason = reason
+        self._estop.set()
+        self._stop.set()
+
+    # -- runs ----------------------------------------------------------------------------
+    def run(self, *, seconds: float | None = None) -> LoopStats:
+        """Walk until ``seconds`` of gait have passed or a stop is requested."""
+        return self._session(lambda: self._walk(seconds))
+
+    def move_to(self, q_goal: Any, *, max_speed: Any = None) -> LoopStats:
+        """Ramp (minimum jerk, slew-limited) from the present pose to ``q_goal`` [rad],
+        clamped to the limits; peak speed ``max_speed`` [rad/s] (capped by each joint's).
+        A stop request ends the ramp where it is."""
+        speed = self.map.max_speed if max_speed is None else np.minimum(self.map.max_speed,
+                                                                        max_speed)
+        return self._session(lambda: self._ramp_to(q_goal, state="pose", interruptible=True,
+                                                   max_speed=speed))
+
+    def _session(self, motion: Callable[[], None]) -> LoopStats:
+        wall0 = time.perf_counter()
+        t_start = self.clock.now()
+        ids = list(self.map.ids)
+        present = self.map.from_positions(self.bus.read_positions(ids))
+        q0 = self._check_start(present)          # StartRefused: nothing moved, torque untouched
+        try:
+            self.bus.write_goals(self.map.goals(q0.tolist()))  # no snap to a stale goal
+            self.bus.set_torque(ids, enabled=True)
+            self._q_last = q0
+            self._next = self.clock.now()
+            self._arm_failsafe()
+            motion()
+        except SafetyStop as e:                  # the watchdog: unsafe or impossible to drive
+            self._bus_dead = isinstance(e, BusDead)
+            self._set_fault(f"watchdog: {e}")
+        except Exception as e:
+            log.exception("the control loop failed")
+            self._set_fault(f"exception: {type(e).__name__}: {e}")
+        except BaseException:                    # KeyboardInterrupt, SystemExit: no ramp
+            self._finish(torque_off=True)
+            raise
+        estop = self._estop.is_set()
+        holding = self.hold_at_end and self._fault is None and not estop
+        self._finish(torque_off=not holding)
+        reason = self._fault or self.telemetry.stop_reason or "completed"
+        self.telemetry.stop_reason = reason
+        return self._stats(t_start, wall0, reason, holding=holding, estop=estop)
+
+    def _check_start(self, present: np.ndarray) -> np.ndarray:
+        return check_inside_limits(self.map, present, tolerance=self._step,
+                                   source=self.engine.robot.source)
+
+    def _walk(self, seconds: float | None) -> None:
+        self._ramp_to(self.engine.start_pose(), state="ramp_in", interruptible=True)
+        if not self._stop.is_set():
+            self.engine.start()
+            if self.feedback is not None:
+                self.feedback.start()
+                self._feedback_on = True
+            t_gait = self.clock.now()
+            while not self._estop.is_set():
+                if self._stop.is_set() or (seconds is not None
+                                           and self.clock.now() - t_gait >= seconds):
+                    self.engine.stop()
+                if self.engine.stopped:
+                    break
+                self._apply_pending()
+                try:
+                    q = self.engine.tick(self.dt)
+                except Exception as e:           # the gait is unusable: straight to rest
+                    log.exception("the gait engine failed")
+                    self._set_fault(f"exception in the gait engine: {type(e).__name__}: {e}")
+                    break
+                self._send(np.asarray(q), state="walking" if self.engine.running
+                           else "ramp_out")
+        if not self._estop.is_set():
+            self._ramp_to(self.map.vector(self.engine.robot.rest), state="rest")
+        self._feedback_on = False
+
+    def _set_fault(self, reason: str) -> None:
+        """Record the first fault and request a stop (its ramp-out, if any, follows)."""
+        if self._fault is None:
+            self._fault = reason
+            log.error("safe stop: %s", reason)
+        self.request_stop(reason)
+
+    def _arm_failsafe(self) -> None:
+        timeout = self.watchdog_config.failsafe_s
+        if timeout:
+            timeout = max(timeout, FAILSAFE_MARGIN * self.bus.retry_span_s + 2 * self.dt)
+            armed = self.bus.arm_failsafe(self.map.ids, timeout_s=timeout)
+            if armed is not None:
+                log.info("servo bus watchdog armed: %.2f s", armed)
+
+    def _finish(self, *, torque_off: bool) -> None:
+        """Torque off (one packet first, then confirmed servo by servo) or hold; disarm the
+        servos' watchdog. On a dead bus only the one packet is tried."""
+        self.telemetry.state = "estop" if self._estop.is_set() else "stopped"
+        ids = list(self.map.ids)
+        steps: list[tuple[str, Callable[[], None]]] = []
+        if torque_off:
+            steps.append(("disable torque", lambda: self.bus.release(ids)))
+        if not self._bus_dead:
+            if self.watchdog_config.failsafe_s:
+                steps.append(("disarm the servos' bus watchdog",
+                              lambda: self.bus.disarm_failsafe(ids)))
+            if torque_off:
+                steps.append(("confirm torque off",
+                              lambda: self.bus.set_torque(ids, enabled=False)))
+        for what, step in steps:
+            try:
+                step()
+            except BusError as e:
+                log.error("could not %s: %s", what, e)
+        if not torque_off:
+            log.info("holding the last pose with torque on (hold_at_end)")
+        self._notify()
+
+    def _apply_pending(self) -> None:
+        with self._lock:
+            if not self._pending:
+                return
+            changes, self._pending = self._pending, {}
+        self.engine.set_params(changes)
+
+    def _ramp_to(self, q_goal: Any, *, state: str, interruptible: bool = False,
+                 max_speed: Any = None) -> None:
+        speed = self.map.max_speed if max_speed is None else max_speed
+        path = ramp(self._q_last, self.map.clamp(q_goal), speed, self.rate_hz,
+                    min_duration=0.3)
+        for q in path[1:]:
+            if self._estop.is_set() or (interruptible and self._stop.is_set()):
+                return
+            self._send(q, state=state)
+
+    # -- the one loop --------------------------------------------------------------------
+    def _send(self, q: np.ndarray, *, state: str) -> None:
+        """(Feedback,) clamp, slew-limit, wait for the deadline, write; read back every Nth
+        tick."""
+        if self._feedback_on:
+            q = self._feed_back(q)
+        q = np.clip(self.map.clamp(q), self._q_last - self._step, self._q_last + self._step)
+        q_list = q.tolist()
+        self._wait_deadline()
+        try:
+            self.bus.write_goals(self.map.goals(q_list))
+            self.watchdog.bus_ok("write")
+        except BusError as e:
+            self._bus_errors += 1
+            self.watchdog.bus_failed("write", e)
+        self._q_last = q
+        self._ticks += 1
+        tel = self.telemetry
+        tel.tick, tel.state, tel.q_cmd = self._ticks, state, q_list
+        tel.amplitude = self.engine.amplitude
+        tel.fresh = False
+        if self._ticks % self.read_every == 0:
+            try:
+                states = self.bus.read_state(self.map.ids)
+                self.watchdog.bus_ok("read")
+                tel.servo = states
+                tel.q_present = self.map.from_positions(
+                    {i: s.position for i, s in states.items()}).tolist()
+                tel.fresh = True
+                self.watchdog.check(states, q)
+            except BusError as e:
+                self._bus_errors += 1
+                self.watchdog.bus_failed("read", e)
+        self._notify()
+
+    def _feed_back(self, q: np.ndarray) -> np.ndarray:
+        """``q`` corrected by the feedback stage; if it fails, the walk ends as a fault
+        and goes on open loop (the servos are fine; only the sensor is not)."""
+        assert self.feedback is not None
+        try:
+            return self.feedback(q, self.dt)
+        except Exception as e:
+            self._feedback_on = False
+            self.feedback.stop()
+            log.exception("the balance feedback failed; open loop from here")
+            self._set_fault(f"exception in the balance feedback: {type(e).__name__}: {e}")
+            return q
+
+    def _wait_deadline(self) -> None:
+        self._next += self.dt
+        self.clock.sleep_until(self._next)
+        now = self.clock.now()
+        late = now - self._next
+        if late > self.dt:
+            # Missed at least one whole slot: count it and realign, never burst to catch up.
+            missed = int(late // self.dt)
+            self._overruns += missed
+            self._next += missed * self.dt
+            try:
+                self.watchdog.overrun()
+            except SafetyStop as e:              # the bus still works: ramp out and stop
+                self._set_fault(f"watchdog: {e}")
+        else:
+            self.watchdog.on_time()
+        self._lateness.add(late)
+        self.telemetry.t = now
+        self.telemetry.period_error_ms = late * 1e3
+        self.telemetry.overruns = self._overruns
+
+    def _notify(self) -> None:
+        if self.observer is None:
+            return
+        try:
+            self.observer(self.telemetry)
+        except Exception as e:                   # e.g. a full disk under --record
+            self.observer = None
+            log.exception("an observer of the loop failed; it is detached")
+            self._set_fault(f"exception in an observer: {type(e).__name__}: {e}")
+
+    def _stats(self, t_start: float, wall0: float, reason: str, *, holding: bool,
+               estop: bool) -> LoopStats:
+        lat = self._lateness
+        duration = max(self.clock.now() - t_start, 1e-9)
+        return LoopStats(
+            ticks=self._ticks, rate_hz=self.rate_hz, duration_s=duration,
+            achieved_hz=self._ticks / duration,
+            period_error_p50_ms=lat.percentile(50) * 1e3,
+            period_error_p99_ms=lat.percentile(99) * 1e3,
+            period_error_max_ms=max(lat.max, 0.0) * 1e3 if lat.count else 0.0,
+            overruns=self._overruns, bus_errors=self._bus_errors,
+            wall_s=time.perf_counter() - wall0, stop_reason=reason,
+            fault=self._fault is not None, holding=holding, estop=estop)

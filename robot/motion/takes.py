@@ -1,0 +1,256 @@
+"""Takes: a recorded performance, as a file ``NAME.take.jsonl`` that ``biped play`` replays.
+
+JSON Lines, one object a line, written while the run goes (a crash or a full disk keeps
+everything up to the last line written); plain text that ``jq`` or pandas read:
+
+  {"take": 1, "robot": ..., "robot_file": ..., "joints": [...], "rate_hz": ..., ...}
+      the header: robot, gait preset and every parameter at the start, loop rate,
+      read-back interval, bus kind, balance feedback on or off
+  {"gait_tick": k, "t": ..., "set": {"turn": 0.2, ...}}
+      a parameter change, applied just before gait tick k (t = k / rate_hz [s] of gait
+      time); every change made live (panel, gamepad, keyboard) is one such line
+  {"gait_tick": k, "t": ..., "stop": true}     the gait told to ramp out before tick k
+  {"tick": n, "t": ..., "state": "walking", "q": [...]}
+      one streamed tick: the commanded joint angles [rad] as they went to the bus (after
+      balance, clamp and slew), ``t`` [s] on the loop's clock since the first tick
+
+The gait is a pure function of the parameter timeline, so replaying the timeline on the
+same robot and rate reproduces the stream (in the simulation with balance feedback too:
+MuJoCo is deterministic from the same start). ``read_take`` validates a file completely
+before anything moves; every problem is one line naming the file, the line and the field.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robot.config.params import GaitParams, canonical_name
+from robot.errors import ConfigError
+from robot.loop.telemetry import Telemetry
+
+SUFFIX = ".take.jsonl"
+VERSION = 1
+#: Largest take read [bytes]: an hour at 200 Hz of 18 joints is ~0.3 GB; refuse beyond.
+MAX_BYTES = 1 << 30
+
+
+def is_take(path: str | Path) -> bool:
+    return str(path).endswith(SUFFIX)
+
+
+@dataclass(frozen=True)
+class TakeHeader:
+    """What a replay needs to reproduce the run. rate_hz [Hz]; read_every: read-back
+    interval [ticks]; params: every gait parameter at the start."""
+
+    robot: str
+    robot_file: str
+    joints: tuple[str, ...]
+    rate_hz: float
+    read_every: int
+    gait: str
+    params: GaitParams
+    bus: str = "sim"
+    balance: bool = False
+    note: str = ""
+    #: A keyframe sequence layered on the gait (robot.motion.keyframes.Sequence.as_json()).
+    keyframes: Mapping[str, Any] | None = None
+
+    def as_json(self) -> dict[str, Any]:
+        return {"take": VERSION, "robot": self.robot, "robot_file": self.robot_file,
+                "joints": list(self.joints), "rate_hz": self.rate_hz,
+                "read_every": self.read_every, "gait": self.gait,
+                "params": self.params.as_dict(), "bus": self.bus, "balance": self.balance,
+                "note": self.note, "keyframes": self.keyframes}
+
+
+@dataclass(frozen=True)
+class Take:
+    """A take read back: header, timeline (gait tick → changes; the tick of the stop, or
+    None) and the joint stream (``q``: ticks x joints [rad]; ``t`` [s]; ``states``)."""
+
+    header: TakeHeader
+    changes: Mapping[int, Mapping[str, float]]
+    stop_tick: int | None
+    t: npt.NDArray[np.float64]
+    q: npt.NDArray[np.float64]
+    states: tuple[str, ...] = field(default=())
+    source: str = "<memory>"
+
+    @property
+    def gait_seconds(self) -> float:
+        """Gait time until the stop [s] (the whole stream if it never stopped)."""
+        if self.stop_tick is not None:
+            return self.stop_tick / self.header.rate_hz
+        return len(self.t) / self.header.rate_hz
+
+
+class TakeWriter:
+    """Writes a take as the run goes: ``open()`` writes the header, ``event()`` a timeline
+    line (from the loop thread, via ``robot.motion.scripted.RecordingEngine``), and calling it with
+    the loop's telemetry writes the tick. A failed write (disk full) is kept and raised at
+    the next tick, so the streamer ends the run as an observer fault (ramp out, torque off)."""
+
+    def __init__(self, path: str | Path, header: TakeHeader) -> None:
+        self.path = Path(path)
+        if not is_take(self.path):
+            raise ConfigError(f"{path}: a take file name ends in {SUFFIX}")
+        self.header = header
+        self._file: IO[str] | None = None
+        self._last_tick = -1
+        self._t0: float | None = None
+        self.error: str | None = None
+        self.ticks = 0
+
+    def open(self) -> TakeWriter:
+        try:
+            self._file = self.path.open("w")
+        except OSError as e:
+            raise ConfigError(f"--record {self.path}: cannot write it: "
+                              f"{e.strerror or e}") from None
+        self._line(self.header.as_json())
+        return self
+
+    def _line(self, obj: Mapping[str, Any]) -> None:
+        if self._file is None:
+            return
+        try:
+            self._file.write(json.dumps(obj) + "\n")
+        except OSError as e:
+            self.error = self.error or f"{self.path}: {e.strerror or e}"
+
+    def event(self, gait_tick: int, **what: Any) -> None:
+        self._line({"gait_tick": gait_tick, "t": gait_tick / self.header.rate_hz, **what})
+
+    def __call__(self, tel: Telemetry) -> None:
+        if self.error is not None:
+            raise OSError(self.error)
+        if self._file is None or tel.tick == self._last_tick or not tel.q_cmd:
+            return
+        self._last_tick = tel.tick
+        if self._t0 is None:
+            self._t0 = tel.t
+        self.ticks += 1
+        self._line({"tick": tel.tick, "t": tel.t - self._t0, "state": tel.state,
+                    "q": tel.q_cmd})
+
+    def close_quietly(self) -> str | None:
+        """Close; the first failed write as one line, or None."""
+        if self._file is not None:
+            file, self._file = self._file, None
+            try:
+                file.close()
+            except OSError as e:
+                self.error = self.error or f"{self.path}: {e.strerror or e}"
+        return self.error
+
+
+# ------------------------------------------------------------------------------ reading
+
+
+def _fail(where: str, what: str) -> ConfigError:
+    return ConfigError(f"{where}: {what}")
+
+
+def _int(where: str, v: Any, name: str, lo: int = 0) -> int:
+    if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+        raise _fail(where, f"{name}: expected an integer >= {lo}, got {v!r:.40}")
+    return v
+
+
+def _header(where: str, h: Any) -> TakeHeader:
+    if not isinstance(h, dict) or h.get("take") != VERSION:
+        raise _fail(where, f"not a take header (expected {{\"take\": {VERSION}, ...}}); "
+                           f"record one with --record NAME{SUFFIX}")
+    joints = h.get("joints")
+    if not (isinstance(joints, list) and joints and all(isinstance(j, str) for j in joints)):
+        raise _fail(where, "joints: expected a list of joint names")
+    rate = h.get("rate_hz")
+    if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not 1 <= rate <= 2000:
+        raise _fail(where, f"rate_hz: expected a rate in [1, 2000] Hz, got {rate!r:.40}")
+    params = h.get("params")
+    if not isinstance(params, dict):
+        raise _fail(where, "params: expected a table of gait parameters")
+    strings = {k: h.get(k, "") for k in ("robot", "robot_file", "gait", "bus", "note")}
+    for k, v in strings.items():
+        if not isinstance(v, str):
+            raise _fail(where, f"{k}: expected a string, got {v!r:.40}")
+    keys = h.get("keyframes")
+    if keys is not None and not isinstance(keys, dict):
+        raise _fail(where, "keyframes: expected a keyframe sequence object or null")
+    return TakeHeader(robot=strings["robot"], robot_file=strings["robot_file"],
+                      joints=tuple(joints), rate_hz=float(rate),
+                      read_every=_int(where, h.get("read_every", 10), "read_every", 1),
+                      gait=strings["gait"] or "take",
+                      params=GaitParams().replace(params, where=f"{where}: params"),
+                      bus=strings["bus"] or "sim", balance=h.get("balance") is True,
+                      note=strings["note"], keyframes=keys)
+
+
+def read_take(path: str | Path) -> Take:
+    """Read and validate a take; ConfigError naming the file and line on any problem."""
+    p = Path(path)
+    try:
+        if p.stat().st_size > MAX_BYTES:
+            raise ConfigError(f"{p}: larger than {MAX_BYTES >> 20} MiB; not a take")
+        lines = p.read_text().splitlines()
+    except FileNotFoundError:
+        raise ConfigError(f"{p}: file not found") from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise ConfigError(f"{p}: cannot read it: {e}") from None
+    rows: list[tuple[str, Any]] = []
+    for i, text in enumerate(lines, 1):
+        if not text.strip():
+            continue
+        try:
+            rows.append((f"{p}: line {i}", json.loads(text)))
+        except json.JSONDecodeError as e:
+            raise ConfigError(f"{p}: line {i}: not JSON: {e.msg}") from None
+    if not rows:
+        raise ConfigError(f"{p}: empty; expected a take header line")
+    header = _header(*rows[0])
+    params, stop = header.params, None
+    changes: dict[int, dict[str, float]] = {}
+    last_gait = -1
+    t: list[float] = []
+    q: list[list[float]] = []
+    states: list[str] = []
+    for where, row in rows[1:]:
+        if not isinstance(row, dict):
+            raise _fail(where, "expected a JSON object")
+        if "gait_tick" in row:
+            k = _int(where, row["gait_tick"], "gait_tick")
+            if k < last_gait:
+                raise _fail(where, f"gait_tick {k} is before the previous one ({last_gait})")
+            last_gait = k
+            if row.get("stop") is True:
+                stop = k if stop is None else stop
+            elif isinstance(row.get("set"), dict) and row["set"]:
+                params = params.replace(row["set"], where=f"{where}: set")  # validates
+                step = changes.setdefault(k, {})
+                step.update({canonical_name(n): float(v) for n, v in row["set"].items()})
+            else:
+                raise _fail(where, "expected \"set\": {name: value} or \"stop\": true")
+        elif "tick" in row:
+            qs = row.get("q")
+            if not (isinstance(qs, list) and len(qs) == len(header.joints)
+                    and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                            and math.isfinite(v) for v in qs)):
+                raise _fail(where, f"q: expected {len(header.joints)} finite joint angles "
+                                   "[rad]")
+            t.append(float(row.get("t", len(t) / header.rate_hz)))
+            q.append(qs)
+            states.append(str(row.get("state", "")))
+        else:
+            raise _fail(where, "expected a timeline line (gait_tick) or a stream line (tick)")
+    q_arr = np.asarray(q, dtype=float).reshape(len(q), len(header.joints))
+    return Take(header, changes, stop, np.asarray(t, dtype=float), q_arr, tuple(states),
+                source=str(p))

@@ -1,0 +1,160 @@
+"""Plots of run records (`biped walk --record`, .csv or .jsonl) and curve files
+(`biped curves`), told apart by their columns."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robot.errors import ConfigError
+from robot.gait.expressions import CHANNELS
+from robot.previs.curves import outside_legend, palette, plot_curves
+
+Array = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Table:
+    """Numeric columns by name (blank / null / text → NaN) and the ``state`` column."""
+
+    columns: dict[str, Array]
+    states: tuple[str, ...]
+    source: str
+
+    def joints(self, prefix: str) -> list[str]:
+        return [c[len(prefix):] for c in self.columns if c.startswith(prefix)]
+
+
+def _num(v: Any) -> float:
+    if v is None or v == "" or isinstance(v, bool):
+        return math.nan
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def read_table(path: str | Path) -> Table:
+    """Read a .csv or .jsonl file of rows into columns."""
+    p = Path(path)
+    try:
+        with p.open(newline="") as f:
+            if p.suffix == ".jsonl":
+                rows = [json.loads(line) for line in f if line.strip()]
+                names = list(rows[0]) if rows else []
+            elif p.suffix == ".csv":
+                reader = csv.reader(f)
+                names = next(reader, [])
+                rows = [dict(zip(names, r, strict=False)) for r in reader]
+            else:
+                raise ConfigError(f"{path}: unknown format {p.suffix!r}; valid: .csv, .jsonl")
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: file not found") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+        raise ConfigError(f"{path}: not a valid record file: {e}") from e
+    if not rows or "t" not in names:
+        raise ConfigError(f"{path}: no rows with a 't' column; expected a `biped walk "
+                          "--record` or `biped curves` file")
+    cols = {n: np.array([_num(r.get(n)) for r in rows]) for n in names if n != "state"}
+    states = tuple(str(r.get("state", "")) for r in rows)
+    return Table(cols, states, str(p))
+
+
+def kind_of(table: Table) -> str:
+    """"record" (cmd_/present_ columns) or "curves" (paper channels and q_ columns)."""
+    if table.joints("cmd_"):
+        return "record"
+    if table.joints("q_") and all(c in table.columns for c in CHANNELS):
+        return "curves"
+    raise ConfigError(f"{table.source}: neither a run record (cmd_<joint> columns) nor a "
+                      "curves file (paper channels and q_<joint> columns)")
+
+
+def plot_file(path: str | Path, out: str | Path) -> str:
+    """Plot ``path`` to the PNG ``out``; returns the detected kind."""
+    table = read_table(path)
+    kind = kind_of(table)
+    if kind == "curves":
+        names = tuple(table.joints("q_"))
+        q = np.vstack([table.columns[f"q_{n}"] for n in names])
+        plot_curves(out, table.columns["t"], {c: table.columns[c] for c in CHANNELS}, names,
+                    q, title=f"curves {Path(path).name}")
+    else:
+        plot_record(table, out)
+    return kind
+
+
+def record_figure(table: Table) -> Any:
+    """Commanded vs present joint positions (legs, arms), loop timing, temperatures, loads;
+    every axis labelled with its unit, a colour per joint within a panel, legends outside."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    c = table.columns
+    t = c["t"] - c["t"][0]
+    names = table.joints("cmd_")
+    legs = [n for n in names if "shoulder" not in n and "elbow" not in n]
+    arms = [n for n in names if n not in legs]
+    groups = [(g, label) for g, label in ((legs, "leg joints"), (arms, "arm joints")) if g]
+    fig, axes = plt.subplots(len(groups) + 3, 1, figsize=(14, 3.0 * (len(groups) + 3)),
+                             sharex=True, layout="constrained")
+    for ax, (group, label) in zip(axes, groups, strict=False):
+        for n, col in zip(group, palette(len(group)), strict=True):
+            ax.plot(t, c[f"cmd_{n}"], "-", color=col, lw=1.1, label=n)
+            present = c.get(f"present_{n}")
+            if present is not None and np.isfinite(present).any():
+                ok = np.isfinite(present)
+                ax.plot(t[ok], present[ok], ".", color=col, ms=2.5)
+        ax.set_title(f"{label}: commanded (lines) vs present (dots)", loc="left", fontsize=10)
+        ax.set_ylabel("angle [rad]")
+        outside_legend(ax, n=len(group))
+    timing = axes[len(groups)]
+    timing.plot(t, c["period_error_ms"], lw=0.8, color="tab:blue", label="period error")
+    timing.set_ylabel("period error [ms]")
+    if "overruns" in c:
+        count = timing.twinx()
+        count.plot(t, c["overruns"], lw=1.2, color="tab:red", label="overruns (cumulative)")
+        count.set_ylabel("overruns [count]")
+        timing.plot([], [], lw=1.2, color="tab:red", label="overruns (cumulative, right)")
+    if len(t) > 1:
+        dt = np.diff(t)
+        rate = 1.0 / np.median(dt[dt > 0]) if (dt > 0).any() else 0.0
+        timing.set_title(f"loop timing (median rate {rate:.0f} Hz, "
+                         f"p99 period error {np.nanpercentile(c['period_error_ms'], 99):.3f} ms)",
+                         loc="left", fontsize=10)
+    timing.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.06, 1.0), borderaxespad=0.0)
+    for ax, prefix, unit in ((axes[-2], "temp_", "temperature [°C]"),
+                             (axes[-1], "load_", "load [% of max torque]")):
+        joints = table.joints(prefix)
+        for n, col in zip(joints, palette(len(joints)), strict=True):
+            v = c[f"{prefix}{n}"]
+            ok = np.isfinite(v)
+            ax.plot(t[ok], v[ok], "-", color=col, lw=1.0, label=n)
+        ax.set_title("temperatures" if prefix == "temp_" else "loads", loc="left", fontsize=10)
+        ax.set_ylabel(unit)
+        if joints:
+            outside_legend(ax, n=len(joints))
+    for ax in axes:
+        ax.grid(alpha=0.3)
+        ax.set_xlabel("t [s]")
+        ax.tick_params(labelbottom=True)
+    fig.suptitle(f"run record {Path(table.source).name}")
+    return fig
+
+
+def plot_record(table: Table, out: str | Path) -> None:
+    """The record figure (``record_figure``) as a PNG."""
+    import matplotlib.pyplot as plt
+
+    fig = record_figure(table)
+    fig.savefig(out, dpi=90)
+    plt.close(fig)

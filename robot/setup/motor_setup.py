@@ -1,0 +1,220 @@
+"""Giving a factory-new servo its joint's id and the robot's baud rate (``biped setup-motors``).
+
+Only one servo may be on the bus. ``find_servo`` looks for it in two passes, cheapest first:
+
+1. the factory id 1 at every standard baud of the family, and the robot's own ids at the
+   robot's baud (a servo set up earlier and left on the chain), most likely bauds first;
+2. if nothing answered: every id 0..252 at each baud (one broadcast ping per baud where the
+   SDK has it, Dynamixel; else one ping per id), stopping at the first baud that answers.
+
+More than one servo, or a garbled reply (two servos sharing an id answer at once), refuses
+before anything is written. ``assign`` then writes, torque off first (EEPROM): return delay
+0, the id, the baud rate; re-opens at the new baud and checks the id and model answer.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+
+from robot.bus.sdk_bus import SdkBus
+from robot.bus.tables import BAUD_CODES, BUS_FAMILIES, RETURN_DELAY_UNIT_S, model_name
+from robot.config.robot_file import SERVO_ID, JointConfig, RobotConfig
+from robot.errors import BusError, ConfigError
+
+log = logging.getLogger(__name__)
+
+FACTORY_ID = 1
+#: Baud rate [bit/s] as shipped: ROBOTIS X series 57600 (Baud Rate(8) = 1), Feetech STS
+#: 1 Mbps (Baud Rate(6) = 0).
+# AX-12A / MX-28 (Protocol 1.0) ship at 1 Mbps (e-Manual AX-12A, Baud Rate(4) initial 1).
+FACTORY_BAUD = {"dynamixel_x": 57_600, "dynamixel_p1": 1_000_000, "feetech_sts": 1_000_000}
+ALL_IDS = range(int(SERVO_ID.lo), int(SERVO_ID.hi) + 1)
+
+
+class SetupRefused(ConfigError):
+    """setup-motors will not write: not exactly one servo, or the wrong model (exit 2)."""
+
+
+@dataclass(frozen=True)
+class Found:
+    """A servo that answered: its id, baud [bit/s] and model number."""
+
+    id: int
+    baud: int
+    model: int
+
+
+def baud_order(family: str, robot_baud: int) -> list[int]:
+    """The family's standard bauds, most likely first: factory, the robot's, then the rest
+    fastest first (hobby setups favour 1 Mbps and up)."""
+    rest = sorted(BAUD_CODES[family].values(), reverse=True)
+    first = [FACTORY_BAUD[family], robot_baud]
+    return list(dict.fromkeys(first + rest))
+
+
+def _shared_id(bus: SdkBus, sid: int, sign: str) -> SetupRefused:
+    return SetupRefused(f"more than one servo answers as id {sid} at {bus.baud} baud on "
+                        f"{bus.port_name} ({sign}); nothing was written: connect only the "
+                        "servo to set up")
+
+
+def _ping_all(bus: SdkBus, ids: Iterable[int]) -> list[Found]:
+    found = []
+    for sid in ids:
+        try:
+            model = bus.ping(sid)
+        # IndexError: scservo_sdk's ping reads the model number next, and takes a second
+        # servo's late ping reply for it (too short: it indexes past its end).
+        except (BusError, IndexError) as e:
+            raise _shared_id(bus, sid, "garbled replies") from e
+        if model is None:
+            continue
+        if bus.stray_bytes():
+            raise _shared_id(bus, sid, "a second reply")
+        found.append(Found(sid, bus.baud, model))
+    return found
+
+
+def _sweep(bus: SdkBus) -> list[Found]:
+    """Every servo at the current baud: a broadcast ping, else one ping per id."""
+    try:
+        answered = bus.broadcast_ping()
+    except BusError as e:
+        raise SetupRefused(f"garbled replies to a broadcast ping at {bus.baud} baud on "
+                           f"{bus.port_name}: servos sharing an id are connected; connect "
+                           "only the servo to set up") from e
+    if answered is None:
+        return _ping_all(bus, ALL_IDS)
+    return _ping_all(bus, sorted(answered))  # one by one: duplicates collapse in the reply
+
+
+def _try_baud(bus: SdkBus, baud: int) -> bool:
+    """Switch to ``baud``; False (logged) for a rate the SDK cannot set (scservo_sdk has
+    no 76800)."""
+    try:
+        bus.set_baud(baud)
+    except BusError as e:
+        log.info("skipping %d baud: %s", baud, e)
+        return False
+    return True
+
+
+def find_servo(bus: SdkBus, robot: RobotConfig, *,
+               progress: Callable[[str], None] = log.info) -> Found:
+    """The one servo on ``bus`` (open; left at its original baud). SetupRefused when none,
+    or more than one, answers."""
+    family = BUS_FAMILIES[robot.bus.kind]
+    original = bus.baud
+    try:
+        bauds = [b for b in baud_order(family, robot.bus.baud) if _try_baud(bus, b)]
+        skipped = sorted(set(BAUD_CODES[family].values()) - set(bauds))
+        progress(f"looking for id {FACTORY_ID} at {', '.join(map(str, bauds))} baud"
+                 + (f" ({', '.join(map(str, skipped))}: the SDK cannot set it)" if skipped
+                    else ""))
+        found: list[Found] = []
+        for baud in bauds:
+            bus.set_baud(baud)
+            ids = [FACTORY_ID] + ([i for i in robot.ids if i != FACTORY_ID]
+                                  if baud == robot.bus.baud else [])
+            found += _ping_all(bus, ids)
+        if not found:
+            for baud in bauds:
+                bus.set_baud(baud)
+                progress(f"scanning every id at {baud} baud")
+                found = _sweep(bus)
+                if found:
+                    break
+    finally:
+        bus.set_baud(original)
+    if not found:
+        raise SetupRefused(f"no servo answers on {bus.port_name} at any id or {family} baud "
+                           "rate; check its power (the LED flashes at power-up) and cable")
+    if len(found) > 1:
+        who = ", ".join(f"id {f.id} at {f.baud} baud" for f in found)
+        raise SetupRefused(f"{len(found)} servos answer on {bus.port_name} ({who}); nothing "
+                           "was written: connect only the servo to set up")
+    return found[0]
+
+
+def check_model(found: Found, robot: RobotConfig, joint: JointConfig) -> None:
+    """SetupRefused unless the found servo is the robot's model."""
+    want = robot.bus.servo
+    if found.model != want.number:
+        family = BUS_FAMILIES[robot.bus.kind]
+        raise SetupRefused(
+            f"the servo at id {found.id}, {found.baud} baud is a "
+            f"{model_name(family, found.model)} (model {found.model}), but {robot.name} uses "
+            f"{want.name} (model {want.number}) for {joint.name}; nothing was written: connect "
+            f"a {want.name}, or fix bus.model in {robot.source}")
+
+
+def _write_tolerant(bus: SdkBus, sid: int, name: str, value: int,
+                    confirm: Callable[[], bool]) -> None:
+    """Write a register whose effect may change how (or whether) the status reply comes
+    back (id, baud); a failed reply is fine when ``confirm()`` then sees the change."""
+    try:
+        bus.write_register(sid, name, value)
+    except BusError:
+        if not confirm():
+            raise
+
+
+def assign(bus: SdkBus, found: Found, joint: JointConfig, robot: RobotConfig) -> list[str]:
+    """Give the one servo ``found`` the joint's id, the robot's baud and return delay 0;
+    verify at the new baud. Returns what changed, in words. ``bus`` is open; it ends at the
+    robot's baud."""
+    family = BUS_FAMILIES[robot.bus.kind]
+    codes = {b: c for c, b in BAUD_CODES[family].items()}
+    new_id, new_baud = joint.servo_id, robot.bus.baud
+    bus.set_baud(found.baud)
+    sid = found.id
+    bus.set_torque([sid], enabled=False)
+    # Feetech: unlock the EEPROM so the writes survive a power cycle. (The AX's Lock(47)
+    # means the opposite: 1 locks the EEPROM until power-off, so it is never written.)
+    lock = "lock" in bus.table and family == "feetech_sts"
+    if lock:
+        bus.write_register(sid, "lock", 0)
+    changes: list[str] = []
+    delay = bus.read_register(sid, "return_delay_time")
+    if delay:
+        bus.write_register(sid, "return_delay_time", 0)
+        us = delay * RETURN_DELAY_UNIT_S[family] * 1e6
+        changes.append(f"return delay {us:.0f} µs -> 0 (every reply waited that long)")
+    if sid != new_id:
+        _write_tolerant(bus, sid, "id", new_id, lambda: bus.ping(new_id) is not None)
+        changes.append(f"id {sid} -> {new_id}")
+        sid = new_id
+    if found.baud != new_baud:
+        def answers_at_new_baud() -> bool:
+            bus.set_baud(new_baud)
+            return bus.ping(sid) is not None
+
+        _write_tolerant(bus, sid, "baud_rate", codes[new_baud], answers_at_new_baud)
+        changes.append(f"baud {found.baud} -> {new_baud}")
+    bus.set_baud(new_baud)
+    model = bus.ping(sid)
+    if model != found.model:
+        raise BusError(f"{joint.name}: after the writes the servo does not answer as id {sid} "
+                       f"at {new_baud} baud on {bus.port_name} (got {model}); power-cycle it "
+                       f"and rerun `biped setup-motors --joint {joint.name}`")
+    if lock:
+        bus.write_register(sid, "lock", 1)
+    return changes
+
+
+def answered(ask: Callable[[str], str], consequence: str) -> Callable[[str], str]:
+    """``ask`` with end of input (stdin closed, Ctrl-D) turned into a one-line ConfigError."""
+    def wrapped(prompt: str) -> str:
+        try:
+            return ask(prompt)
+        except EOFError:
+            raise ConfigError(f"input ended before the last prompt was answered; "
+                              f"{consequence}") from None
+    return wrapped
+
+
+def joints_to_set(robot: RobotConfig, name: str | None) -> Sequence[JointConfig]:
+    """The joint ``name`` (ConfigError naming the valid ones), or every joint in order."""
+    return [robot.joint(name)] if name else list(robot.joints)

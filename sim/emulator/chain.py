@@ -1,0 +1,342 @@
+"""A chain of emulated servos on a pseudo-terminal, served from its own process.
+
+The real vendor SDKs (dynamixel_sdk, scservo_sdk) open the pty's slave path like a USB
+adapter and talk Dynamixel Protocol 2.0 (``sim.emulator.dxl_protocol``) or Feetech STS
+(``sim.emulator.sts_protocol``) to it. The test process drives faults and reads the log through a
+``multiprocessing`` pipe while the child serves.
+
+- Time: every time stamp is ``time.monotonic()`` [s] (system-wide on Linux, so comparable
+  between the test process and the child). Motion is evaluated lazily at each packet.
+- Baud: a pty carries no baud rate, but pyserial stores the requested speed in the slave's
+  termios; the child holds the slave open and reads that speed (``TCGETS2``) at every
+  packet. A servo whose ``baud_rate`` register names another rate does not hear the packet
+  (counted as ``baud_mismatch``), so "wrong baud: nothing answers" is testable.
+- Replies come back as fast as the pty allows (no wire-time emulation) after each servo's
+  return delay (``return_delay_time`` x 2 us). A missing servo costs the SDK its timeout.
+- Hardware faults: Dynamixel X latches ``hardware_error_status`` until reboot and drops
+  torque (shutdown), every status packet then carries the alert bit 0x80; Feetech's
+  ``status`` register follows the injected condition live and is the reply's error byte.
+- Bus Watchdog (Dynamixel X): each servo keeps the time of the last instruction packet
+  addressed to it; armed, torque on and silent for longer than the setting, it stops
+  (goal := present), the register reads -1 and goal writes get a Data Range Error until
+  0 is written; torque stays on. Evaluated lazily like motion, so ``registers()`` after a
+  silent gap shows the trip. Feetech STS has no such register (see ``tables.COMM_WATCHDOG``).
+- Log: one :class:`Packet` per instruction packet with a valid checksum that at least one
+  servo heard. Broadcast writes log id 254. Written values are decoded little-endian
+  (signed for Dynamixel's signed registers); for bulk reads ``values`` maps id → address.
+- Servos: present position starts at the joint's ``zero_ticks`` (2048 without a robot),
+  position limits are the joint limits in ticks (rounded outward). Sync/bulk reads answer
+  in the order the ids appear in the packet; a missing servo silences the rest. A chain
+  built from a robot is one already set up (return delay 0).
+- Factory-new servos (:meth:`Emulator.factory_new`): id 1, factory baud and return delay,
+  unplugged until :meth:`Emulator.plug` / :meth:`Emulator.plug_all`. Unplugging powers a
+  servo off: it keeps its EEPROM (on STS only what was written with Lock 0), RAM restarts.
+  Servos sharing an id all execute a packet and all answer, one status each (a real bus
+  would garble the overlapping replies; here the host sees both).
+- Closing the port (``set_faults(close_port=True)``) makes the SDK's next call raise
+  (``termios.error``/``SerialException``, EIO) and leaves ``PortHandler.is_using`` set.
+- dynamixel_sdk 4.1 does not byte-stuff what it sends (``addStuffing``'s result is
+  dropped when the packet grows); the emulator's parser still reads such packets by length.
+  Replies are stuffed, and the SDK unstuffs them.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import socket
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import replace
+from multiprocessing.connection import Connection
+from pathlib import Path
+from types import TracebackType
+from typing import Any
+
+from robot.bus.tables import BUS_FAMILIES, ERROR_BITS, MODELS
+from robot.config.robot_file import RobotConfig
+from sim.emulator.control_tables import BAUD_CODES, TABLES
+from sim.emulator.server import ChainSpec, EmulatorError, Packet
+from sim.emulator.servo import ServoSpec
+
+__all__ = ["ChainSpec", "Emulator", "EmulatorError", "Packet"]
+
+log = logging.getLogger(__name__)
+
+ROOT = Path(__file__).resolve().parents[2]  # puts `sim` and `robot` on the child's path
+
+DEFAULT_MODEL = {"dynamixel": "XL430-W250", "dynamixel1": "AX-12A", "feetech": "STS3215"}
+DEFAULT_BAUD = 1_000_000
+# As shipped: ROBOTIS e-Manual XL430-W250 (Baud Rate(8) initial 1 = 57600, Return Delay
+# Time(9) initial 250 = 500 us, ID(7) initial 1); Feetech STS memory table (ID(5) 1, Baud
+# Rate(6) 0 = 1 Mbps, Return Delay Time(7) 0); e-Manual AX-12A (ID(3) 1, Baud Rate(4) 1 =
+# 1 Mbps, Return Delay Time(5) 250 = 500 us).
+FACTORY_BAUD = {"dynamixel": 57_600, "dynamixel1": 1_000_000, "feetech": 1_000_000}
+FACTORY_RETURN_DELAY = {"dynamixel": 250, "dynamixel1": 250, "feetech": 0}
+FACTORY_ID = 1
+REPLY_TIMEOUT_S = 5.0        # control-channel answer [s]
+START_TIMEOUT_S = 20.0       # child start-up [s]
+
+
+def _limits(robot: RobotConfig | None, servo_id: int, model: str) -> tuple[int, int, int]:
+    """(zero, min, max) [ticks] for ``servo_id`` from the robot's joint, else the full range
+    with the horn at its middle (2048 of 4096; 512 of the AX's 1024)."""
+    resolution = MODELS[model].resolution
+    joint = robot.joint_by_id(servo_id) if robot is not None else None
+    if joint is None:
+        return resolution // 2, 0, resolution - 1
+    per_rad = MODELS[model].ticks_per_rad
+    ends = [joint.zero_ticks + joint.sign * q * per_rad for q in (joint.min_rad, joint.max_rad)]
+    lo = max(0, math.floor(min(ends)))
+    hi = min(resolution - 1, math.ceil(max(ends)))
+    return joint.zero_ticks, lo, hi
+
+
+class Emulator:
+    """A servo chain on a pty in a child process. No I/O until :meth:`start`."""
+
+    def __init__(self, protocol: str, robot: RobotConfig | None = None, *,
+                 ids: Sequence[int] | None = None, model: str | None = None, seed: int = 0,
+                 baud: int | None = None) -> None:
+        if protocol not in BUS_FAMILIES:
+            raise EmulatorError(f"protocol: expected one of {', '.join(BUS_FAMILIES)}, "
+                                f"got {protocol!r}")
+        self.protocol = protocol
+        self.family = BUS_FAMILIES[protocol]
+        same_kind = robot is not None and robot.bus.kind == protocol
+        model = model or (robot.bus.model if robot is not None and same_kind
+                          else DEFAULT_MODEL[protocol])
+        if model not in MODELS or MODELS[model].family != self.family:
+            valid = [m for m, s in MODELS.items() if s.family == self.family]
+            raise EmulatorError(f"model: {model!r} is not a {protocol} servo; valid: "
+                                f"{', '.join(valid)}")
+        if ids is None:
+            if robot is None:
+                raise EmulatorError("Emulator needs a robot config or ids=[...]")
+            ids = robot.ids
+        baud = baud or (robot.bus.baud if robot is not None and same_kind else DEFAULT_BAUD)
+        if baud not in BAUD_CODES[self.family].values():
+            raise EmulatorError(f"baud: {baud} is not a {protocol} rate; valid: "
+                                f"{sorted(BAUD_CODES[self.family].values())}")
+        specs = []
+        for sid in ids:
+            joint = robot.joint_by_id(sid) if robot is not None and same_kind else None
+            own = joint.model if joint is not None and joint.model else model  # mixed models
+            zero, lo, hi = _limits(robot, sid, own)
+            specs.append(ServoSpec(sid, own, zero, lo, hi, baud))
+        self.model = model
+        self.baud = baud
+        self.ids = tuple(ids)
+        self.spec = ChainSpec(protocol, tuple(specs), seed)
+        self._proc: subprocess.Popen[bytes] | None = None
+        self._conn: Connection | None = None
+        self._port: str | None = None
+        self._lock = threading.Lock()
+
+    @classmethod
+    def factory_new(cls, protocol: str, count: int, *, model: str | None = None) -> Emulator:
+        """``count`` servos as they come out of the box, none plugged in yet.
+
+        Each has id 1, the factory baud and return delay, torque off and its horn at
+        mid-range; connect them with :meth:`plug` (one at a time) or :meth:`plug_all`.
+        """
+        if protocol not in FACTORY_BAUD:
+            raise EmulatorError(f"protocol: expected one of {', '.join(FACTORY_BAUD)}, "
+                                f"got {protocol!r}")
+        if count < 1:
+            raise EmulatorError(f"count: expected at least 1 servo, got {count}")
+        emu = cls(protocol, ids=[FACTORY_ID] * count, model=model,
+                  baud=FACTORY_BAUD[protocol])
+        delay = FACTORY_RETURN_DELAY[protocol]
+        emu.spec = replace(emu.spec, plugged=(),
+                           servos=tuple(replace(s, return_delay=delay) for s in emu.spec.servos))
+        return emu
+
+    # ------------------------------------------------------------------ lifecycle
+    def start(self) -> str:
+        """Start the child; return the pty slave path (e.g. ``/dev/pts/5``).
+
+        The child is a fresh interpreter (``python -c``), not a ``multiprocessing`` spawn,
+        so callers need no ``if __name__ == "__main__"`` guard; the control channel is a
+        socketpair wrapped in a ``multiprocessing`` Connection.
+        """
+        if self._port is not None:
+            return self._port
+        parent_sock, child_sock = socket.socketpair()
+        fd = child_sock.fileno()
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(
+            p for p in (str(ROOT), env.get("PYTHONPATH", "")) if p)
+        self._proc = subprocess.Popen(
+            [sys.executable, "-c", f"import sim.emulator.server as s; s.child_main({fd})"],
+            pass_fds=[fd], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, env=env)
+        child_sock.close()
+        self._conn = Connection(parent_sock.detach())
+        try:
+            self._conn.send(self.spec)
+            if not self._conn.poll(START_TIMEOUT_S):
+                raise EmulatorError(
+                    f"the emulator process did not start within {START_TIMEOUT_S} s")
+            tag, path = self._conn.recv()
+        except (OSError, EOFError) as e:
+            self.stop()
+            raise EmulatorError("the emulator process died while starting (see its "
+                                "stderr)") from e
+        except EmulatorError:
+            self.stop()
+            raise
+        if tag != "ready":
+            self.stop()
+            raise EmulatorError(f"the emulator failed to start: {path}")
+        self._port = str(path)
+        log.info("emulating %d %s servos (%s, %d bit/s) on %s", len(self.ids), self.model,
+                 self.protocol, self.baud, self._port)
+        return self._port
+
+    def stop(self) -> None:
+        """Stop the child and close the pty. Idempotent."""
+        conn, proc = self._conn, self._proc
+        self._conn = self._proc = None
+        self._port = None
+        if conn is not None:
+            try:
+                conn.send(("stop", ()))
+                if conn.poll(1.0):
+                    conn.recv()
+            except (OSError, EOFError):
+                pass
+            conn.close()
+        if proc is not None:
+            try:
+                proc.wait(2.0)
+            except subprocess.TimeoutExpired:
+                proc.terminate()
+                proc.wait(2.0)
+
+    @property
+    def port(self) -> str:
+        if self._port is None:
+            raise EmulatorError("the emulator is not running; call start() first")
+        return self._port
+
+    @property
+    def alive(self) -> bool:
+        return self._proc is not None and self._proc.poll() is None
+
+    def __enter__(self) -> Emulator:
+        self.start()
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        self.stop()
+
+    # ------------------------------------------------------------------ control
+    def _call(self, cmd: str, *args: Any) -> Any:
+        with self._lock:
+            if self._conn is None:
+                raise EmulatorError("the emulator is not running; call start() first")
+            try:
+                self._conn.send((cmd, args))
+                if not self._conn.poll(REPLY_TIMEOUT_S):
+                    raise EmulatorError(f"the emulator did not answer {cmd!r} within "
+                                        f"{REPLY_TIMEOUT_S} s")
+                tag, payload = self._conn.recv()
+            except (OSError, EOFError) as e:
+                raise EmulatorError(f"the emulator process is gone ({e!r})") from e
+        if tag == "error":
+            raise EmulatorError(payload)
+        return payload
+
+    def set_faults(self, *, drop_rate: float | None = None, corrupt_rate: float | None = None,
+                   missing_ids: Iterable[int] | None = None,
+                   vanish: Mapping[int, float] | None = None,
+                   hw_error: Mapping[int, str | None] | None = None,
+                   stuck_ids: Iterable[int] | None = None,
+                   close_port: bool = False) -> None:
+        """Change faults while serving; unspecified ones keep their setting.
+
+        drop_rate / corrupt_rate: share of replies lost / sent with a bad checksum [0..1];
+        missing_ids: ids that never answer (replaces the set); vanish: id → seconds from now
+        after which it stops answering; hw_error: id → "overheating" | "overload" |
+        "voltage" | ... (names in tables.ERROR_BITS) or None to end the condition;
+        stuck_ids: ids whose horn is jammed from now on (they answer, take goals and
+        report no error, but do not move; replaces the set);
+        close_port: close the pty (the SDK then gets an error; the log stays readable).
+        """
+        for name, rate in (("drop_rate", drop_rate), ("corrupt_rate", corrupt_rate)):
+            if rate is not None and not 0.0 <= rate <= 1.0:
+                raise EmulatorError(f"{name}: expected a share in [0, 1], got {rate}")
+        kinds = set(ERROR_BITS[self.family].values())
+        for sid, kind in (hw_error or {}).items():
+            if kind is not None and kind not in kinds:
+                raise EmulatorError(f"hw_error[{sid}]: unknown fault {kind!r}; valid: "
+                                    f"{', '.join(sorted(kinds))}")
+        now = time.monotonic()
+        self._call("faults", {
+            "drop_rate": drop_rate, "corrupt_rate": corrupt_rate,
+            "missing_ids": None if missing_ids is None else list(missing_ids),
+            "vanish_at": {sid: now + t for sid, t in (vanish or {}).items()},
+            "hw_error": dict(hw_error or {}), "close_port": close_port,
+            "stuck_ids": None if stuck_ids is None else list(stuck_ids),
+        })
+
+    def clear_faults(self) -> None:
+        """End every injected fault (a latched Dynamixel hardware error needs a reboot)."""
+        self._call("clear")
+
+    def log(self, *, clear: bool = False) -> list[Packet]:
+        """Every logged instruction packet, oldest first; ``clear`` empties the log."""
+        return list(self._call("log", clear))
+
+    def counters(self) -> dict[str, int]:
+        """Packets per instruction name, plus rx/tx bytes and packets and fault counts."""
+        return dict(self._call("counters"))
+
+    def registers(self, servo_id: int) -> dict[str, int]:
+        """Snapshot of one servo's control table by register name (motion brought to now)."""
+        return dict(self._call("registers", servo_id))
+
+    def registers_of(self, index: int) -> dict[str, int]:
+        """Snapshot of servo number ``index`` (0-based, plugged or not; ids may repeat)."""
+        self._check_index(index)
+        return dict(self._call("registers_of", index))
+
+    def plug(self, index: int | None) -> None:
+        """Connect servo number ``index`` (0-based) alone, unplugging the others; None: none.
+
+        A servo that was unplugged powers on: it keeps what was saved in its EEPROM (id,
+        baud rate, ...) and its RAM (torque, goals, ...) starts from the power-on values.
+        """
+        if index is not None:
+            self._check_index(index)
+        self._call("plug", [] if index is None else [index])
+
+    def plug_all(self) -> None:
+        """Connect every servo (a chain after setup)."""
+        self._call("plug", None)
+
+    def _check_index(self, index: int) -> None:
+        if not 0 <= index < len(self.ids):
+            raise EmulatorError(f"servo index {index} is out of range; the chain has "
+                                f"{len(self.ids)} servos (0..{len(self.ids) - 1})")
+
+    def set_register(self, servo_id: int, name: str, value: int) -> None:
+        """Store a register without the checks a host write gets (e.g. return_delay_time)."""
+        if name not in TABLES[self.family]:
+            raise EmulatorError(f"register {name!r} is not in the {self.family} table; "
+                                f"valid: {', '.join(TABLES[self.family])}")
+        self._call("set_register", servo_id, name, int(value))
+
+    def set_baud(self, baud: int) -> None:
+        """Make every servo listen at ``baud`` [bit/s] (writes their baud_rate register)."""
+        codes = {b: c for c, b in BAUD_CODES[self.family].items()}
+        if baud not in codes:
+            raise EmulatorError(f"baud: {baud} is not a {self.protocol} rate; valid: "
+                                f"{sorted(codes)}")
+        for sid in self.ids:
+            self.set_register(sid, "baud_rate", codes[baud])

@@ -1,0 +1,296 @@
+"""The emulator's child process: owns the pty, the servos, the fault state and the log.
+
+Started by :class:`sim.emulator.chain.Emulator` as ``python -c "...; child_main(fd)"``; ``fd`` is
+a socketpair end carrying ``multiprocessing`` Connection messages: first the
+:class:`ChainSpec`, then requests ``(cmd, args)`` each answered ``("ok", payload)`` or
+``("error", message)``. The child exits on ``stop`` or when the parent goes away.
+"""
+
+from __future__ import annotations
+
+import array
+import collections
+import fcntl
+import os
+import random
+import select
+import signal
+import time
+import tty
+from dataclasses import dataclass, field
+from multiprocessing.connection import Connection
+from types import ModuleType
+from typing import Any
+
+from robot.errors import BipedError
+from sim.emulator import dxl1_protocol, dxl_protocol, sts_protocol
+from sim.emulator.servo import EmulatedServo, ServoSpec
+
+LOG_MAX = 200_000            # packets kept in the child
+TCGETS2 = 0x802C542A         # Linux ioctl: struct termios2 (44 bytes), c_ospeed at word 10
+TERMIOS2_WORDS = 11
+TERMIOS2_OSPEED = 10
+COUNTER_KEYS = ("rx_bytes", "tx_bytes", "rx_packets", "tx_packets", "rx_bad_checksum",
+                "dropped", "corrupted", "baud_mismatch", "tx_overflow")
+
+
+class EmulatorError(BipedError):
+    """The emulator was misused or its child process failed."""
+
+
+@dataclass(frozen=True)
+class Packet:
+    """One received instruction packet.
+
+    t: reception time [s, time.monotonic()]; instruction: "ping", "read", "write",
+    "reboot", "sync_read", "sync_write", "fast_sync_read", "bulk_read", ...; ids: target
+    ids in packet order; address: start address (None for ping/reboot/bulk); values:
+    written value per id (writes), start address per id (bulk read), else empty;
+    length: data length [bytes] where the instruction has one.
+    """
+
+    t: float
+    instruction: str
+    ids: tuple[int, ...]
+    address: int | None
+    values: dict[int, int] = field(default_factory=dict)
+    length: int | None = None
+
+
+#: Wire protocol codec per bus kind.
+CODECS: dict[str, ModuleType] = {"dynamixel": dxl_protocol, "dynamixel1": dxl1_protocol,
+                                 "feetech": sts_protocol}
+
+
+@dataclass(frozen=True)
+class ChainSpec:
+    """The chain to serve; ``plugged``: indices into ``servos`` on the bus (None: all)."""
+
+    protocol: str
+    servos: tuple[ServoSpec, ...]
+    seed: int = 0
+    plugged: tuple[int, ...] | None = None
+
+
+class _ChainServer:
+    """Runs in the child: owns the pty, the servos and the fault state."""
+
+    def __init__(self, spec: ChainSpec, conn: Connection) -> None:
+        self.conn = conn
+        self.codec: ModuleType = CODECS[spec.protocol]
+        self.parser = self.codec.Parser()
+        now = time.monotonic()
+        self.servos = [EmulatedServo(s, now) for s in spec.servos]
+        self.plugged: set[int] = set(range(len(self.servos)) if spec.plugged is None
+                                     else spec.plugged)
+        self.rng = random.Random(spec.seed)
+        self.log: collections.deque[Packet] = collections.deque(maxlen=LOG_MAX)
+        self.counters: dict[str, int] = dict.fromkeys(
+            [*COUNTER_KEYS, *self.codec.NAMES.values()], 0)
+        self.drop_rate = self.corrupt_rate = 0.0
+        self.missing: set[int] = set()
+        self.vanish: dict[int, float] = {}
+        master, slave = os.openpty()
+        tty.setraw(slave)
+        os.set_blocking(master, False)
+        self.master: int | None = master
+        self.slave: int | None = slave
+        self.path = os.ttyname(slave)
+
+    def by_id(self, servo_id: int) -> EmulatedServo:
+        """The servo with ``servo_id``, a plugged one first when several share it."""
+        order = sorted(range(len(self.servos)), key=lambda i: i not in self.plugged)
+        for i in order:
+            if self.servos[i].servo_id == servo_id:
+                return self.servos[i]
+        raise EmulatorError(f"no emulated servo with id {servo_id}; ids: "
+                            f"{sorted(s.servo_id for s in self.servos)}")
+
+    def port_speed(self) -> int | None:
+        """The baud rate [bit/s] the host configured on the slave, if readable."""
+        if self.slave is None:
+            return None
+        buf = array.array("I", [0] * TERMIOS2_WORDS)
+        try:
+            fcntl.ioctl(self.slave, TCGETS2, buf)
+        except OSError:
+            return None
+        return int(buf[TERMIOS2_OSPEED]) or None
+
+    # ------------------------------------------------------------------ wire
+    def on_bytes(self, data: bytes) -> None:
+        self.counters["rx_bytes"] += len(data)
+        before = self.parser.bad_checksum
+        frames = self.parser.feed(data)
+        self.counters["rx_bad_checksum"] += self.parser.bad_checksum - before
+        for servo_id, inst, params in frames:
+            now = time.monotonic()
+            speed = self.port_speed()
+            present = [s for i, s in enumerate(self.servos) if i in self.plugged
+                       and s.servo_id not in self.missing
+                       and self.vanish.get(s.servo_id, float("inf")) > now]
+            listening = [s for s in present if speed is None or s.baud == speed]
+            if present and not listening:
+                self.counters["baud_mismatch"] += 1
+                continue
+            for s in listening:
+                s.update(now)
+            # Servos sharing an id all execute the packet and all answer (on a real bus
+            # their replies collide); each layer holds at most one servo per id.
+            layers: list[dict[int, EmulatedServo]] = []
+            for s in listening:
+                layer = next((d for d in layers if s.servo_id not in d), None)
+                if layer is None:
+                    layer = {}
+                    layers.append(layer)
+                layer[s.servo_id] = s
+            handled = [self.codec.handle(servo_id, inst, params, d)
+                       for d in layers or [{}]]
+            h = handled[0]
+            for layer, hl in zip(layers, handled, strict=False):
+                addressed = layer.values() if self.codec.BROADCAST_ID in hl.ids else (
+                    layer[i] for i in hl.ids if i in layer)
+                for s in addressed:
+                    s.hear(now)
+            self.counters["rx_packets"] += 1
+            self.counters[h.instruction] = self.counters.get(h.instruction, 0) + 1
+            self.log.append(Packet(now, h.instruction, h.ids, h.address, h.values, h.length))
+            for r in (r for hl in handled for r in hl.replies):
+                self.send(r.data, r.delay_s)
+
+    def send(self, data: bytes, delay_s: float) -> None:
+        if self.rng.random() < self.drop_rate:
+            self.counters["dropped"] += 1
+            return
+        if self.rng.random() < self.corrupt_rate:
+            self.counters["corrupted"] += 1
+            data = data[:-1] + bytes([data[-1] ^ 0xFF])   # the checksum / CRC high byte
+        if delay_s > 0:
+            time.sleep(delay_s)
+        if self.master is None:
+            return
+        try:
+            n = os.write(self.master, data)
+        except (BlockingIOError, OSError):
+            n = 0
+        if n < len(data):
+            self.counters["tx_overflow"] += 1
+        self.counters["tx_bytes"] += n
+        self.counters["tx_packets"] += 1
+
+    def close_port(self) -> None:
+        for fd in (self.master, self.slave):
+            if fd is not None:
+                os.close(fd)
+        self.master = self.slave = None
+
+    # ------------------------------------------------------------------ control
+    def on_request(self, cmd: str, args: tuple[Any, ...]) -> Any:
+        if cmd == "faults":
+            return self.set_faults(args[0])
+        if cmd == "clear":
+            self.drop_rate = self.corrupt_rate = 0.0
+            self.missing.clear()
+            self.vanish.clear()
+            for s in self.servos:
+                s.conditions.clear()
+                s.stuck = False
+            return None
+        if cmd == "log":
+            out = list(self.log)
+            if args[0]:
+                self.log.clear()
+            return out
+        if cmd == "counters":
+            return dict(self.counters)
+        if cmd == "registers":
+            s = self.by_id(args[0])
+            s.update(time.monotonic())
+            return s.snapshot()
+        if cmd == "plug":
+            return self.plug(args[0])
+        if cmd == "registers_of":
+            s = self.servos[args[0]]
+            s.update(time.monotonic())
+            return s.snapshot()
+        if cmd == "set_register":
+            s = self.by_id(args[0])
+            s.update(time.monotonic())
+            s.set(args[1], args[2])
+            return None
+        raise EmulatorError(f"unknown emulator request {cmd!r}")
+
+    def plug(self, indices: list[int] | None) -> None:
+        """Connect exactly ``indices`` (None: every servo); a newly connected servo powers on."""
+        wanted = set(range(len(self.servos))) if indices is None else set(indices)
+        now = time.monotonic()
+        for i in self.plugged - wanted:
+            self.servos[i].power_off(now)
+        for i in wanted - self.plugged:
+            self.servos[i].power_on(now)
+        self.plugged = wanted
+
+    def set_faults(self, f: dict[str, Any]) -> None:
+        if f.get("drop_rate") is not None:
+            self.drop_rate = f["drop_rate"]
+        if f.get("corrupt_rate") is not None:
+            self.corrupt_rate = f["corrupt_rate"]
+        if f.get("missing_ids") is not None:
+            self.missing = set(f["missing_ids"])
+        self.vanish.update(f.get("vanish_at") or {})
+        if f.get("stuck_ids") is not None:
+            now = time.monotonic()
+            for s in self.servos:
+                s.update(now)
+                s.stuck = s.servo_id in f["stuck_ids"]
+        for sid, kind in (f.get("hw_error") or {}).items():
+            s = self.by_id(sid)
+            s.conditions = {kind} if kind else set()
+            s.update(time.monotonic())
+        if f.get("close_port"):
+            self.close_port()
+
+    def serve(self) -> None:
+        self.conn.send(("ready", self.path))
+        while True:
+            fds: list[Any] = [self.conn] + ([self.master] if self.master is not None else [])
+            readable, _, _ = select.select(fds, [], [])
+            if self.master is not None and self.master in readable:
+                try:
+                    data = os.read(self.master, 4096)
+                except (BlockingIOError, InterruptedError):
+                    data = b""
+                except OSError:      # EIO: nobody has the slave open (cannot happen: we do)
+                    data = b""
+                if data:
+                    self.on_bytes(data)
+            if self.conn in readable:
+                try:
+                    cmd, args = self.conn.recv()
+                except (EOFError, OSError):
+                    return           # the parent is gone
+                if cmd == "stop":
+                    self.conn.send(("ok", None))
+                    return
+                try:
+                    self.conn.send(("ok", self.on_request(cmd, args)))
+                except Exception as e:  # noqa: BLE001 - report every failure to the parent
+                    self.conn.send(("error", f"{type(e).__name__}: {e}"))
+
+
+def child_main(fd: int) -> None:
+    """Child-process entry point: ``fd`` is the control socket; the spec comes first."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)   # the parent decides when to stop
+    conn = Connection(fd)
+    try:
+        spec = conn.recv()
+        server = _ChainServer(spec, conn)
+    except Exception as e:  # noqa: BLE001 - tell the parent why we could not start
+        conn.send(("error", f"{type(e).__name__}: {e}"))
+        conn.close()
+        return
+    try:
+        server.serve()
+    finally:
+        server.close_port()
+        conn.close()

@@ -1,0 +1,338 @@
+"""One emulated servo: a control table (bytearray) laid out by ``sim.emulator.control_tables``
+(the manuals' tables, initial values included).
+
+The servo is protocol-agnostic: ``sim.emulator.dispatch`` calls :meth:`EmulatedServo.read` /
+:meth:`EmulatedServo.write` (checked in ``sim.emulator.servo_write``) with raw addresses and bytes,
+and the instruction methods (reg write / action, reboot, factory reset, clear multi-turn).
+Power: EEPROM (below ``EEPROM_END``) survives unplugging; RAM comes back at its power-on
+values (a reboot is the same).
+Motion is evaluated lazily: call :meth:`EmulatedServo.update` with the current time [s]
+before touching the table; present position then moves toward goal position
+(``sim.emulator.servo_motion``) while torque is enabled.
+
+Communication watchdog (Dynamixel X "Bus Watchdog", ``tables.COMM_WATCHDOG``): the chain
+calls :meth:`EmulatedServo.hear` for every instruction packet addressed to the servo (its id,
+broadcast, or listed in a sync/bulk packet; the manual counts "all the Instruction Packet",
+which may include packets for other ids: the stricter reading is modelled, so a host that
+forgets a servo sees it trip). When the register is armed (1..127), torque is on and the gap
+since the last packet exceeds the setting, :meth:`update` stops the servo at the moment the
+gap ran out (goal := present), the register reads -1 and goal writes are refused with a
+range error until 0 (or a new setting) is written. Torque is left as it was.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+from robot.bus.tables import COMM_WATCHDOG, ERROR_BITS, MODELS, RETURN_DELAY_UNIT_S
+from sim.emulator import servo_motion, servo_write
+from sim.emulator.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, Entry
+
+#: Values where the manual prints "-" (firmware, sensors, tuning the factory sets per
+#: unit): what this emulator reports. The manual's initial values come from the table.
+UNPRINTED: dict[str, dict[str, int]] = {
+    "dynamixel_x": {"firmware_version": 46, "present_input_voltage": 115,
+                    "present_temperature": 35},
+    "dynamixel_p1": {"firmware_version": 24, "present_voltage": 120,
+                     "present_temperature": 35, "torque_limit": 1023, "moving_speed": 0},
+    "feetech_sts": {"firmware_major": 3, "firmware_minor": 10, "max_voltage_limit": 140,
+                    "p_coefficient": 32, "d_coefficient": 32, "present_voltage": 74,
+                    "present_temperature": 35},
+}
+
+
+class WriteError(enum.Enum):
+    """Why a write was refused; each codec maps it to its protocol's error code."""
+
+    NONE = 0
+    ACCESS = 1       # read-only, unknown or EEPROM-while-torque-on address
+    RANGE = 2        # value outside the register's allowed range
+    LIMIT = 3        # goal outside the position limits
+    LENGTH = 4       # the write covers part of a register
+
+
+@dataclass(frozen=True)
+class ServoSpec:
+    """What the emulator needs to build one servo.
+
+    servo_id: bus id; model: key of ``tables.MODELS``; zero_ticks: initial present
+    position [ticks]; min_ticks/max_ticks: position limits [ticks]; baud: [bit/s];
+    return_delay: Return Delay Time register [raw steps] (0: a chain already set up).
+    """
+
+    servo_id: int
+    model: str
+    zero_ticks: int
+    min_ticks: int
+    max_ticks: int
+    baud: int
+    return_delay: int = 0
+
+
+class EmulatedServo:
+    """Control table plus a first-order position model for one servo."""
+
+    def __init__(self, spec: ServoSpec, now: float) -> None:
+        self.spec = spec
+        self.model = MODELS[spec.model]
+        self.family = self.model.family
+        self.table: dict[str, Entry] = TABLES[self.family]
+        self.mem = bytearray(max(r.address + r.size for r in self.table.values()))
+        self._owner = bytearray(len(self.mem))  # 0: no register; else index+1
+        self._regs = list(self.table.items())
+        for i, (_, reg) in enumerate(self._regs):
+            self._owner[reg.address:reg.address + reg.size] = bytes([i + 1]) * reg.size
+        self.conditions: set[str] = set()   # injected hardware faults (names of ERROR_BITS)
+        self.stuck = False                  # injected jam: the horn does not move
+        self.speed_tps = self.model.no_load_speed * self.model.ticks_per_rad
+        self._p1_errors = 0   # Protocol 1.0 has no error register: the status byte only
+        codes = {b: c for c, b in BAUD_CODES[self.family].items()}
+        if spec.baud not in codes:
+            raise ValueError(f"servo {spec.servo_id}: baud {spec.baud} is not a "
+                             f"{self.family} rate; valid: {sorted(codes)}")
+        values = {n: e.initial for n, e in self.table.items() if e.initial is not None}
+        values.update(UNPRINTED[self.family])
+        values.update(model_number=self.model.number, id=spec.servo_id,
+                      baud_rate=codes[spec.baud], return_delay_time=spec.return_delay,
+                      present_position=spec.zero_ticks, goal_position=spec.zero_ticks)
+        if self.family == "dynamixel_x":
+            values.update(max_position_limit=spec.max_ticks, min_position_limit=spec.min_ticks)
+        elif self.family == "dynamixel_p1":
+            values.update(ccw_angle_limit=spec.max_ticks, cw_angle_limit=spec.min_ticks)
+        else:
+            values.update(max_angle_limit=spec.max_ticks, min_angle_limit=spec.min_ticks)
+        for name, v in values.items():
+            self.set(name, v)
+        self._pos = float(spec.zero_ticks)
+        self._t = now
+        self.watchdog = COMM_WATCHDOG[self.family]
+        self.heard = now    # time of the last instruction packet addressed to this servo [s]
+        self.eeprom_end = EEPROM_END[self.family]   # EEPROM below, RAM from here
+        self._saved = bytes(self.mem[:self.eeprom_end])   # EEPROM as kept over power-off
+        self._ram_at_power_on = bytes(self.mem[self.eeprom_end:])
+        self.pending: tuple[int, bytes] | None = None     # a Reg Write waiting for Action
+        self._registered = {"dynamixel_x": "registered_instruction",
+                            "dynamixel_p1": "registered"}.get(self.family, "async_write_flag")
+        # Indirect Data address -> name of the Indirect Address register pointing it (X).
+        self._indirect = {e.address: name.replace("data", "address")
+                          for name, e in self.table.items() if name.startswith("indirect_data")}
+
+    # ------------------------------------------------------------------ raw access
+    def get(self, name: str) -> int:
+        """Value of a register by name (signed where the Dynamixel table says so)."""
+        reg = self.table[name]
+        signed = self.family == "dynamixel_x" and name in DXL_SIGNED
+        return int.from_bytes(self.mem[reg.address:reg.address + reg.size], "little",
+                              signed=signed)
+
+    def set_raw(self, name: str, value: int) -> None:
+        """Store a register by name, leaving the position model alone."""
+        reg = self.table[name]
+        self.mem[reg.address:reg.address + reg.size] = (value % (1 << 8 * reg.size)).to_bytes(
+            reg.size, "little")
+
+    def set(self, name: str, value: int) -> None:
+        """Store a register by name without any check (the emulator's back door)."""
+        reg = self.table[name]
+        bits = 8 * reg.size
+        self.mem[reg.address:reg.address + reg.size] = (value % (1 << bits)).to_bytes(
+            reg.size, "little")
+        if name == "present_position":
+            self._pos = float(self.get(name))
+
+    def snapshot(self) -> dict[str, int]:
+        return {name: self.get(name) for name in self.table}
+
+    @property
+    def servo_id(self) -> int:
+        return self.get("id")
+
+    @property
+    def baud(self) -> int | None:
+        """The rate [bit/s] the servo listens at (from its baud_rate register)."""
+        return BAUD_CODES[self.family].get(self.get("baud_rate"))
+
+    @property
+    def return_delay_s(self) -> float:
+        return self.get("return_delay_time") * RETURN_DELAY_UNIT_S[self.family]
+
+    @property
+    def status_return_level(self) -> int:
+        return self.get("status_return_level")
+
+    @property
+    def error_register(self) -> str:
+        return "hardware_error_status" if self.family == "dynamixel_x" else "status"
+
+    # ------------------------------------------------------------------ behaviour
+    def hear(self, now: float) -> None:
+        """An instruction packet addressed to this servo arrived at ``now`` [s]."""
+        self.heard = now
+
+    @property
+    def watchdog_tripped(self) -> bool:
+        wd = self.watchdog
+        return wd is not None and self.get(wd.register) == wd.tripped
+
+    def _watchdog_deadline(self) -> float | None:
+        """When the armed watchdog trips if nothing is heard [s], else None."""
+        wd = self.watchdog
+        if wd is None or not self.get("torque_enable"):
+            return None
+        steps = self.get(wd.register)
+        if not wd.steps[0] <= steps <= wd.steps[1]:
+            return None
+        return self.heard + steps * wd.unit_s
+
+    def update(self, now: float) -> None:
+        """Advance the position model (and the watchdog) to ``now`` [s, time.monotonic()]."""
+        self._assert_faults()
+        deadline = self._watchdog_deadline()
+        if self.watchdog is not None and deadline is not None and deadline < now:
+            self._advance(max(deadline, self._t))
+            self.set("goal_position", round(self._pos))   # stop where it is
+            self.set(self.watchdog.register, self.watchdog.tripped)
+        self._advance(now)
+
+    def _advance(self, now: float) -> None:
+        dt = max(0.0, now - self._t)
+        self._t = now
+        self._pos = servo_motion.advance(self, self._pos, dt)
+
+    def _assert_faults(self) -> None:
+        bits = {name: bit for bit, name in ERROR_BITS[self.family].items()}
+        value = 0
+        for name in self.conditions:
+            value |= 1 << bits[name]
+        if self.family == "dynamixel_x":
+            # X series latch hardware errors until reboot and drop torque (shutdown).
+            value |= self.get("hardware_error_status")
+            if value:
+                self.set("torque_enable", 0)
+        if self.family == "dynamixel_p1":
+            self._p1_errors = value
+            return
+        self.set(self.error_register, value)
+
+    @property
+    def error_bits(self) -> int:
+        if self.family == "dynamixel_p1":
+            return self._p1_errors
+        return self.get(self.error_register)
+
+    def read(self, address: int, length: int) -> bytes | None:
+        """``length`` bytes from ``address``; None when the range leaves the table or holds
+        no register at all (undefined address: the manual's Access Error). Indirect Data
+        bytes read the byte their Indirect Address points at."""
+        if address < 0 or length < 0 or address + length > len(self.mem):
+            return None
+        if length and not any(self._owner[address:address + length]):
+            return None
+        out = bytearray(self.mem[address:address + length])
+        for i in range(length):
+            target = self._indirect_target(address + i)
+            if target is not None:
+                out[i] = self.mem[target]
+        return bytes(out)
+
+    def write(self, address: int, data: bytes) -> WriteError:
+        """Apply a host write if every byte lands in whole, writable registers (Indirect
+        Data bytes land where their Indirect Address points); all or nothing."""
+        plans = []
+        for run_address, run in self._runs(address, data):
+            err, values = servo_write.plan(self, run_address, run)
+            if err is not WriteError.NONE:
+                return err
+            plans.append(values)
+        for values in plans:
+            servo_write.apply(self, values)
+        if address < self.eeprom_end and self._keeps_eeprom():
+            self._saved = bytes(self.mem[:self.eeprom_end])
+        return WriteError.NONE
+
+    def _indirect_target(self, address: int) -> int | None:
+        name = self._indirect.get(address)
+        return None if name is None else self.get(name)
+
+    def _runs(self, address: int, data: bytes) -> list[tuple[int, bytes]]:
+        """The write as (address, bytes) runs after indirect translation."""
+        runs: list[tuple[int, bytearray]] = []
+        for i, b in enumerate(data):
+            target = self._indirect_target(address + i)
+            a = address + i if target is None else target
+            if runs and runs[-1][0] + len(runs[-1][1]) == a:
+                runs[-1][1].append(b)
+            else:
+                runs.append((a, bytearray([b])))
+        return [(a, bytes(d)) for a, d in runs] or [(address, b"")]
+
+    # ------------------------------------------------------------------ instructions
+    def reg_write(self, address: int, data: bytes) -> WriteError:
+        """Reg Write: hold the write until Action; the flag register reads 1 meanwhile."""
+        if address < 0 or address + len(data) > len(self.mem) or not data:
+            return WriteError.ACCESS
+        self.pending = (address, bytes(data))
+        self.set(self._registered, 1)
+        return WriteError.NONE
+
+    def action(self) -> WriteError:
+        """Action: execute the registered write, if any."""
+        pending, self.pending = self.pending, None
+        self.set(self._registered, 0)
+        return WriteError.NONE if pending is None else self.write(*pending)
+
+    def factory_reset(self, option: int) -> None:
+        """X Factory Reset: 0xFF everything, 0x01 all but ID, 0x02 all but ID and baud."""
+        keep = {0x01: ("id",), 0x02: ("id", "baud_rate")}.get(option, ())
+        kept = {name: self.get(name) for name in keep}
+        pos = round(self._pos)
+        for name, e in self.table.items():
+            self.set_raw(name, e.initial if e.initial is not None else 0)
+        for name, v in {**UNPRINTED[self.family], "model_number": self.model.number,
+                        **kept}.items():
+            self.set_raw(name, v)
+        self._saved = bytes(self.mem[:self.eeprom_end])
+        self.set("present_position", pos)
+        self.set("goal_position", pos)
+
+    def clear_multi_turn(self) -> None:
+        """X Clear (multi-turn): present position back within one turn, while stopped."""
+        if not self.get("moving"):
+            pos = round(self._pos) % self.model.resolution
+            self.set("present_position", pos)
+            self.set("goal_position", pos)
+
+    def _keeps_eeprom(self) -> bool:
+        """Whether an EEPROM write survives power-off: always on Dynamixel X; on Feetech
+        STS only with the Lock flag (55) at 0 (1 = changes not saved, the factory value)."""
+        return self.family == "dynamixel_x" or self.get("lock") == 0
+
+    def power_off(self, now: float) -> None:
+        """Unplugged: the horn stops where it is and torque is gone."""
+        self.update(now)
+        self.set("torque_enable", 0)
+
+    def power_on(self, now: float) -> None:
+        """Plugged in again: EEPROM as saved, RAM at its power-on values, horn unmoved."""
+        self.update(now)
+        pos = round(self._pos)
+        self.mem[:self.eeprom_end] = self._saved
+        self.mem[self.eeprom_end:] = self._ram_at_power_on
+        self.set("present_position", pos)
+        self.set("goal_position", pos)
+        self._t = self.heard = now
+
+    def reboot(self) -> None:
+        """Reboot: like a power cycle (RAM to its power-on values, latched errors gone)."""
+        self.power_on(self._t)
+        self.pending = None
+        self._assert_faults()
+
+
+def decode_value(family: str, address: int, data: bytes) -> int:
+    """A written value as the log shows it: little-endian, signed for signed registers."""
+    signed = family == "dynamixel_x" and any(
+        reg.address == address and reg.size == len(data) and name in DXL_SIGNED
+        for name, reg in TABLES[family].items())
+    return int.from_bytes(data, "little", signed=signed)

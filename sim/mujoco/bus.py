@@ -1,0 +1,317 @@
+"""The MuJoCo mock bus: the real buses' interface, speaking ticks, with simulated servos.
+
+The servo model (goal → setpoint slewed at ``max_speed_rad_s`` → position actuator with its
+force limited to the stall torque; torque, load, thermal model, overload flag) lives in
+``sim.mujoco.servos``; its docstring states the discretisation. Like real servos after
+power-up, torque starts off; the robot starts in the ``home`` keyframe (or ``pose``) with
+its goals at the present positions.
+
+Time is simulation time: ``bus.clock.sleep_until(t)`` steps the physics to exactly ``t``
+(whole ``timestep`` steps, batched into one ``mj_step`` call once the setpoints are
+constant, then one shorter step to land on ``t``).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+import mujoco
+import numpy as np
+import numpy.typing as npt
+
+from robot.bus.base import Bus, ServoInfo, ServoState
+from robot.bus.servo_map import ServoMap
+from robot.config.robot_file import RobotConfig
+from robot.errors import BusError
+from sim.mujoco.mjcf import FOOT_GEOMS, build_mjcf, standing_qpos
+from sim.mujoco.servos import AMBIENT_C, SimServos
+from sim.mujoco.view import OffscreenRenderer, SimClock, WallPacer, check_display, launch_viewer
+from sim.mujoco.world import PUSH_WINDOW_S, TimedForces, World
+from sim.mujoco.world_scene import apply_world_to_model, place_on_floor
+
+__all__ = ["AMBIENT_C", "MujocoBus", "SimClock"]
+
+log = logging.getLogger(__name__)
+
+_TIME_EPS = 1e-9  # [s]
+_OVERLOAD = frozenset({"overload"})
+_NO_ERRORS: frozenset[str] = frozenset()
+
+
+class MujocoBus(Bus):
+    """Simulated servo chain for ``robot`` (see the module docstring for the servo model).
+
+    realtime: also wait on the wall clock so the sim runs at 1x; view: open the passive
+    viewer (needs a display); timestep: physics step [s] (default 0.002); pose: start pose
+    {joint: rad} instead of the ``home`` keyframe (standing, soles on the floor); world:
+    perturbations (``sim.mujoco.world.World``: slope, bumps, latency, friction, mass; pushes via
+    ``push`` / ``sim.mujoco.world.PushScheduler``), None for the plain scene.
+    """
+
+    kind = "sim"
+
+    def __init__(self, robot: RobotConfig, *, realtime: bool = False, view: bool = False,
+                 timestep: float | None = None, pose: Mapping[str, float] | None = None,
+                 world: World | None = None) -> None:
+        self.robot = robot
+        self.world = world
+        self.realtime = realtime
+        self.view = view
+        self.timestep = timestep
+        self.pose = dict(pose) if pose is not None else None
+        self.servo_map = ServoMap(robot)
+        self.clock = SimClock(self)
+        self._id_index = {sid: i for i, sid in enumerate(robot.ids)}
+        self._model: mujoco.MjModel | None = None
+        self._data: mujoco.MjData | None = None
+        self._viewer: Any = None
+        self._renderer = OffscreenRenderer()
+        self._pacer = WallPacer()
+        self._forces = TimedForces()  # pushes on the torso in progress
+
+    # ------------------------------------------------------------------ lifecycle
+
+    def open(self) -> None:
+        if self._model is not None:
+            return
+        if self.view:
+            check_display()
+        world = self.world
+        model = build_mjcf(self.robot, timestep=self.timestep, world=world).model()
+        data = mujoco.MjData(model)
+        if world is not None:
+            apply_world_to_model(model, data, world)
+        mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+        if self.pose is not None:
+            unknown = sorted(set(self.pose) - set(self.robot.joint_names))
+            if unknown:
+                raise BusError(f"sim bus: pose: unknown joint {unknown[0]!r}; valid: "
+                               f"{', '.join(self.robot.joint_names)}")
+            data.qpos[:] = standing_qpos(model, self.pose)
+        if world is not None:
+            place_on_floor(data, world)
+        mujoco.mj_forward(model, data)
+        names = self.robot.joint_names
+        self._qadr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names])
+        self._act = np.array([model.actuator(n).id for n in names])
+        self._kp = model.actuator_gainprm[self._act, 0].copy()
+        self._kv = -model.actuator_biasprm[self._act, 2].copy()
+        stall = np.array([self.robot.servo(j).stall_torque for j in self.robot.joints])
+        self._ground = np.flatnonzero((model.geom_bodyid == 0)
+                                      & ((model.geom_contype | model.geom_conaffinity) != 0))
+        self._feet = tuple(model.geom(n).id for n in FOOT_GEOMS)
+        self._torso = model.body("torso").id
+        self._dt = float(model.opt.timestep)
+        self._opt = model.opt
+        self._servos = SimServos(self.servo_map, stall, data.qpos[self._qadr],
+                                 latency_s=world.latency_s if world is not None else 0.0)
+        self._forces = TimedForces()
+        self._model, self._data = model, data
+        self._apply_torque()
+        data.ctrl[self._act] = self._servos.setpoint
+        self._pacer.anchor(data.time)
+        if self.view:
+            self._viewer = launch_viewer(model, data)
+        log.info("sim bus open: %s, %d servos, timestep %.4f s", self.robot.name, len(names),
+                 model.opt.timestep)
+
+    def close(self, *, torque_off: bool = True) -> None:
+        if self._model is None:
+            return
+        if torque_off:
+            self._servos.enabled[:] = False
+            self._apply_torque()
+        if self._viewer is not None:
+            self._viewer.close()
+            self._viewer = None
+        self._renderer.close()
+        self._model = None
+        self._data = None
+
+    @property
+    def is_open(self) -> bool:
+        return self._model is not None
+
+    @property
+    def standing_height(self) -> float:
+        """Torso (pelvis origin) height in the ``home`` keyframe [m]."""
+        return float(self.model.key("home").qpos[2])
+
+    @property
+    def floor_normal(self) -> tuple[float, float, float]:
+        """Unit normal of the floor plane through the origin (world frame)."""
+        return self.world.floor_normal() if self.world is not None else (0.0, 0.0, 1.0)
+
+    @property
+    def model(self) -> mujoco.MjModel:
+        if self._model is None:
+            raise BusError("sim bus: not open; call open() (or use `with bus:`) first")
+        return self._model
+
+    @property
+    def data(self) -> mujoco.MjData:
+        if self._data is None:
+            raise BusError("sim bus: not open; call open() (or use `with bus:`) first")
+        return self._data
+
+    # ------------------------------------------------------------------ Bus interface
+
+    def _indices(self, ids: Iterable[int]) -> list[int]:
+        """Joint indices of ``ids``; BusError naming the first unknown id (or if closed)."""
+        self.model  # noqa: B018  (raises BusError if closed)
+        index = self._id_index
+        try:
+            return [index[i] for i in ids]
+        except KeyError as e:
+            raise BusError(f"sim bus: servo id {e.args[0]} does not exist on robot "
+                           f"{self.robot.name} ({self.robot.source}); configured ids: "
+                           f"{', '.join(map(str, self.robot.ids))}") from None
+
+    def ping(self, servo_id: int) -> int | None:
+        self.model  # noqa: B018  (raises BusError if closed)
+        joint = self.robot.joint_by_id(servo_id)
+        return None if joint is None else self.robot.servo(joint).number
+
+    def scan(self, ids: Iterable[int]) -> list[ServoInfo]:
+        return [ServoInfo(id=i, model=servo.number, model_name=servo.name, firmware=None,
+                          return_delay_us=0.0, baud=self.robot.bus.baud)
+                for i in sorted(set(ids)) if self.ping(i) is not None
+                for servo in [self.robot.servo(self.robot.joint_by_id(i))]]  # type: ignore[arg-type]
+
+    def set_torque(self, ids: Iterable[int], *, enabled: bool) -> None:
+        idx = self._indices(ids)
+        self._servos.set_torque(idx, enabled, self.data.qpos[self._qadr])
+        self._apply_torque()
+
+    def write_goals(self, goals: Mapping[int, int]) -> None:
+        if not goals:
+            return
+        d = self.data  # BusError if closed
+        servos = self._servos
+        idx = servos.index_all(goals)
+        if idx is None:
+            idx = np.array(self._indices(goals))
+        servos.write(idx, servos.to_rad(goals, idx), d.time)
+
+    def read_state(self, ids: Iterable[int]) -> dict[int, ServoState]:
+        idx = self._indices(ids)
+        servos = self._servos
+        force = self.data.actuator_force[self._act]
+        servos.flush(force)
+        ticks = self.present_ticks().tolist()
+        load = servos.load_percent(force).tolist()
+        temperature = servos.temperature.tolist()
+        overloaded = servos.overloaded().tolist()
+        volts = self.robot.bus.servo.nominal_voltage
+        sids = self.servo_map.ids
+        return {sids[i]: ServoState(id=sids[i], position=ticks[i], load=load[i],
+                                    temperature=temperature[i], voltage=volts,
+                                    errors=_OVERLOAD if overloaded[i] else _NO_ERRORS)
+                for i in idx}
+
+    # ------------------------------------------------------------------ simulation
+
+    def present_ticks(self) -> npt.NDArray[np.int64]:
+        """Present positions [ticks] in joint order (rounded, not clamped)."""
+        q = self.data.qpos[self._qadr]
+        sm = self.servo_map
+        return np.rint(sm.zero + sm.sign * q * sm.ticks_per_rad).astype(np.int64)
+
+    def _apply_torque(self) -> None:
+        m = self.model
+        on = self._servos.enabled.astype(float)
+        m.actuator_gainprm[self._act, 0] = self._kp * on
+        m.actuator_biasprm[self._act, 1] = -self._kp * on
+        m.actuator_biasprm[self._act, 2] = -self._kv * on
+
+    def advance(self, deadline: float) -> None:
+        """Step the physics until data.time == deadline [s] exactly (a last partial step
+        if needed), applying delayed goals when they fall due; with realtime, then wait for
+        the wall clock. No-op if already past."""
+        d = self.data
+        t0 = float(d.time)
+        if deadline <= t0:
+            return
+        while (event := self._next_event()) < deadline - _TIME_EPS:
+            if event > d.time:
+                self._physics_to(event)
+                d.time = event
+            self._events_due(event)
+        self._physics_to(deadline)
+        d.time = deadline
+        self._events_due(deadline)
+        self._servos.elapse(d.actuator_force[self._act], deadline - t0)
+        if self.realtime:
+            self._pacer.wait(deadline)
+        if self._viewer is not None:
+            self._pacer.sync_viewer(self._viewer)
+
+    def _next_event(self) -> float:
+        """Sim time [s] of the next delayed goal or push end (inf if none)."""
+        return min(self._servos.next_due(), self._forces.next_end())
+
+    def _events_due(self, now: float) -> None:
+        self._servos.release_due(now)
+        self._forces.end_due(now, self.data.xfrc_applied[self._torso])
+
+    def push(self, jx: float, jy: float, *, window_s: float = PUSH_WINDOW_S) -> None:
+        """An impulse on the torso starting now: jx forward, jy left in the torso's
+        heading frame (yaw only) [N*s], as a constant force at its centre of mass
+        J / window_s [N] for window_s [s] of sim time."""
+        if not window_s > 0:
+            raise BusError(f"sim bus: push window must be > 0 s, got {window_s}")
+        d = self.data
+        w, x, y, z = d.qpos[3:7].tolist()
+        yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+        c, s = math.cos(yaw), math.sin(yaw)
+        force = np.array([c * jx - s * jy, s * jx + c * jy, 0.0]) / window_s
+        self._forces.start(d.time + window_s, force, d.xfrc_applied[self._torso])
+
+    def _physics_to(self, stop: float) -> None:
+        """Physics steps up to ``stop`` [s]: the setpoints slew before each step until they
+        are settled, then the remaining whole steps run in one call, then one short step."""
+        m, d, opt, servos, dt = self.model, self.data, self._opt, self._servos, self._dt
+        while (remaining := stop - d.time) > _TIME_EPS:
+            if not servos.settled:
+                d.ctrl[self._act] = servos.slew(min(dt, remaining))
+            if remaining < dt:
+                opt.timestep = remaining
+                try:
+                    mujoco.mj_step(m, d)
+                finally:
+                    opt.timestep = dt
+            else:
+                mujoco.mj_step(m, d, int(remaining / dt + 1e-6) if servos.settled else 1)
+
+    # ------------------------------------------------------------------ observation
+
+    def base_pose(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """Torso (pelvis frame) position [m] and orientation quaternion (w, x, y, z)."""
+        q = self.data.qpos
+        return q[0:3].copy(), q[3:7].copy()
+
+    def upright_angle(self) -> float:
+        """Angle between the torso's z axis and world z [rad] (0 upright, pi/2 lying)."""
+        _, x, y, _ = self.data.qpos[3:7]
+        qn = float(np.dot(self.data.qpos[3:7], self.data.qpos[3:7]))
+        return math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (x * x + y * y) / qn)))
+
+    def contacts_feet(self) -> tuple[bool, bool]:
+        """(right, left): is each foot box touching the ground (floor or a bump; as of the
+        last step)."""
+        d = self.data
+        pairs = d.contact.geom[: d.ncon]
+        ground = np.isin(pairs, self._ground)
+        touching = []
+        for foot in self._feet:
+            hit = ((pairs[:, 0] == foot) & ground[:, 1]) | ((pairs[:, 1] == foot) & ground[:, 0])
+            touching.append(bool(hit.any()))
+        return touching[0], touching[1]
+
+    def render(self, width: int, height: int, camera: str = "track") -> npt.NDArray[np.uint8]:
+        """An offscreen RGB frame (height, width, 3) of the current state (needs MUJOCO_GL
+        set, e.g. egl, before mujoco is imported). Reuses one renderer per size."""
+        return self._renderer.render(self.model, self.data, width, height, camera)

@@ -1,0 +1,241 @@
+"""The robot's MJCF element tree: defaults (servo model + joint groups), bodies, actuators.
+
+Kinematic chain exactly as ``robot.config.robot_file.Geometry`` documents it; every body frame is
+parallel to the pelvis frame at zero pose, so every joint axis is +x, +y or +z of the
+pelvis frame (right-hand rule). Link masses come from ``Masses`` as explicit
+``<inertial>`` elements (solid boxes sized by the geometry and the servo's size).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from typing import NamedTuple
+
+from robot.bus.tables import ServoModel
+from robot.config.robot_file import JOINT_NAMES, RobotConfig
+
+AXES = {"hip_yaw": "0 0 1", "hip_roll": "1 0 0", "hip_pitch": "0 1 0", "knee": "0 1 0",
+        "ankle_pitch": "0 1 0", "ankle_roll": "1 0 0", "shoulder_pitch": "0 1 0",
+        "shoulder_roll": "1 0 0", "elbow": "0 1 0"}
+SIDE_Y = {"r": -1.0, "l": 1.0}
+#: Extra joints (head pan, tilt, ...) are modelled as a small servo on top of the torso
+#: turning about z: held at a fixed angle, their axis does not change the walk.
+EXTRA_AXIS = "0 0 1"
+EXTRA_MASS_KG = 0.02
+#: Collision bits: floor/world 1, right leg 2, left leg 4. Legs collide with the floor and
+#: the other leg; torso and arms only with the floor (never parent-child, never same leg).
+CONTACT = {"r_leg": ("2", "5"), "l_leg": ("4", "3"), "body": ("0", "1")}
+#: Mechanical time constant of a small iron-core servo motor [s] (armature = b * tau).
+MOTOR_TAU_S = 0.03
+SERVO_DENSITY = 1500.0  # [kg/m^3], a servo's average density (sets link thickness)
+
+
+class ServoDynamics(NamedTuple):
+    """Position-actuator parameters for one servo model.
+
+    kp [N m/rad]; kv: velocity gain that critically damps the unloaded servo (its D term
+    plus back-EMF) [N m s/rad]; forcerange: stall torque [N m]; armature: reflected rotor
+    inertia (back-EMF damping stall_torque / no_load_speed times MOTOR_TAU_S) [kg m^2];
+    damping: gearbox viscous loss [N m s/rad]; frictionloss: gearbox friction [N m].
+    """
+
+    kp: float
+    kv: float
+    forcerange: float
+    armature: float
+    damping: float
+    frictionloss: float
+
+
+def servo_dynamics(servo: ServoModel) -> ServoDynamics:
+    """A hobby servo: stiff but compliant (stall torque at 0.05 rad error)."""
+    b = servo.stall_torque / servo.no_load_speed
+    kp = servo.stall_torque / 0.05
+    armature = b * MOTOR_TAU_S
+    return ServoDynamics(kp=kp, kv=2.0 * (kp * armature) ** 0.5, forcerange=servo.stall_torque,
+                         armature=armature, damping=0.05 * b,
+                         frictionloss=0.01 * servo.stall_torque)
+
+
+def fmt(*values: float) -> str:
+    """Floats as exact shortest round-trip strings (FK tests compare to 1e-9 m)."""
+    return " ".join(repr(float(v)) for v in values)
+
+
+def num(*values: float) -> str:
+    """Physical parameters to 6 significant digits (readability over round-trip)."""
+    return " ".join(f"{v:.6g}" for v in values)
+
+
+def _sub(parent: ET.Element, tag: str, **attrs: str) -> ET.Element:
+    return ET.SubElement(parent, tag, {k.rstrip("_"): v for k, v in attrs.items() if v})
+
+
+def joint_class(robot: RobotConfig, name: str) -> str:
+    """Default class of joint ``name``: its group ("knee"), or per side if the sides differ
+    (limits or servo model); an extra joint (head_pan) has its own."""
+    if name not in JOINT_NAMES:
+        return name
+    group = name[2:]
+    other = robot.joint(("l_" if name.startswith("r_") else "r_") + group)
+    mine = robot.joint(name)
+    same = ((mine.min_rad, mine.max_rad, robot.servo(mine).name)
+            == (other.min_rad, other.max_rad, robot.servo(other).name))
+    return group if same else name
+
+
+def add_defaults(root: ET.Element, robot: RobotConfig) -> None:
+    default = _sub(root, "default")
+    top = _sub(default, "default", class_=robot.name)
+    _sub(top, "geom", friction="1 0.005 0.0001", solref="0.005 1")
+    _sub(top, "site", group="5", size="0.005", rgba="1 0.2 0.2 1")
+    models: dict[str, ET.Element] = {}   # one class per servo model (a robot may mix them)
+    done: set[str] = set()
+    for j in robot.joints:
+        servo = robot.servo(j)
+        if servo.name not in models:
+            dyn = servo_dynamics(servo)
+            model = models[servo.name] = _sub(top, "default", class_=servo.name)
+            _sub(model, "joint", armature=num(dyn.armature), damping=num(dyn.damping),
+                 frictionloss=num(dyn.frictionloss))
+            _sub(model, "position", kp=num(dyn.kp), kv=num(dyn.kv),
+                 forcerange=num(-dyn.forcerange, dyn.forcerange))
+        cls = joint_class(robot, j.name)
+        if cls in done:
+            continue
+        done.add(cls)
+        group = _sub(models[servo.name], "default", class_=cls)
+        _sub(group, "joint", axis=AXES.get(j.name[2:], EXTRA_AXIS),
+             range=fmt(j.min_rad, j.max_rad))
+        _sub(group, "position", ctrlrange=fmt(j.min_rad, j.max_rad))
+    visual = _sub(top, "default", class_="visual")
+    _sub(visual, "geom", contype="0", conaffinity="0", group="2", density="0")
+    collision = _sub(top, "default", class_="collision")
+    _sub(collision, "geom", group="3", rgba="0.6 0.2 0.2 0.5")
+    for name, (contype, conaffinity) in CONTACT.items():
+        sub = _sub(collision, "default", class_=name)
+        _sub(sub, "geom", contype=contype, conaffinity=conaffinity)
+
+
+def _inertial(body: ET.Element, mass: float, centre: tuple[float, float, float],
+              size: tuple[float, float, float]) -> None:
+    """A solid box of full ``size`` [m] and ``mass`` [kg] centred at ``centre``."""
+    a, b, c = size
+    inertia = (mass * (b * b + c * c) / 12, mass * (a * a + c * c) / 12,
+               mass * (a * a + b * b) / 12)
+    _sub(body, "inertial", pos=fmt(*centre), mass=fmt(mass), diaginertia=fmt(*inertia))
+
+
+def _body(parent: ET.Element, name: str, pos: tuple[float, float, float],
+          joint: str | None, robot: RobotConfig) -> ET.Element:
+    body = _sub(parent, "body", name=name, pos=fmt(*pos))
+    if joint is not None and joint in robot.joint_names:   # 5-DoF legs: no hip yaw joint
+        _sub(body, "joint", name=joint, class_=joint_class(robot, joint))
+    return body
+
+
+def add_worldbody(root: ET.Element, robot: RobotConfig) -> None:
+    g, m = robot.geometry, robot.mass
+    s = (robot.bus.servo.mass / SERVO_DENSITY) ** (1 / 3)  # servo edge [m]
+    r = 0.45 * s  # link capsule radius [m]
+    world = _sub(root, "worldbody")
+    height0 = g.thigh + g.shin + g.ankle_height  # qpos0: straight legs, soles at z=0
+    torso = _sub(world, "body", name="torso", pos=fmt(0, 0, height0), childclass=robot.name)
+    _sub(torso, "freejoint", name="root")
+    width = max(g.hip_width + s, g.shoulder_width - 1.6 * s)
+    bottom, top = 0.6 * s, g.torso_height + 0.4 * s
+    tsize = (g.torso_depth, width, top - bottom)
+    tcentre = (0.0, 0.0, (bottom + top) / 2)
+    _inertial(torso, m.torso, tcentre, tsize)
+    for cls in ("visual", "body"):
+        _sub(torso, "geom", name="torso" if cls == "body" else "torso_visual", class_=cls,
+             type="box", pos=fmt(*tcentre), size=fmt(*(x / 2 for x in tsize)),
+             material="shell")
+    _sub(torso, "site", name="imu", pos=fmt(*tcentre))
+    servo_box = fmt(s / 2, s / 2, s / 2)
+    for side in ("r", "l"):
+        y = SIDE_Y[side]
+        leg = f"{side}_leg"
+        b = _body(torso, f"{side}_hip_yaw_link", (0, y * g.hip_width / 2, 0),
+                  f"{side}_hip_yaw", robot)
+        _inertial(b, m.hip_yaw_link, (0, 0, 0.5 * s), (s, s, s))
+        _sub(b, "geom", class_="visual", type="box", pos=fmt(0, 0, 0.5 * s), size=servo_box,
+             material="servo")
+        b = _body(b, f"{side}_hip_roll_link", (0, 0, 0), f"{side}_hip_roll", robot)
+        _inertial(b, m.hip_roll_link, (0, 0, 0), (s, s, s))
+        _sub(b, "geom", class_="visual", type="box", size=servo_box, material="servo")
+        b = _body(b, f"{side}_thigh", (0, 0, 0), f"{side}_hip_pitch", robot)
+        _inertial(b, m.thigh, (0, 0, -g.thigh / 2), (s, s, g.thigh))
+        for cls, gname in (("visual", ""), (leg, f"{side}_thigh")):
+            _sub(b, "geom", name=gname, class_=cls, type="capsule", size=fmt(r),
+                 fromto=fmt(0, 0, 0, 0, 0, -g.thigh), material="link")
+        b = _body(b, f"{side}_shin", (0, 0, -g.thigh), f"{side}_knee", robot)
+        _inertial(b, m.shin, (0, 0, -g.shin / 2), (s, s, g.shin))
+        _sub(b, "geom", class_="visual", type="box", size=servo_box, material="servo")
+        for cls, gname in (("visual", ""), (leg, f"{side}_shin")):
+            _sub(b, "geom", name=gname, class_=cls, type="capsule", size=fmt(r),
+                 fromto=fmt(0, 0, 0, 0, 0, -g.shin), material="link")
+        b = _body(b, f"{side}_ankle_link", (0, 0, -g.shin), f"{side}_ankle_pitch", robot)
+        _inertial(b, m.ankle_link, (0, 0, 0), (s, s, s))
+        _sub(b, "geom", class_="visual", type="box", size=servo_box, material="servo")
+        b = _body(b, f"{side}_foot", (0, 0, 0), f"{side}_ankle_roll", robot)
+        fsize = (g.foot_length, g.foot_width, g.ankle_height)
+        fcentre = (g.foot_forward, 0.0, -g.ankle_height / 2)
+        _inertial(b, m.foot, fcentre, fsize)
+        half = fmt(g.foot_length / 2, g.foot_width / 2, g.ankle_height / 4)
+        plate = fmt(g.foot_forward, 0, -0.75 * g.ankle_height)
+        _sub(b, "geom", name=f"{side}_foot", class_=leg, type="box", pos=plate, size=half)
+        _sub(b, "geom", class_="visual", type="box", pos=plate, size=half, material="foot")
+        _sub(b, "site", name=f"{side}_sole", pos=fmt(0, 0, -g.ankle_height))
+    if not robot.has_arms:
+        add_extra_joints(torso, robot, s)   # after the legs and arms: robot.joints order
+        return
+    for side in ("r", "l"):
+        y = SIDE_Y[side]
+        b = _body(torso, f"{side}_shoulder_link", (0, y * g.shoulder_width / 2, g.torso_height),
+                  f"{side}_shoulder_pitch", robot)
+        _inertial(b, m.shoulder_link, (0, 0, 0), (s, s, s))
+        _sub(b, "geom", class_="visual", type="box", size=servo_box, material="servo")
+        b = _body(b, f"{side}_upper_arm", (0, 0, 0), f"{side}_shoulder_roll", robot)
+        _inertial(b, m.upper_arm, (0, 0, -g.upper_arm / 2), (s, s, g.upper_arm))
+        for cls in ("visual", "body"):
+            _sub(b, "geom", class_=cls, type="capsule", size=fmt(0.8 * r),
+                 fromto=fmt(0, 0, 0, 0, 0, -g.upper_arm), material="link")
+        b = _body(b, f"{side}_forearm", (0, 0, -g.upper_arm), f"{side}_elbow", robot)
+        _inertial(b, m.forearm, (0, 0, -g.forearm / 2), (s, s, g.forearm))
+        _sub(b, "geom", class_="visual", type="box", size=servo_box, material="servo")
+        for cls in ("visual", "body"):
+            _sub(b, "geom", class_=cls, type="capsule", size=fmt(0.8 * r),
+                 fromto=fmt(0, 0, 0, 0, 0, -g.forearm), material="link")
+        _sub(b, "site", name=f"{side}_hand", pos=fmt(0, 0, -g.forearm))
+    add_extra_joints(torso, robot, s)
+
+
+def add_extra_joints(torso: ET.Element, robot: RobotConfig, s: float) -> None:
+    """One small body per extra joint on top of the torso. Added after the legs and arms,
+    so qpos and the actuators follow ``robot.joints`` order."""
+    g = robot.geometry
+    for j in robot.joints:
+        if j.name in JOINT_NAMES:
+            continue
+        b = _body(torso, f"{j.name}_link", (0, 0, g.torso_height + s), j.name, robot)
+        _inertial(b, EXTRA_MASS_KG, (0, 0, 0), (s / 2, s / 2, s / 2))
+
+
+def add_actuators_and_sensors(root: ET.Element, robot: RobotConfig) -> None:
+    act = _sub(root, "actuator")
+    for j in robot.joints:
+        _sub(act, "position", name=j.name, joint=j.name, class_=joint_class(robot, j.name))
+    sensors = _sub(root, "sensor")
+    _sub(sensors, "gyro", name="imu_gyro", site="imu")
+    _sub(sensors, "accelerometer", name="imu_accelerometer", site="imu")
+    _sub(sensors, "framequat", name="imu_orientation", objtype="site", objname="imu")
+
+
+def add_assets(root: ET.Element) -> None:
+    assets = _sub(root, "asset")
+    for name, rgba in (("shell", "0.85 0.85 0.8 1"), ("servo", "0.1 0.1 0.1 1"),
+                       ("link", "0.55 0.6 0.65 1"), ("foot", "0.9 0.45 0.1 1")):
+        _sub(assets, "material", name=name, rgba=rgba)
+
+

@@ -15,7 +15,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import robot.cli as cli
-from robot.bus.tables import MODELS
 from robot.commands import capture as capture_cmd
 from robot.config.robot_file import DEFAULT_ROBOT, RobotConfig, load_gait, load_robot
 from robot.errors import ConfigError
@@ -23,6 +22,7 @@ from robot.motion.interp import min_jerk, smooth
 from robot.motion.keyframes import load_sequence
 from robot.motion.takes import read_take
 from robot.previs.plots import read_table
+from robot.servo.models import MODELS
 from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)

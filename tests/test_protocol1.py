@@ -14,7 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from robot.bus.tables import MODELS, TABLES
+from robot.bus.tables import TABLES
+from robot.servo.models import MODELS
 from sim.emulator.chain import Emulator
 
 # e-Manual AX-12A: (address, size)

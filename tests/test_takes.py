@@ -18,11 +18,11 @@ import numpy as np
 import pytest
 
 import robot.cli as cli
-from robot.bus.tables import MODELS
 from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
 from robot.motion.takes import read_take
 from robot.panel.controller import LoopOptions, make_controller
 from robot.panel.studio import Studio
+from robot.servo.models import MODELS
 from sim.emulator.chain import Emulator
 from sim.mujoco.bus import MujocoBus
 

@@ -13,10 +13,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from robot.bus.tables import BAUD_CODES, BUS_FAMILIES, MODELS
 from robot.config.joint_names import ARM_NAMES, EXTRA_NAME, HIP_YAW_NAMES, JOINT_NAMES, LEG_NAMES
 from robot.config.toml_io import show
 from robot.errors import ConfigError
+from robot.servo.models import BAUD_CODES, BUS_FAMILIES, MODELS
 
 if TYPE_CHECKING:
     from robot.config.robot_file import BusConfig, JointConfig, RobotConfig

@@ -12,7 +12,6 @@ from functools import cached_property
 from pathlib import Path
 from typing import Any
 
-from robot.bus.tables import MODELS, ServoModel
 from robot.config.bundled import (  # noqa: F401  (re-exported: where configs come from)
     CONFIG_DIR,
     DEFAULT_GAIT,
@@ -39,6 +38,7 @@ from robot.config.params import BALANCE, SPECS, canonical_name, check_value
 from robot.config.toml_io import Range, build, number, read_toml, show, spec, table
 from robot.errors import ConfigError
 from robot.imu.config import ImuConfig, parse_imu
+from robot.servo.models import MODELS, ServoModel
 
 # Valid ranges of the numeric fields (checked at load; see robot/config/toml_io.py).
 #: bus.retries: extra attempts per transaction; more than 10 only hides a broken bus.

@@ -11,7 +11,7 @@ from robot.bus import health
 from robot.bus.sdk_bus import SdkBus
 from robot.bus.servo_map import ServoMap
 from robot.bus.tables import TABLES
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import BusError
 from robot.servo.models import MODELS
 from sim.emulator.chain import Emulator

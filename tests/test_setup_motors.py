@@ -11,7 +11,7 @@ import pytest
 
 import robot.cli as cli
 from robot.commands import setup_motors
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.servo.models import BAUD_CODES, BUS_FAMILIES
 from robot.setup.motor_setup import FACTORY_BAUD, baud_order
 from sim.emulator.chain import Emulator

@@ -18,7 +18,9 @@ import numpy as np
 import pytest
 
 import robot.cli as cli
-from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
+from robot.config.bundled import DEFAULT_ROBOT
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.motion.takes import read_take
 from robot.panel.controller import LoopOptions, make_controller
 from robot.panel.studio import Studio

@@ -20,7 +20,7 @@ from robot.bus.sdk_port import PORT_ERRORS
 from robot.bus.sdk_registers import SdkRegisters
 from robot.bus.sync_read import BlockSyncRead, Reply
 from robot.bus.tables import COMM_WATCHDOG, RETURN_DELAY_UNIT_S
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.servo.models import model_name
 
 log = logging.getLogger(__name__)

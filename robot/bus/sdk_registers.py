@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 
 from robot.bus.sdk_port import PORT_ERRORS
 from robot.bus.tables import TABLES, Register
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import BusError
 from robot.servo.models import BAUD_CODES
 

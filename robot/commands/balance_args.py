@@ -12,7 +12,7 @@ from collections.abc import Callable
 from robot.balance.stage import Balance, attitude_reader
 from robot.bus.base import Bus
 from robot.commands.common import bounded_float
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.imu import Imu, open_imu

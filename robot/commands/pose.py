@@ -26,7 +26,7 @@ from robot.commands.common import (
 )
 from robot.commands.signals import SignalLatch, stop_on_signals
 from robot.config.params import GaitParams
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.gait.engine import GaitEngine
 from robot.loop.streamer import LoopStats, Streamer
 

@@ -16,7 +16,7 @@ from robot.config.toml_io import read_toml, show, table
 from robot.errors import ConfigError
 
 if TYPE_CHECKING:
-    from robot.config.robot_file import RobotConfig
+    from robot.config.robot import RobotConfig
 
 
 @dataclass(frozen=True)

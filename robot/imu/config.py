@@ -23,6 +23,7 @@ from typing import Any
 from robot.config.toml_io import Range, build, number, show, spec, table
 from robot.errors import ConfigError
 from robot.imu.frames import Mount
+from robot.imu.kinds import imu_kinds
 
 #: noise / bias: a scale of the BNO055 datasheet figures; 0 turns it off, 100 is absurd.
 SCALE = Range(0.0, 100.0)
@@ -68,8 +69,6 @@ class ImuConfig:
 
 def parse_imu(src: str, data: Any) -> ImuConfig:
     """The ``[imu]`` table of robot file ``src``, validated."""
-    from robot.imu.factory import imu_kinds
-
     tab: Mapping[str, Any] = table(src, "imu", data)
     valid = [f for f in ImuConfig.__dataclass_fields__]
     unknown = sorted(set(tab) - set(valid))

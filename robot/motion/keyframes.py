@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.config.toml_io import number, read_toml, show
 from robot.errors import ConfigError
 from robot.motion.interp import METHODS, interpolate

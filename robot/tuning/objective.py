@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from robot.config.gait_file import Gait, gait_to_toml
 from robot.config.params import GaitParams
-from robot.config.robot_file import Gait, gait_to_toml
 from robot.errors import ConfigError
 from robot.tuning.robustness import Condition, Outcome, conditions, outcome, run_walk
 

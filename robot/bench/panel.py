@@ -87,7 +87,7 @@ def _window(mode: str, n: int, seconds: float) -> dict[str, Any]:
         server = build_server(controller, port=0, studio=Studio(
             controller, takes_dir=Path(tmp) / "t", keys_dir=Path(tmp) / "k"))
         _, base = serve_in_thread(server)
-        hub = server.hub  # type: ignore[attr-defined]
+        hub = server.hub
         try:
             controller.start(observer=observe)
             end = time.monotonic() + 20

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from robot.config.joint_names import ARM_NAMES, EXTRA_NAME, HIP_YAW_NAMES, JOINT_NAMES, LEG_NAMES
-from robot.config.toml_io import show
+from robot.config.toml_io import TomlValue, show
 from robot.errors import ConfigError
 from robot.servo import ticks as tick_math
 from robot.servo.models import BAUD_CODES, BUS_FAMILIES, MODELS
@@ -98,7 +98,7 @@ def check_ticks(robot: RobotConfig) -> None:
             "or another zero_ticks")
 
 
-def check_joint_set(src: str, jtab: Mapping[str, Any]) -> None:
+def check_joint_set(src: str, jtab: Mapping[str, TomlValue]) -> None:
     """Every leg joint (hip yaw on both sides or neither), all arm joints or none; any
     other name is an extra joint and needs ``fixed_rad``."""
     for name, entry in jtab.items():

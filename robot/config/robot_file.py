@@ -7,14 +7,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
 
 from robot.config.bundled import DEFAULT_ROBOT, resolve_robot_path
 from robot.config.checks import check_bus, check_joint_extras, check_joint_set, check_ticks
 from robot.config.joint_names import ARM_NAMES, JOINT_NAMES
 from robot.config.params import BALANCE, SPECS, canonical_name, check_value
 from robot.config.robot import ANGLE, BusConfig, Geometry, JointConfig, Masses, RobotConfig
-from robot.config.toml_io import Range, build, number, read_toml, show, table
+from robot.config.toml_io import Range, TomlValue, build, number, read_toml, show, table
 from robot.errors import ConfigError
 from robot.imu.config import parse_imu
 from robot.servo.models import MODELS
@@ -27,7 +26,8 @@ def load_robot(name_or_path: str | Path | None = None) -> RobotConfig:
     return parse_robot(read_toml(p), source=str(p))
 
 
-def parse_robot(data: Mapping[str, Any], *, source: str = "<memory>") -> RobotConfig:
+def parse_robot(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> RobotConfig:
+    """A validated robot from a robot file's table (ConfigError, one line, on any problem)."""
     src = source
     allowed = {"name", "bus", "geometry", "mass", "joints", "rest", "imu", "balance"}
     unknown = sorted(set(data) - allowed)

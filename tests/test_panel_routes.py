@@ -12,7 +12,9 @@ from pathlib import Path
 
 import pytest
 
-from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
+from robot.config.bundled import DEFAULT_ROBOT
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.panel.controller import PanelController
 from robot.panel.guard import MAX_BODY, Guard
 from robot.panel.live import LiveHub

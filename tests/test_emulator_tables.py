@@ -160,13 +160,13 @@ def test_return_delay_units_are_2_us_and_the_drivers() -> None:
 
 
 def test_protocol_families_are_the_drivers() -> None:
-    assert models.PROTOCOL_FAMILY == driver.BUS_FAMILIES
+    assert models.PROTOCOL_FAMILY == driver_models.BUS_FAMILIES
 
 
 def test_servo_models_agree_with_the_drivers() -> None:
-    assert set(models.MODELS) == set(driver.MODELS)
+    assert set(models.MODELS) == set(driver_models.MODELS)
     for name, ours in models.MODELS.items():
-        theirs = driver.MODELS[name]
+        theirs = driver_models.MODELS[name]
         assert (theirs.name, theirs.number, theirs.family, theirs.resolution) == (
             ours.name, ours.number, ours.family, ours.resolution), name
         assert theirs.span_deg == ours.span_deg, name

@@ -11,10 +11,10 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 
+from robot.config.imu_file import ImuConfig
 from robot.config.joint_names import ARM_NAMES, JOINT_NAMES, LEG_NAMES
 from robot.config.toml_io import Range, spec
 from robot.errors import ConfigError
-from robot.imu.config import ImuConfig
 from robot.servo.models import MODELS, ServoModel
 
 # Valid ranges of the numeric fields (checked at load; see robot/config/toml_io.py).
@@ -136,7 +136,7 @@ class RobotConfig:
     joints: tuple[JointConfig, ...]
     rest: Mapping[str, float] = field(default_factory=dict)
     source: str = "<memory>"
-    #: The ``[imu]`` section (optional; robot.imu.config): None when the robot has no IMU.
+    #: The ``[imu]`` section (optional; robot.config.imu_file): None when the robot has no IMU.
     imu: ImuConfig | None = None
     #: The ``[balance]`` section (optional): balance gains (robot/config/params.py group
     #: "balance feedback") for this robot; a gait preset that names a gain itself, and

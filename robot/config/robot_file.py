@@ -10,12 +10,12 @@ from pathlib import Path
 
 from robot.config.bundled import DEFAULT_ROBOT, resolve_robot_path
 from robot.config.checks import check_bus, check_joint_extras, check_joint_set, check_ticks
+from robot.config.imu_file import parse_imu
 from robot.config.joint_names import ARM_NAMES, JOINT_NAMES
 from robot.config.params import BALANCE, SPECS, canonical_name, check_value
 from robot.config.robot import ANGLE, BusConfig, Geometry, JointConfig, Masses, RobotConfig
 from robot.config.toml_io import Range, TomlValue, build, number, read_toml, show, table
 from robot.errors import ConfigError
-from robot.imu.config import parse_imu
 from robot.servo.models import MODELS
 
 

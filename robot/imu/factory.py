@@ -11,13 +11,13 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from robot.config.imu_file import ENTRY_POINT_GROUP, ImuConfig, imu_kinds
 from robot.errors import ConfigError
 from robot.imu.base import Imu
-from robot.imu.kinds import ENTRY_POINT_GROUP, imu_kinds, plugin
+from robot.imu.kinds import plugin
 
 if TYPE_CHECKING:
     from robot.bus.base import Bus
-    from robot.imu.config import ImuConfig
 
 def open_imu(config: ImuConfig, *, bus: Bus | None = None) -> Imu:
     """The IMU backend for ``config`` (not yet opened: use ``with open_imu(...) as imu:``).
@@ -34,4 +34,8 @@ def open_imu(config: ImuConfig, *, bus: Bus | None = None) -> Imu:
         raise ConfigError(f"imu.kind: unknown IMU {config.kind!r}; valid: "
                           f"{', '.join(imu_kinds())} (plugins are entry points in group "
                           f"{ENTRY_POINT_GROUP}; reinstall biped if 'sim' is missing)")
-    return factory(config, bus=bus)
+    imu = factory(config, bus=bus)
+    if not isinstance(imu, Imu):
+        raise ConfigError(f"imu.kind {config.kind}: its plugin returned a "
+                          f"{type(imu).__name__}, not an IMU (robot.imu.base.Imu)")
+    return imu

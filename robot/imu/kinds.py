@@ -1,34 +1,25 @@
-"""Which IMU kinds exist: the built-in ones and the plugins (entry point group
-``biped.imus``, or registered at run time). A leaf of ``robot.imu``: the robot file's
-``[imu]`` check (robot/imu/config.py) and the factory (robot/imu/factory.py) both ask it.
+"""Registering an IMU backend at run time (``register_imu``) and finding a plugin's
+factory. The names themselves live with the robot file's ``[imu]`` check
+(``robot.config.imu_file.IMU_BACKENDS``), which must know them without importing the IMUs.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 
+from robot.config.imu_file import IMU_BACKENDS, imu_kinds
 from robot.imu.base import Imu
-from robot.imu.registry import Registry
 
-#: Entry-point group where IMU plugins are declared.
-ENTRY_POINT_GROUP = "biped.imus"
-BUILTIN = ("bno055",)
+__all__ = ["ImuFactory", "imu_kinds", "plugin", "register_imu"]
 
 ImuFactory = Callable[..., Imu]   # (config: ImuConfig, *, bus: Bus | None) -> Imu
-
-_plugins: Registry[ImuFactory] = Registry(ENTRY_POINT_GROUP, BUILTIN, "imu.kind")
 
 
 def register_imu(kind: str, factory: ImuFactory) -> None:
     """Make ``open_imu`` build IMUs of ``kind`` with ``factory(config, bus=...)``."""
-    _plugins.register(kind, factory)
+    IMU_BACKENDS.register(kind, factory)
 
 
-def imu_kinds() -> tuple[str, ...]:
-    """Every IMU kind ``open_imu`` accepts: plugins (registered or declared), then built-in."""
-    return _plugins.kinds()
-
-
-def plugin(kind: str) -> ImuFactory | None:
+def plugin(kind: str) -> Callable[..., object] | None:
     """The factory of plugin ``kind`` (loading its entry point), None if unknown."""
-    return _plugins.plugin(kind)
+    return IMU_BACKENDS.plugin(kind)

@@ -16,12 +16,12 @@ fusion = true                # sim: report the fused quaternion (false: gyro+acc
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from robot.config.plugins import Registry
 from robot.config.toml_io import Range, TomlValue, build, number, show, spec, table
 from robot.errors import ConfigError
-from robot.imu.frames import Mount
-from robot.imu.kinds import imu_kinds
 
 #: noise / bias: a scale of the BNO055 datasheet figures; 0 turns it off, 100 is absurd.
 SCALE = Range(0.0, 100.0)
@@ -37,6 +37,19 @@ SIM_ONLY = ("noise", "bias", "latency_ms", "seed", "fusion")
 SERIAL_ONLY = ("port",)
 #: The built-in serial device kinds.
 SERIAL_KINDS = ("bno055",)
+#: Entry-point group where IMU plugins are declared.
+ENTRY_POINT_GROUP = "biped.imus"
+
+#: IMU backends by kind: the built-in ones, the entry points of group ``biped.imus`` and the
+#: ones registered at run time (``robot.imu.kinds.register_imu``). Each is a callable
+#: ``(config: ImuConfig, *, bus) -> robot.imu.base.Imu``; the factory checks what it returns.
+IMU_BACKENDS: Registry[Callable[..., object]] = Registry(ENTRY_POINT_GROUP, SERIAL_KINDS,
+                                                       "imu.kind")
+
+
+def imu_kinds() -> tuple[str, ...]:
+    """Every IMU kind a robot file may name: plugins (registered or declared), then built-in."""
+    return IMU_BACKENDS.kinds()
 
 
 @dataclass(frozen=True)
@@ -59,10 +72,6 @@ class ImuConfig:
     latency_ms: float = field(default=10.0, metadata=spec(LATENCY_MS))
     seed: int = field(default=0, metadata=spec(SEED))
     fusion: bool = True
-
-    @property
-    def mount(self) -> Mount:
-        return Mount.from_rpy_deg(self.mount_rpy_deg)
 
 
 def parse_imu(src: str, data: TomlValue) -> ImuConfig:

@@ -25,11 +25,13 @@ import numpy.typing as npt
 from robot.bus.base import Bus, ServoInfo, ServoState
 from robot.bus.servo_map import ServoMap
 from robot.config.robot_file import RobotConfig
+from robot.config.world import World
 from robot.errors import BusError
 from sim.mujoco.mjcf import FOOT_GEOMS, build_mjcf, standing_qpos
+from sim.mujoco.run_watch import SimRunWatch
 from sim.mujoco.servos import AMBIENT_C, SimServos
 from sim.mujoco.view import OffscreenRenderer, SimClock, WallPacer, check_display, launch_viewer
-from sim.mujoco.world import PUSH_WINDOW_S, TimedForces, World
+from sim.mujoco.world import PUSH_WINDOW_S, TimedForces
 from sim.mujoco.world_scene import apply_world_to_model, place_on_floor
 
 __all__ = ["AMBIENT_C", "MujocoBus", "SimClock"]
@@ -47,7 +49,7 @@ class MujocoBus(Bus):
     realtime: also wait on the wall clock so the sim runs at 1x; view: open the passive
     viewer (needs a display); timestep: physics step [s] (default 0.002); pose: start pose
     {joint: rad} instead of the ``home`` keyframe (standing, soles on the floor); world:
-    perturbations (``sim.mujoco.world.World``: slope, bumps, latency, friction, mass; pushes via
+    perturbations (``robot.config.world.World``: slope, bumps, latency, friction, mass; pushes via
     ``push`` / ``sim.mujoco.world.PushScheduler``), None for the plain scene.
     """
 
@@ -144,6 +146,12 @@ class MujocoBus(Bus):
     def floor_normal(self) -> tuple[float, float, float]:
         """Unit normal of the floor plane through the origin (world frame)."""
         return self.world.floor_normal() if self.world is not None else (0.0, 0.0, 1.0)
+
+    def run_watch(self) -> SimRunWatch:
+        """A watch for one run on the open bus (robot.run.spec.WatchedBus)."""
+        return SimRunWatch(self.model, self.data, self.robot, world=self.world,
+                           standing_height=self.standing_height,
+                           floor_normal=self.floor_normal, push_target=self)
 
     @property
     def model(self) -> mujoco.MjModel:

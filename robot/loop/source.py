@@ -12,7 +12,7 @@ has ``stopped``, then ramps to ``exit_pose``; it never asks what kind of source 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Protocol, TypeAlias, runtime_checkable
+from typing import Protocol, TypeAlias, TypeVar, runtime_checkable
 
 import numpy as np
 import numpy.typing as npt
@@ -67,6 +67,11 @@ class MotionSource(Protocol):
     def amplitude(self) -> float: ...
 
     def tick(self, dt: float) -> JointTargets: ...
+
+
+#: A run's or a streamer's source type (e.g. GaitEngine for the panel, which sets its
+#: parameters live).
+SourceT = TypeVar("SourceT", bound=MotionSource)
 
 
 class Feedback(Protocol):

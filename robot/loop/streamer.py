@@ -29,7 +29,7 @@ import logging
 import threading
 import time
 from collections.abc import Mapping
-from typing import Generic, TypeVar
+from typing import Generic
 
 import numpy as np
 
@@ -40,7 +40,7 @@ from robot.errors import BusDead, BusError, ConfigError, SafetyStop
 from robot.loop.clock import Clock, MonotonicClock
 from robot.loop.ending import arm_failsafe, finish
 from robot.loop.latency import SampleStats
-from robot.loop.source import Feedback, JointTargets, JointVector, MotionSource
+from robot.loop.source import Feedback, JointTargets, JointVector, MotionSource, SourceT
 from robot.loop.start_check import check_inside_limits
 from robot.loop.telemetry import LoopStats, Telemetry, TickObserver, loop_stats
 from robot.loop.watchdog import Watchdog, WatchdogConfig
@@ -50,13 +50,10 @@ __all__ = ["Feedback", "LoopStats", "MotionSource", "Streamer", "Telemetry", "Ti
 
 log = logging.getLogger(__name__)
 
-S = TypeVar("S", bound=MotionSource)
-
-
-class Streamer(Generic[S]):
+class Streamer(Generic[SourceT]):
     """Streams a motion source's joint angles to a bus at ``rate_hz`` [Hz]."""
 
-    def __init__(self, robot_map: ServoMap, bus: Bus, source: S, *,
+    def __init__(self, robot_map: ServoMap, bus: Bus, source: SourceT, *,
                  rate_hz: float = 200.0, read_every: int = 10, clock: Clock | None = None,
                  hold_at_end: bool = False, watchdog: WatchdogConfig | None = None,
                  observer: TickObserver | None = None,
@@ -90,7 +87,7 @@ class Streamer(Generic[S]):
         self._ticks = 0
 
     @property
-    def engine(self) -> S:
+    def engine(self) -> SourceT:
         """The source being streamed (the name from when it was always a gait engine)."""
         return self.source
 

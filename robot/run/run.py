@@ -18,12 +18,13 @@ import logging
 import time
 from collections.abc import Callable
 from types import TracebackType
+from typing import Generic
 
 from robot.balance.stage import Balance, attitude_reader
 from robot.bus.servo_map import ServoMap
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
-from robot.loop.source import Feedback, MotionSource
+from robot.loop.source import Feedback, SourceT
 from robot.loop.streamer import Streamer
 from robot.loop.telemetry import LoopStats, Telemetry
 from robot.run.result import RunResult
@@ -33,22 +34,22 @@ from robot.run.spec import RunSpec, RunWatch, WatchedBus
 log = logging.getLogger(__name__)
 
 
-class Run:
+class Run(Generic[SourceT]):
     """The object that owns one run's recorder, bus (unless ``options.close_bus`` is
     False), IMU, observers, Streamer and signals. No I/O before ``__enter__``."""
 
-    def __init__(self, spec: RunSpec) -> None:
+    def __init__(self, spec: RunSpec[SourceT]) -> None:
         self.spec = spec
         self.latch = SignalLatch()
         self.watch: RunWatch | None = None
-        self._streamer: Streamer[MotionSource] | None = None
+        self._streamer: Streamer[SourceT] | None = None
         self._stats: LoopStats | None = None
         self._result: RunResult | None = None
         self._wall0 = 0.0
         self._imu_opened = False
 
     @property
-    def streamer(self) -> Streamer[MotionSource]:
+    def streamer(self) -> Streamer[SourceT]:
         if self._streamer is None:
             raise ConfigError("run: not open; use `with Run(spec) as run:` first")
         return self._streamer
@@ -60,7 +61,13 @@ class Run:
         return self._result
 
     # -- opening -------------------------------------------------------------------------
-    def __enter__(self) -> Run:
+    def __enter__(self) -> Run[SourceT]:
+        self.open()
+        return self
+
+    def open(self) -> None:
+        """Open the recorder, then the bus (unless open), the IMU, and build the Streamer;
+        on an error, close what was opened."""
         spec = self.spec
         self._wall0 = time.perf_counter()
         if spec.recorder is not None:
@@ -70,7 +77,6 @@ class Run:
         except BaseException:
             self._close()
             raise
-        return self
 
     def _open(self) -> None:
         spec, o = self.spec, self.spec.options
@@ -132,6 +138,10 @@ class Run:
     # -- closing -------------------------------------------------------------------------
     def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Close what the run opened; then ``result`` holds the outcome (if it streamed)."""
         record_error = self._close()
         if self._stats is None:
             return
@@ -157,7 +167,7 @@ class Run:
         return spec.recorder.close_quietly() if spec.recorder is not None else None
 
 
-def execute(spec: RunSpec) -> RunResult:
+def execute(spec: RunSpec[SourceT]) -> RunResult:
     """Open, stream and close ``spec``'s run; its result."""
     run = Run(spec)
     with run:

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Protocol, runtime_checkable
+from typing import Generic, Protocol, runtime_checkable
 
 from robot.bus.base import Bus
 from robot.config.robot_file import RobotConfig
 from robot.imu import Imu
-from robot.loop.source import Feedback, MotionSource
+from robot.loop.source import Feedback, SourceT
 from robot.loop.telemetry import Telemetry, TickObserver
 
 
@@ -70,7 +70,7 @@ class RunOptions:
 
 
 @dataclass(frozen=True)
-class RunSpec:
+class RunSpec(Generic[SourceT]):
     """One run: ``source`` streamed to ``bus`` for ``robot``.
 
     imu: opened after the bus and closed by the run; the balance stage reads it (the
@@ -79,7 +79,7 @@ class RunSpec:
     """
 
     robot: RobotConfig
-    source: MotionSource
+    source: SourceT
     bus: Bus
     options: RunOptions = field(default_factory=RunOptions)
     imu: Imu | None = None

@@ -50,7 +50,7 @@ def walk_imu(robot: RobotConfig, bus: Bus, *, balance: bool = True,
 
 def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
               imu: Imu | None = None, keyframes: Sequence | None = None,
-              record: str | None = None, options: RunOptions | None = None) -> RunSpec:
+              record: str | None = None, options: RunOptions | None = None) -> RunSpec[GaitEngine]:
     """The run of a walk with ``params`` (preset ``gait``, for a take's header), a
     keyframe layer on the arms, and a recording (NAME.take.jsonl: the parameter
     timeline; .csv or .jsonl: the joint stream)."""
@@ -74,7 +74,7 @@ def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
                    recorder=recorder)
 
 
-def walk_summary(spec: RunSpec, result: RunResult, *, gait: str) -> dict[str, Any]:
+def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *, gait: str) -> dict[str, Any]:
     """The JSON object of `biped walk --json`: robot, gait, bus, seconds, balance, then
     the result (RunResult.as_dict)."""
     return {"robot": spec.robot.name, "gait": gait, "bus": spec.bus.kind,

@@ -74,7 +74,8 @@ def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
                    recorder=recorder)
 
 
-def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *, gait: str) -> dict[str, Any]:
+def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *,
+                 gait: str) -> dict[str, Any]:
     """The JSON object of `biped walk --json`: robot, gait, bus, seconds, balance, then
     the result (RunResult.as_dict)."""
     return {"robot": spec.robot.name, "gait": gait, "bus": spec.bus.kind,

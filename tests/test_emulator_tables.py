@@ -7,6 +7,7 @@ from __future__ import annotations
 import pytest
 
 from robot.bus import tables as driver
+from robot.servo import models as driver_models
 from sim.emulator import control_tables as manual
 from sim.emulator.servo import EmulatedServo, ServoSpec
 
@@ -19,9 +20,9 @@ def test_every_driver_register_matches_the_manual(family: str) -> None:
         assert (reg.address, reg.size) == theirs[name][:2], f"{family}: {name}"
 
 
-@pytest.mark.parametrize("family", sorted(driver.BAUD_CODES))
+@pytest.mark.parametrize("family", sorted(driver_models.BAUD_CODES))
 def test_driver_baud_codes_are_the_manuals(family: str) -> None:
-    for code, baud in driver.BAUD_CODES[family].items():
+    for code, baud in driver_models.BAUD_CODES[family].items():
         assert manual.BAUD_CODES[family][code] == baud
 
 

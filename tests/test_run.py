@@ -16,7 +16,9 @@ import pytest
 from robot import cli
 from robot.bus.factory import make_bus
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import DEFAULT_ROBOT_NAME, load_gait, load_robot
+from robot.config.bundled import DEFAULT_ROBOT_NAME
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.gait.engine import GaitEngine
 from robot.loop.source import MotionSource
 from robot.loop.streamer import Streamer, Telemetry

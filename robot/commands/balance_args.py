@@ -11,7 +11,7 @@ from collections.abc import Callable
 from robot.balance.stage import Balance, attitude_reader
 from robot.bus.base import Bus
 from robot.commands.common import bounded_float
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.gait.engine import GaitEngine
 from robot.imu import Imu
 from robot.run.walk import walk_imu

@@ -26,7 +26,9 @@ from robot.commands.common import (
     rate_hz,
     seconds,
 )
-from robot.config.robot_file import DEFAULT_GAIT, RobotConfig, load_robot
+from robot.config.bundled import DEFAULT_GAIT
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.loop.recorder import Recorder

@@ -25,7 +25,7 @@ from robot.commands.common import (
     robot_from,
 )
 from robot.commands.signals import SignalLatch, stop_on_signals
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.loop.streamer import LoopStats, Streamer
 from robot.motion.posing import PoseMove
 

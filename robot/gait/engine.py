@@ -16,8 +16,9 @@ from collections.abc import Mapping
 import numpy as np
 import numpy.typing as npt
 
+from robot.config.joint_names import JOINT_NAMES
 from robot.config.params import SPECS, GaitParams
-from robot.config.robot_file import JOINT_NAMES, RobotConfig
+from robot.config.robot import RobotConfig
 from robot.gait import expressions as gait
 from robot.gait.ik import arm_ik, leg_ik
 from robot.gait.targets import NO_TRIM, BodyTargets, body_targets

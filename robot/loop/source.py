@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.config.params import GaitParams
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 
 #: Joint angles [rad] in the robot's joint order (``robot.joints``).
 JointVector: TypeAlias = npt.NDArray[np.float64]

@@ -10,7 +10,7 @@ import numpy.typing as npt
 
 from robot.bus.base import ServoState
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import BusDead, BusError, SafetyStop
 
 #: How many times the longest retried transaction the servos' bus watchdog must allow.

@@ -12,8 +12,9 @@ keyframe, clamp, slew, ramp to rest at the end.
 
 from __future__ import annotations
 
+from robot.config.joint_names import LEG_NAMES
 from robot.config.params import GaitParams
-from robot.config.robot_file import LEG_NAMES, RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.motion.keyframes import Sequence

@@ -21,8 +21,9 @@ import numpy.typing as npt
 
 from robot.bus.base import Bus
 from robot.bus.servo_map import ServoMap
+from robot.config.joint_names import ARM_NAMES, JOINT_NAMES, LEG_NAMES
 from robot.config.params import GaitParams
-from robot.config.robot_file import ARM_NAMES, JOINT_NAMES, LEG_NAMES, RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.loop.streamer import Streamer
 from robot.motion.keyframes import Sequence

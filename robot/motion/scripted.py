@@ -17,7 +17,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 
 from robot.config.params import GaitParams, canonical_name
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.motion.keyframes import Sequence
 from robot.motion.layered import LayeredEngine
 

@@ -20,7 +20,7 @@ from typing import Any
 from robot.bus.base import Bus
 from robot.bus.servo_map import ServoMap
 from robot.config.params import GaitParams
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import BipedError
 from robot.gait.engine import GaitEngine
 from robot.loop.streamer import LoopStats, Streamer, Telemetry, TickObserver

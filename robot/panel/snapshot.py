@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from robot.config.params import GROUPS, SPECS, GaitParams
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.loop.telemetry import Telemetry
 from robot.panel.figure import views
 from robot.panel.labels import LABELS, SIMPLE

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from typing import Generic, Protocol, runtime_checkable
 
 from robot.bus.base import Bus
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.imu import Imu
 from robot.loop.source import Feedback, SourceT
 from robot.loop.telemetry import Telemetry, TickObserver

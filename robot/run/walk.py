@@ -10,7 +10,7 @@ from typing import Any
 
 from robot.bus.base import Bus
 from robot.config.params import GaitParams
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.imu import Imu, open_imu

@@ -57,8 +57,9 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
-from robot.bus.tables import BUS_FAMILIES, ERROR_BITS, MODELS
-from robot.config.robot_file import RobotConfig
+from robot.bus.tables import ERROR_BITS
+from robot.config.robot import RobotConfig
+from robot.servo.models import BUS_FAMILIES, MODELS
 from sim.emulator.control_tables import BAUD_CODES, TABLES
 from sim.emulator.server import ChainSpec, EmulatorError, Packet
 from sim.emulator.servo import ServoSpec

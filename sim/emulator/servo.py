@@ -25,7 +25,8 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
-from robot.bus.tables import COMM_WATCHDOG, ERROR_BITS, MODELS, RETURN_DELAY_UNIT_S
+from robot.bus.tables import COMM_WATCHDOG, ERROR_BITS, RETURN_DELAY_UNIT_S
+from robot.servo.models import MODELS
 from sim.emulator import servo_motion, servo_write
 from sim.emulator.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, Entry
 

@@ -24,7 +24,7 @@ import numpy.typing as npt
 
 from robot.bus.base import Bus, ServoInfo, ServoState
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.config.world import World
 from robot.errors import BusError
 from sim.mujoco.mjcf import FOOT_GEOMS, build_mjcf, standing_qpos

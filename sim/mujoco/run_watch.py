@@ -10,7 +10,7 @@ from typing import Any
 
 import mujoco
 
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.config.world import World
 from robot.loop.telemetry import Telemetry
 from sim.mujoco.effort import EffortMonitor

@@ -127,14 +127,15 @@ def run(args: argparse.Namespace) -> int:
     spec = RunSpec(robot=robot, source=engine, bus=bus, imu=imu, recorder=writer,
                    options=RunOptions(rate_hz=rate, read_every=read_every, hold=args.hold,
                                       seconds=limit, signals=True, watch=False))
-    run_ = Run(spec)
-    with run_:
+    playing = Run(spec)
+    with playing:
         if isinstance(writer, TakeWriter) and isinstance(engine, PlaybackEngine):
             for k, step in sorted(take.changes.items()):
                 writer.event(k, set=dict(step))
             writer.event(stop, stop=True)
-        run_.stream()
-    stats, record_error, code = run_.result.stats, run_.result.record_error, run_.result.exit_code
+        playing.stream()
+    done = playing.result
+    stats, record_error, code = done.stats, done.record_error, done.exit_code
     result = {"file": args.file, "robot": robot.name, "bus": kind, "ticks": stats.ticks,
               "rate_hz": rate, "gait_seconds": engine.time, "overruns": stats.overruns,
               "stop_reason": stats.stop_reason, "fault": stats.fault,

@@ -25,7 +25,8 @@ from robot.commands.common import (
 )
 from robot.errors import ConfigError
 from robot.motion.keyframes import SUFFIXES, load_sequence, sequence_to_toml
-from robot.motion.posing import Capture, limb_joints, release
+from robot.motion.posing import Capture, limb_joints
+from robot.run.release import release
 
 Ask = Callable[[str], str]
 

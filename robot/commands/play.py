@@ -32,10 +32,11 @@ from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.loop.recorder import Recorder
+from robot.loop.take_writer import TakeWriter
 from robot.motion.keyframes import SUFFIXES, load_sequence, parse_sequence
 from robot.motion.layered import LayeredEngine
 from robot.motion.scripted import PlaybackEngine
-from robot.motion.takes import SUFFIX, Take, TakeHeader, TakeWriter, is_take, read_take
+from robot.motion.takes import SUFFIX, Take, TakeHeader, is_take, read_take
 from robot.run.run import Run
 from robot.run.spec import RunOptions, RunSpec
 

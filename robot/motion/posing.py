@@ -2,10 +2,8 @@
 move it, capture poses.
 
 ``PoseMove`` is the motion source (robot.loop.source) of a move to a pose: `biped pose`,
-`biped torque on` (a move to the present pose) and ``release`` stream it.
-``release`` holds every joint outside the limb where it is, through the streamer's start
-(refused if a joint is outside its limits; goal := present, torque on, no snap), then
-turns torque off on the limb; ``"all"`` only turns torque off. ``capture`` reads the
+`biped torque on` (a move to the present pose) and ``robot.run.release`` stream it.
+``limbs`` names what can be released. ``capture`` reads the
 present positions (the bus never writes) and returns the limb's joint angles [rad],
 clamped to the joint limits, as the next keyframe of a sequence (robot.motion.keyframes).
 """
@@ -25,7 +23,6 @@ from robot.config.joint_names import ARM_NAMES, JOINT_NAMES, LEG_NAMES
 from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
-from robot.loop.streamer import Streamer
 from robot.motion.keyframes import Sequence
 from robot.motion.ramp import ramp
 
@@ -114,20 +111,6 @@ def limb_joints(robot: RobotConfig, limb: object) -> tuple[str, ...]:
         raise ConfigError(f"limb {limb!r}: unknown; valid for {robot.name}: "
                           f"{', '.join(valid)}")
     return valid[limb]
-
-
-def release(robot: RobotConfig, bus: Bus, limb: str) -> tuple[str, ...]:
-    """Hold the other joints where they are (torque on), torque off on ``limb``'s."""
-    joints = limb_joints(robot, limb)
-    smap = ServoMap(robot)
-    if len(joints) < len(robot.joints):
-        here = PoseMove(robot, smap.from_positions(bus.read_positions(smap.ids)))
-        stats = Streamer(smap, bus, here, hold_at_end=True).run()
-        if not stats.holding:
-            raise ConfigError(f"could not hold the other joints: {stats.stop_reason}")
-    bus.set_torque([robot.joint(j).servo_id for j in joints], enabled=False)
-    log.info("released %s (%d joints); the rest holds", limb, len(joints))
-    return joints
 
 
 @dataclass

@@ -24,12 +24,14 @@ from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
+from robot.loop.take_writer import TakeWriter
 from robot.motion.keyframes import Sequence, load_sequence, parse_sequence, sequence_to_toml
 from robot.motion.layered import LayeredEngine
-from robot.motion.posing import Capture, limb_joints, limbs, release
+from robot.motion.posing import Capture, limb_joints, limbs
 from robot.motion.scripted import PlaybackEngine, RecordingEngine
-from robot.motion.takes import SUFFIX, TakeHeader, TakeWriter, read_take
+from robot.motion.takes import SUFFIX, TakeHeader, read_take
 from robot.panel.controller import PanelController, PanelStateError
+from robot.run.release import release
 
 log = logging.getLogger(__name__)
 

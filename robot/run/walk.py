@@ -15,10 +15,11 @@ from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.imu import Imu, open_imu
 from robot.loop.recorder import Recorder
+from robot.loop.take_writer import TakeWriter
 from robot.motion.keyframes import Sequence
 from robot.motion.layered import LayeredEngine
 from robot.motion.scripted import RecordingEngine
-from robot.motion.takes import TakeHeader, TakeWriter, is_take
+from robot.motion.takes import TakeHeader, is_take
 from robot.run.result import RunResult
 from robot.run.spec import Recording, RunOptions, RunSpec
 

@@ -45,16 +45,6 @@ def checked(option: str, parse: Callable[[str], T], text: str) -> T:
         raise ConfigError(f"{option}: {e}") from None
 
 
-def positive_float(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}") from None
-    if not v > 0 or v != v or v == float("inf"):
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
-    return v
-
-
 def positive_int(text: str) -> int:
     try:
         v = int(text)

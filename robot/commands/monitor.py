@@ -27,9 +27,9 @@ from robot.commands.common import (
     one_line_errors,
     robot_from,
 )
-from robot.commands.signals import SignalLatch, stop_on_signals
 from robot.config.robot import RobotConfig
 from robot.errors import BusError
+from robot.run.signals import SignalLatch, stop_on_signals
 from robot.setup.monitor_table import format_table, rows
 
 #: --rate: a terminal table faster than 50 Hz is unreadable; slower than 0.1 Hz is not live.

@@ -17,13 +17,13 @@ from typing import Any
 
 from robot.commands.balance_args import feedback_factory, imu_for
 from robot.commands.common import add_set_arg, bus_from, params_from, robot_from
-from robot.commands.signals import SignalLatch, stop_on_signals
 from robot.commands.walk import add_walk_args
 from robot.errors import ConfigError
 from robot.panel.controller import LoopOptions, make_controller
 from robot.panel.presets import PresetStore, user_presets_dir
 from robot.panel.server import build_server, is_loopback, panel_url, serve_in_thread
 from robot.panel.studio import Studio, user_data_dir
+from robot.run.signals import SignalLatch, stop_on_signals
 
 log = logging.getLogger(__name__)
 

@@ -24,10 +24,10 @@ from robot.commands.common import (
     rate_hz,
     robot_from,
 )
-from robot.commands.signals import SignalLatch, stop_on_signals
 from robot.config.robot import RobotConfig
 from robot.loop.streamer import LoopStats, Streamer
 from robot.motion.posing import PoseMove
+from robot.run.signals import SignalLatch, stop_on_signals
 
 log = logging.getLogger(__name__)
 

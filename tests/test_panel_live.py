@@ -194,8 +194,9 @@ def test_studio_over_http(served: tuple[PanelController, int, LiveHub]) -> None:
     assert status == 200 and r["take"] == "http-take" and r["studio"]["recording"]
     assert until(lambda: controller.state()["state"] == "walking", 10)
     assert post(port, "/api/pose/release", {"limb": "arms"})[0] == 409  # not while walking
+    tick = controller.state()["tick"]
     assert post(port, "/api/params", {"turn": 0.1})[0] == 200
-    time.sleep(0.5)
+    assert until(lambda: controller.state()["tick"] >= tick + 50, 20)  # the change recorded
     assert post(port, "/api/stop")[0] == 200
     assert until(lambda: not controller.running, 20)
     with connect_get(port, "/api/takes") as names:

@@ -130,8 +130,9 @@ def test_bad_values_refused_and_nothing_changes(panel: tuple[PanelController, Ca
     status, d = call("POST", "/api/params", body)
     assert status == 400 and needle in d["error"]
     assert call("GET", "/api/params")[1]["params"] == before
-    time.sleep(0.05)  # a few ticks: nothing pending reaches the engine either
-    assert streamer.engine.params == engine_before
+    tick = controller.state()["tick"]
+    assert wait_for(lambda: controller.state()["tick"] >= tick + 5)  # a few ticks later,
+    assert streamer.engine.params == engine_before                   # nothing pending landed
 
 
 @pytest.mark.parametrize("raw", [b"not json", b"[1, 2]", b"\xff\xfe"])

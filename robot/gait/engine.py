@@ -20,7 +20,8 @@ from robot.config.params import SPECS, GaitParams
 from robot.config.robot_file import JOINT_NAMES, RobotConfig
 from robot.gait import expressions as gait
 from robot.gait.ik import arm_ik, leg_ik
-from robot.gait.targets import NO_TRIM, BodyTargets, body_targets
+from robot.gait.targets import NO_TRIM, BodyTargets, BodyTrim, body_targets
+from robot.gait.tick import TickKernel
 from robot.gait.xmath import Num
 
 log = logging.getLogger(__name__)
@@ -74,6 +75,14 @@ def solve(t: BodyTargets, robot: RobotConfig) -> tuple[list[Num], Num]:
     return q, ok
 
 
+def _plain(values: tuple[Num, ...]) -> bool:
+    """Every value a Python float or int (not a numpy scalar or array)."""
+    for v in values:
+        if type(v) is not float and type(v) is not int:
+            return False
+    return True
+
+
 def _smoothstep(x: float) -> float:
     x = min(max(x, 0.0), 1.0)
     return x * x * (3.0 - 2.0 * x)
@@ -111,6 +120,12 @@ class GaitEngine:
         self.lift = (0.0, 0.0)
         self._lo = [j.min_rad for j in robot.joints]
         self._hi = [j.max_rad for j in robot.joints]
+        self._limits = list(zip(self._lo, self._hi, strict=True))
+        self._kernel = TickKernel(robot)
+        self._plain_p: GaitParams | None = None   # the last parameters found _plain
+        self._plain_trim: BodyTrim | None = None  # the last trim found _plain
+        self._ramp_p: GaitParams | None = None    # the parameters _ramp_s is for
+        self._ramp_s = 0.0
 
     # -- parameters -------------------------------------------------------------------
     @property
@@ -181,21 +196,37 @@ class GaitEngine:
     def pose(self, *, amplitude: float | None = None) -> list[float]:
         """Joint angles [rad] at the current phase (default: the current envelope)."""
         a = self.amplitude if amplitude is None else amplitude
-        p = self._live
-        ch = gait.channels(self.phase, p, amplitude=a)
-        targets = body_targets(ch, p, self.robot.geometry, amplitude=a,
-                               leg_yaw=self._leg_yaw, trim=self.trim)
-        self.lift = (float(targets.lift_r), float(targets.lift_l))
-        q, ok = solve(targets, self.robot)
+        p, ph, trim = self._live, self.phase, self.trim
+        q: list[Num]
+        if self._plain_inputs(p, ph, a, trim):
+            # Python numbers throughout: the fused kernel, the same bits (robot.gait.tick).
+            q, lift_r, lift_l, ok = self._kernel.pose(ph, p, a, trim)
+        else:  # numpy scalars somewhere: the general functions, evaluated as they do
+            ch = gait.channels(ph, p, amplitude=a)
+            targets = body_targets(ch, p, self.robot.geometry, amplitude=a,
+                                   leg_yaw=self._leg_yaw, trim=trim)
+            lift_r, lift_l = float(targets.lift_r), float(targets.lift_l)
+            q, ok = solve(targets, self.robot)
+            q = [float(v) for v in q]
+        self.lift = (lift_r, lift_l)
         if not ok:
             self.unreachable_ticks += 1
             if self.unreachable_ticks in (1, 10, 100) or self.unreachable_ticks % 1000 == 0:
                 log.warning("gait target out of reach (%d ticks so far): clamped to the "
                             "nearest reachable pose; reduce stride, foot height or crouch",
                             self.unreachable_ticks)
-        lo, hi = self._lo, self._hi
-        return [lo[i] if v < lo[i] else hi[i] if v > hi[i] else float(v)
-                for i, v in enumerate(q)]
+        return [lo if v < lo else hi if v > hi else v
+                for v, (lo, hi) in zip(q, self._limits, strict=True)]
+
+    def _plain_inputs(self, p: GaitParams, ph: gait.Phase, a: float, trim: BodyTrim) -> bool:
+        """Every input a Python float or int, so the kernel's arithmetic is exactly the
+        general functions' (checked once per parameter set and per trim)."""
+        if p is not self._plain_p:
+            self._plain_p = p if _plain(tuple(vars(p).values())) else None
+        if trim is not self._plain_trim:
+            self._plain_trim = trim if _plain(trim) else None
+        return (p is self._plain_p and trim is self._plain_trim and _plain(ph)
+                and (type(a) is float or type(a) is int))
 
     def start_pose(self) -> list[float]:
         """The pose at phase 0 with the envelope at 0 (where a walk starts and ends)."""
@@ -211,7 +242,9 @@ class GaitEngine:
         angles [rad]."""
         self._follow(dt)
         p = self._live
-        ramp_s = p.ramp_cycles * p.cycle_s
+        if p is not self._ramp_p:
+            self._ramp_p, self._ramp_s = p, p.ramp_cycles * p.cycle_s
+        ramp_s = self._ramp_s
         step = 1.0 if not math.isfinite(ramp_s) or ramp_s <= 0 else dt / ramp_s
         if self._running:
             self._ramp = min(1.0, self._ramp + step)

@@ -19,9 +19,10 @@ import numpy.typing as npt
 from robot.config.params import SPECS, GaitParams
 from robot.config.robot_file import JOINT_NAMES, RobotConfig
 from robot.gait import expressions as gait
-from robot.gait.ik import arm_ik, leg_ik
-from robot.gait.targets import NO_TRIM, BodyTargets, BodyTrim, body_targets
+from robot.gait import vectorised
+from robot.gait.targets import NO_TRIM, BodyTrim, body_targets
 from robot.gait.tick import TickKernel
+from robot.gait.vectorised import solve
 from robot.gait.xmath import Num
 
 log = logging.getLogger(__name__)
@@ -55,24 +56,6 @@ def within_steering_budget(p: GaitParams) -> GaitParams:
         return p
     k = STEER_BUDGET / used
     return dataclasses.replace(p, speed=p.speed * k, turn=p.turn * k, side_step=p.side_step * k)
-
-
-def solve(t: BodyTargets, robot: RobotConfig) -> tuple[list[Num], Num]:
-    """IK for every joint of ``robot`` (its joint order) and a reachable flag."""
-    g = robot.geometry
-    r = leg_ik(g, "r", t.r_sole, t.r_foot)
-    lft = leg_ik(g, "l", t.l_sole, t.l_foot)
-    q: list[Num] = [*r.q, *lft.q]
-    ok = r.reachable & lft.reachable
-    if robot.has_arms:
-        ra = arm_ik(g, t.r_hand)
-        la = arm_ik(g, t.l_hand)
-        q += [*ra.q, *la.q]
-        ok = ok & ra.reachable & la.reachable
-    layout = robot.layout
-    if layout is not None:   # 5-DoF legs, extra joints held at fixed angles
-        q = [q[i] if i >= 0 else fixed for i, fixed in layout]
-    return q, ok
 
 
 def _plain(values: tuple[Num, ...]) -> bool:
@@ -263,21 +246,7 @@ class GaitEngine:
                with_channels: bool = True
                ) -> tuple[dict[str, npt.NDArray[np.float64]], npt.NDArray[np.float64]]:
         """Channels and joint angles (n_joints, n) over ``times`` [s] at full amplitude and
-        constant parameters (vectorised, in cache-sized chunks). ``with_channels=False``
-        returns an empty channel dict and only the joint angles."""
-        times = np.asarray(times, dtype=float)
-        n = times.shape[0]
-        names = gait.CHANNELS if with_channels else ()
-        out_ch = {name: np.empty(n) for name in names}
-        out_q = np.empty((len(self.robot.joints), n))
-        for i in range(0, n, chunk):
-            sl = slice(i, min(i + chunk, n))
-            ch = gait.curves(times[sl], self._target)
-            q, _ = solve(body_targets(ch, self._target, self.robot.geometry,
-                                      leg_yaw=self._leg_yaw), self.robot)
-            for name in names:
-                out_ch[name][sl] = ch[name]
-            for j, v in enumerate(q):
-                out_q[j, sl] = v
-        np.clip(out_q, np.array(self._lo)[:, None], np.array(self._hi)[:, None], out=out_q)
-        return out_ch, out_q
+        constant parameters (robot.gait.vectorised: in cache-sized chunks, over threads).
+        ``with_channels=False`` returns an empty channel dict and only the joint angles."""
+        return vectorised.curves(self.robot, self._target, times, chunk=chunk,
+                                 with_channels=with_channels)

@@ -33,6 +33,7 @@ import pytest
 
 from robot.config.params import GaitParams
 from robot.config.robot_file import ROBOTS_DIR, load_gait, load_robot
+from robot.gait import vectorised
 from robot.gait.engine import GaitEngine
 from robot.gait.targets import NO_TRIM, BodyTrim
 
@@ -195,6 +196,17 @@ def test_vectorised_curves_are_bit_for_bit_the_stored_ones(
     q, ch = curve_stream(robot, GaitParams(**params[name]), chunk=chunk)
     assert_same(f"curves/{robot}/{name}/q", q, golden)
     assert_same(f"curves/{name}/channels", ch, golden)
+
+
+@pytest.mark.parametrize("workers", [1, 3])
+def test_vectorised_curves_do_not_depend_on_the_threads(
+        workers: int, golden: dict[str, npt.NDArray[np.generic]],
+        params: dict[str, dict[str, float]]) -> None:
+    robot = load_robot(ROBOTS_DIR / "biped18-dynamixel.toml")
+    ch, q = vectorised.curves(robot, GaitParams(**params["walk"]), curve_times(),
+                              chunk=SMALL_CHUNK, workers=workers)
+    assert_same("curves/biped18-dynamixel/walk/q", q, golden)
+    assert_same("curves/walk/channels", np.array(list(ch.values())), golden)
 
 
 def test_the_fixture_covers_every_bundled_robot(

@@ -199,7 +199,7 @@ def test_vectorised_curves_are_bit_for_bit_the_stored_ones(
 
 
 @pytest.mark.parametrize("workers", [1, 3])
-def test_vectorised_curves_do_not_depend_on_the_threads(
+def test_vectorised_curves_do_not_depend_on_the_threads_or_the_channels(
         workers: int, golden: dict[str, npt.NDArray[np.generic]],
         params: dict[str, dict[str, float]]) -> None:
     robot = load_robot(ROBOTS_DIR / "biped18-dynamixel.toml")
@@ -207,6 +207,10 @@ def test_vectorised_curves_do_not_depend_on_the_threads(
                               chunk=SMALL_CHUNK, workers=workers)
     assert_same("curves/biped18-dynamixel/walk/q", q, golden)
     assert_same("curves/walk/channels", np.array(list(ch.values())), golden)
+    none, q = vectorised.curves(robot, GaitParams(**params["walk"]), curve_times(),
+                                chunk=SMALL_CHUNK, workers=workers, with_channels=False)
+    assert none == {}
+    assert_same("curves/biped18-dynamixel/walk/q", q, golden)
 
 
 def test_the_fixture_covers_every_bundled_robot(

@@ -91,7 +91,8 @@ def curves(robot: RobotConfig, p: GaitParams, times: npt.NDArray[np.float64], *,
 
     def one(start: int) -> None:
         sl = slice(start, min(start + chunk, n))
-        ch = gait.curves(times[sl], p)
+        t = times[sl]
+        ch = gait.curves(t, p) if with_channels else gait.channels(gait.phase_at(t, p), p)
         q, _ = solve(body_targets(ch, p, robot.geometry, leg_yaw=leg_yaw), robot)
         for name in names:
             out_ch[name][sl] = ch[name]

@@ -14,10 +14,6 @@ class ConfigError(BipedError):
     """A robot or gait file, CLI argument or live parameter is invalid."""
 
 
-class IKError(BipedError):
-    """Inverse kinematics could not produce a pose (never raised inside the control loop)."""
-
-
 class BusError(BipedError):
     """A servo bus operation failed: names the servo id, its joint, the SDK's message and a fix."""
 

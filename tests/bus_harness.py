@@ -14,7 +14,9 @@ import pytest
 
 from robot.bus.factory import make_bus
 from robot.bus.sdk_bus import SdkBus
-from robot.config.robot_file import ROBOTS_DIR, RobotConfig, load_robot
+from robot.config.bundled import ROBOTS_DIR
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from sim.emulator.chain import Emulator
 
 PROTOCOLS = ("dynamixel", "feetech")

@@ -8,7 +8,10 @@ os.environ.setdefault("MUJOCO_GL", "egl")  # headless: before anything imports m
 
 import pytest
 
-from robot.config.robot_file import GAITS_DIR, ROBOTS_DIR, Gait, RobotConfig, load_gait, load_robot
+from robot.config.bundled import GAITS_DIR, ROBOTS_DIR
+from robot.config.gait_file import Gait, load_gait
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 
 ROBOT_FILES = sorted(p.name for p in ROBOTS_DIR.glob("*.toml"))
 GAIT_FILES = sorted(p.stem for p in GAITS_DIR.glob("*.toml"))

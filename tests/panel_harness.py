@@ -16,7 +16,9 @@ from pathlib import Path
 import pytest
 from playwright.sync_api import Browser, sync_playwright
 
-from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
+from robot.config.bundled import DEFAULT_ROBOT
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.panel.controller import LoopOptions, PanelController, make_controller
 from robot.panel.server import build_server, serve_in_thread
 from robot.panel.studio import Studio

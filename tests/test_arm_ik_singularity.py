@@ -22,7 +22,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_engine import DT, cycles
 
-from robot.config.robot_file import Gait, Geometry, RobotConfig, load_gait, load_robot
+from robot.config.gait_file import Gait, load_gait
+from robot.config.robot import Geometry, RobotConfig
+from robot.config.robot_file import load_robot
 from robot.gait import expressions as gait
 from robot.gait.engine import GaitEngine, solve
 from robot.gait.ik import arm_fk_local, arm_ik

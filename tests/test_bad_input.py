@@ -22,7 +22,8 @@ import numpy as np
 import pytest
 
 import robot.cli as cli
-from robot.config.robot_file import ROBOTS_DIR, load_robot
+from robot.config.bundled import ROBOTS_DIR
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.motion.ramp import ramp, ramp_duration
 from sim.emulator.chain import Emulator

@@ -18,8 +18,9 @@ from robot.balance.stage import (
     balance_step,
     wrap,
 )
+from robot.config.gait_file import load_gait
 from robot.config.params import BALANCE, SPECS, GaitParams
-from robot.config.robot_file import load_gait, load_robot
+from robot.config.robot_file import load_robot
 from robot.gait import xmath as xm
 from robot.gait.engine import GaitEngine
 from robot.gait.ik import leg_fk_full

@@ -18,8 +18,9 @@ from robot.balance.law import (
 )
 from robot.balance.rhythm import BINS, Rhythm
 from robot.balance.stage import Balance
+from robot.config.gait_file import load_gait
 from robot.config.params import GaitParams
-from robot.config.robot_file import load_gait, load_robot
+from robot.config.robot_file import load_robot
 from robot.gait.engine import GaitEngine
 from robot.gait.ik import leg_fk_full
 

@@ -7,7 +7,7 @@ import pytest
 import scservo_sdk
 
 from robot.bus.sdk_bus import SdkBus
-from robot.bus.tables import MODELS
+from robot.servo.models import MODELS
 from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)

@@ -10,9 +10,10 @@ import pytest
 from robot.bus import health
 from robot.bus.sdk_bus import SdkBus
 from robot.bus.servo_map import ServoMap
-from robot.bus.tables import MODELS, TABLES
-from robot.config.robot_file import RobotConfig
+from robot.bus.tables import TABLES
+from robot.config.robot import RobotConfig
 from robot.errors import BusError
+from robot.servo.models import MODELS
 from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)

@@ -13,7 +13,9 @@ import numpy as np
 import pytest
 
 import robot.cli as cli
-from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
+from robot.config.bundled import DEFAULT_ROBOT
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.gait.engine import GaitEngine
 from robot.gait.ik import arm_fk_local, leg_fk_full, shoulder_centre
 from robot.motion.takes import read_take

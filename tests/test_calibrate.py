@@ -12,7 +12,8 @@ import pytest
 
 import robot.cli as cli
 from robot.commands import calibrate
-from robot.config.robot_file import RobotConfig, load_robot
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from robot.config.toml_edit import edit_joints
 from robot.errors import ConfigError
 from robot.setup.calibration import (

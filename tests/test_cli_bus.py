@@ -15,7 +15,8 @@ import pytest
 
 import robot.cli as cli
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import RobotConfig, load_robot
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)

@@ -17,18 +17,11 @@ from hypothesis import strategies as st
 
 from robot.bus.limits import TickLimits
 from robot.bus.servo_map import ServoMap
+from robot.config.bundled import ROBOTS_DIR, gait_names
+from robot.config.gait_file import Gait, gait_to_toml, load_gait, parse_gait
+from robot.config.joint_names import ARM_NAMES
 from robot.config.params import ALIASES, SPECS, GaitParams
-from robot.config.robot_file import (
-    ARM_NAMES,
-    ROBOTS_DIR,
-    Gait,
-    gait_names,
-    gait_to_toml,
-    load_gait,
-    load_robot,
-    parse_gait,
-    parse_robot,
-)
+from robot.config.robot_file import load_robot, parse_robot
 from robot.errors import BipedError, BusError, ConfigError
 
 BASE_ROBOT = (ROBOTS_DIR / "biped18-dynamixel.toml").read_text()

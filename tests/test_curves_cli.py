@@ -13,7 +13,9 @@ import pytest
 from test_gait import CHANNEL_NAMES, close, printed
 
 from robot.cli import main
-from robot.config.robot_file import DEFAULT_ROBOT, ROBOTS_DIR, gait_names, load_gait, load_robot
+from robot.config.bundled import DEFAULT_ROBOT, ROBOTS_DIR, gait_names
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.gait.engine import GaitEngine
 
 

@@ -10,8 +10,8 @@ import pytest
 from test_gait import EQUATIONS
 
 from robot.config import docs_gen
+from robot.config.bundled import gait_names
 from robot.config.params import ALIASES, SPECS
-from robot.config.robot_file import gait_names
 
 DOC = docs_gen.DOC
 TEXT = DOC.read_text()

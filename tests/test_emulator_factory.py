@@ -20,12 +20,18 @@ from typing import Any
 import dynamixel_sdk as dxl
 import pytest
 import scservo_sdk as scs
+from sdk_timeouts import allow_slow_replies
 
 from sim.emulator.chain import Emulator, EmulatorError
 
 ROOT = Path(__file__).resolve().parent.parent
 X_ID, X_BAUD, X_DELAY, X_TORQUE = 7, 8, 9, 64
 S_ID, S_BAUD, S_LOCK, S_TORQUE = 5, 6, 55, 40
+
+
+@pytest.fixture(autouse=True)
+def patient_sdks(monkeypatch: pytest.MonkeyPatch) -> None:
+    allow_slow_replies(monkeypatch)
 
 
 @pytest.fixture(autouse=True)

@@ -14,7 +14,8 @@ from bus_harness import open_bus
 
 import robot.cli as cli
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import RobotConfig, load_gait
+from robot.config.gait_file import load_gait
+from robot.config.robot import RobotConfig
 from robot.gait.engine import GaitEngine
 from robot.loop.latency import SampleStats
 from robot.loop.streamer import Streamer

@@ -10,8 +10,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from robot.config.gait_file import Gait, load_gait
 from robot.config.params import SPECS, GaitParams
-from robot.config.robot_file import Gait, RobotConfig, load_gait, load_robot
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from robot.gait import expressions as gait
 from robot.gait.engine import GaitEngine, solve
 from robot.gait.ik import leg_fk_full

@@ -24,7 +24,7 @@ import pytest
 from robot.bus.base import Bus
 from robot.bus.sdk_bus import SdkBus
 from robot.bus.tables import TABLES
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import BusError, ConfigError
 from sim.emulator.chain import Emulator, Packet
 
@@ -151,7 +151,8 @@ class Child:
     SCRIPT = """
 import sys, time
 from robot.bus.factory import make_bus
-from robot.config.robot_file import ROBOTS_DIR, load_robot
+from robot.config.bundled import ROBOTS_DIR
+from robot.config.robot_file import load_robot
 protocol, port, timeout_s, knee_id, knee = sys.argv[1:6]
 robot = load_robot(ROBOTS_DIR / f"biped18-{protocol}.toml")
 bus = make_bus(protocol, robot=robot, port=port, timeout_ms=50.0)

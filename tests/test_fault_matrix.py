@@ -29,7 +29,7 @@ import numpy as np
 import pytest
 
 import robot.cli as cli
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from sim.emulator.chain import Emulator, Packet
 
 pytest_plugins = ("bus_harness",)

@@ -1,5 +1,6 @@
 """`biped find-port` on fake device lists: the pure comparison, `run()` with an injected
-lister and scripted answers, and the CLI in a subprocess (BIPED_FAKE_PORTS, real stdin)."""
+lister and scripted answers, and the real lister and CLI on pyserial with its backend
+replaced (tests/fake_comports.py; in a subprocess for the CLI, real stdin)."""
 
 from __future__ import annotations
 
@@ -12,14 +13,13 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+from fake_comports import serve, write_listings
 
 from robot.commands.find_port import run
 from robot.setup.serial_ports import (
-    FAKE_PORTS_ENV,
     PortSearchError,
     SerialPort,
     added_port,
-    fake_lister,
     list_ports,
     removed_port,
 )
@@ -113,27 +113,42 @@ def test_run_list_json(capsys: pytest.CaptureFixture[str]) -> None:
     assert rows[1]["serial_number"] == "7573" and rows[1]["description"] == "Arduino Uno"
 
 
-def write_listings(tmp_path: Path, listings: list[list[SerialPort]]) -> Path:
-    path = tmp_path / "ports.json"
-    path.write_text(json.dumps([[p.as_dict() for p in ls] for ls in listings]))
-    return path
-
-
 def biped(argv: list[str], ports: Path, stdin: str) -> subprocess.CompletedProcess[str]:
-    code = ("import sys, robot.cli as c; c.COMMANDS = ('find_port',); "
-            "sys.exit(c.main(sys.argv[1:]))")
-    return subprocess.run([sys.executable, "-c", code, *argv], cwd=REPO, input=stdin,
-                          capture_output=True, text=True, timeout=60,
-                          env={**os.environ, FAKE_PORTS_ENV: str(ports)})
+    code = ("import sys; sys.path.insert(1, 'tests'); import fake_comports as f; "
+            "sys.exit(f.main(sys.argv[1:]))")
+    return subprocess.run([sys.executable, "-c", code, str(ports), *argv], cwd=REPO,
+                          input=stdin, capture_output=True, text=True, timeout=60,
+                          env=dict(os.environ))
 
 
-def test_fake_lister_serves_listings_in_order(tmp_path: Path) -> None:
-    lister = fake_lister(write_listings(tmp_path, [[U2D2, CH340], [CH340]]))
-    assert [lister(), lister(), lister()] == [[U2D2, CH340], [CH340], [CH340]]
+def test_list_ports_reads_pyserial_sorted(monkeypatch: pytest.MonkeyPatch) -> None:
+    serve(monkeypatch, [[U2D2, ARDUINO, CH340], [CH340]])
+    assert list_ports() == [ARDUINO, U2D2, CH340]   # by device name
+    assert list_ports() == [CH340]
+    assert list_ports() == [CH340]   # the last listing stays
+
+
+def test_run_defaults_to_pyserial(monkeypatch: pytest.MonkeyPatch,
+                                  capsys: pytest.CaptureFixture[str]) -> None:
+    serve(monkeypatch, [[U2D2, CH340], [CH340], [CH340, U2D2_BACK]])
+    answers = iter(["\n", "\n"])
+    assert run(ns(json=True), read_line=lambda: next(answers), settle_s=0) == 0
+    found = json.loads(capsys.readouterr().out)
+    assert found["device"] == "/dev/ttyUSB2" and found["serial_number"] == "FT6Z5XXX"
+
+
+def test_help_has_no_test_hook() -> None:
+    r = subprocess.run([sys.executable, "-c", "import sys, robot.cli as c; "
+                        "c.COMMANDS = ('find_port',); sys.exit(c.main(sys.argv[1:]))",
+                        "find-port", "--help"], cwd=REPO, capture_output=True, text=True,
+                       timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert "find the robot's" in r.stdout
+    assert "BIPED_FAKE_PORTS" not in r.stdout and "test hook" not in r.stdout.lower()
 
 
 def test_cli_same_port_back_json(tmp_path: Path) -> None:
-    ports = write_listings(tmp_path, [[ARDUINO, U2D2], [ARDUINO], [ARDUINO, U2D2]])
+    ports = write_listings(tmp_path / "ports.json", [[ARDUINO, U2D2], [ARDUINO], [ARDUINO, U2D2]])
     r = biped(["find-port", "--json"], ports, "\n\n")
     assert r.returncode == 0, r.stderr
     found = json.loads(r.stdout)
@@ -142,7 +157,7 @@ def test_cli_same_port_back_json(tmp_path: Path) -> None:
 
 
 def test_cli_text(tmp_path: Path) -> None:
-    ports = write_listings(tmp_path, [[ARDUINO, CH340], [ARDUINO], [ARDUINO, CH340]])
+    ports = write_listings(tmp_path / "ports.json", [[ARDUINO, CH340], [ARDUINO], [ARDUINO, CH340]])
     r = biped(["find-port"], ports, "\n\n")
     assert r.returncode == 0, r.stderr
     assert r.stdout.splitlines()[-1] == ("robot's adapter: /dev/ttyUSB1 (QinHeng Electronics "
@@ -156,7 +171,7 @@ def test_cli_text(tmp_path: Path) -> None:
 ])
 def test_cli_refusals_are_one_line(tmp_path: Path, listings: list[list[SerialPort]],
                                    needle: str) -> None:
-    r = biped(["find-port"], write_listings(tmp_path, listings), "\n\n")
+    r = biped(["find-port"], write_listings(tmp_path / "ports.json", listings), "\n\n")
     assert r.returncode == 2
     assert r.stderr.count("\n") == 1 and needle in r.stderr, r.stderr
     assert r.stderr.startswith("biped find-port: error: ")

@@ -16,7 +16,9 @@ import pytest
 from test_bvh import ROTATIONS  # glTF's axes are BVH's: X left, Y up, Z forward
 
 import robot.cli as cli
-from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
+from robot.config.bundled import DEFAULT_ROBOT
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.gait.engine import GaitEngine
 from robot.motion.takes import read_take
 

@@ -16,7 +16,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robot.config.robot_file import Geometry, load_robot
+from robot.config.robot import Geometry
+from robot.config.robot_file import load_robot
 from robot.gait import xmath as xm
 from robot.gait.ik import arm_fk, arm_fk_local, arm_ik, hip_centre, leg_fk, leg_fk_full, leg_ik
 from robot.gait.xmath import Rot, Vec

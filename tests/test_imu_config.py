@@ -7,7 +7,9 @@ from typing import Any
 
 import pytest
 
-from robot.config.robot_file import ROBOTS_DIR, RobotConfig, load_robot, parse_robot
+from robot.config.bundled import ROBOTS_DIR
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot, parse_robot
 from robot.errors import ConfigError
 from robot.imu import Imu, ImuConfig, ImuSample, imu_kinds, open_imu, register_imu
 from robot.imu.bno055 import Bno055Imu

@@ -9,7 +9,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from robot.config.robot_file import RobotConfig, load_robot
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.imu import ImuConfig, ImuError, TiltEstimator, open_imu, tilt_from_accel, tilt_from_quat
 from robot.imu.frames import quat_conj, quat_from_rpy, quat_rotate

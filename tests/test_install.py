@@ -20,18 +20,10 @@ import pytest
 from robot.bus.base import Bus
 from robot.bus.factory import ENTRY_POINT_GROUP, bus_kinds, make_bus, register_bus
 from robot.cli import main
-from robot.config.robot_file import (
-    DEFAULT_ROBOT,
-    GAITS_DIR,
-    ROBOTS_DIR,
-    Gait,
-    RobotConfig,
-    gait_names,
-    gait_to_toml,
-    load_gait,
-    load_robot,
-    robot_names,
-)
+from robot.config.bundled import DEFAULT_ROBOT, GAITS_DIR, ROBOTS_DIR, gait_names, robot_names
+from robot.config.gait_file import Gait, gait_to_toml, load_gait
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 
 REPO = Path(__file__).resolve().parent.parent

@@ -15,14 +15,17 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import robot.cli as cli
-from robot.bus.tables import MODELS
 from robot.commands import capture as capture_cmd
-from robot.config.robot_file import DEFAULT_ROBOT, RobotConfig, load_gait, load_robot
+from robot.config.bundled import DEFAULT_ROBOT
+from robot.config.gait_file import load_gait
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.motion.interp import min_jerk, smooth
 from robot.motion.keyframes import load_sequence
 from robot.motion.takes import read_take
 from robot.previs.plots import read_table
+from robot.servo.models import MODELS
 from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)

@@ -13,7 +13,10 @@ from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 from robot.cli import main  # noqa: E402
-from robot.config.robot_file import ARM_JOINTS, LEG_JOINTS, ROBOTS_DIR, RobotConfig, load_robot  # noqa: E402
+from robot.config.bundled import ROBOTS_DIR  # noqa: E402
+from robot.config.joint_names import ARM_JOINTS, LEG_JOINTS  # noqa: E402
+from robot.config.robot import RobotConfig  # noqa: E402
+from robot.config.robot_file import load_robot  # noqa: E402
 from robot.gait import ik  # noqa: E402
 from sim.mujoco.mjcf import build_mjcf, standing_qpos  # noqa: E402
 

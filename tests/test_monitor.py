@@ -19,7 +19,7 @@ import pytest
 
 import robot.cli as cli
 from robot.commands.monitor import next_deadline
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)

@@ -14,7 +14,8 @@ import pytest  # noqa: E402
 
 from robot.bus.factory import make_bus  # noqa: E402
 from robot.bus.servo_map import ServoMap  # noqa: E402
-from robot.config.robot_file import ROBOTS_DIR, load_robot  # noqa: E402
+from robot.config.bundled import ROBOTS_DIR  # noqa: E402
+from robot.config.robot_file import load_robot  # noqa: E402
 from robot.errors import BusError  # noqa: E402
 from sim.mujoco.bus import AMBIENT_C, MujocoBus  # noqa: E402
 

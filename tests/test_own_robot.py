@@ -11,7 +11,10 @@ import numpy as np
 import pytest
 
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import ROBOTS_DIR, RobotConfig, load_gait, load_robot
+from robot.config.bundled import ROBOTS_DIR
+from robot.config.gait_file import load_gait
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.gait import expressions as gaitmod
 from robot.gait.engine import GaitEngine

@@ -15,7 +15,9 @@ import pytest
 from panel_harness import served_panel, wait_for
 from playwright.sync_api import Browser, Page, expect
 
-from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
+from robot.config.bundled import DEFAULT_ROBOT
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.panel.controller import LoopOptions, PanelController, make_controller
 from robot.panel.server import build_server, panel_url, serve_in_thread
 from sim.mujoco.bus import MujocoBus

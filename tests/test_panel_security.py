@@ -15,7 +15,9 @@ from typing import Any
 
 import pytest
 
-from robot.config.robot_file import DEFAULT_ROBOT, GAITS_DIR, load_gait, load_robot
+from robot.config.bundled import DEFAULT_ROBOT, GAITS_DIR
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.panel.controller import LoopOptions, PanelController, make_controller
 from robot.panel.guard import MAX_BODY
 from robot.panel.presets import PresetStore

@@ -19,8 +19,10 @@ from typing import Any
 import pytest
 
 from robot.bus.factory import make_bus
+from robot.config.bundled import DEFAULT_ROBOT, GAITS_DIR, ROBOTS_DIR
+from robot.config.gait_file import load_gait
 from robot.config.params import GROUPS, SPECS
-from robot.config.robot_file import DEFAULT_ROBOT, GAITS_DIR, ROBOTS_DIR, load_gait, load_robot
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.panel.controller import LoopOptions, PanelController, make_controller
 from robot.panel.presets import PresetStore

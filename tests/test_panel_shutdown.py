@@ -17,7 +17,8 @@ import pytest
 
 import robot.cli as cli
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import ROBOTS_DIR, RobotConfig
+from robot.config.bundled import ROBOTS_DIR
+from robot.config.robot import RobotConfig
 from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)

@@ -13,7 +13,8 @@ import pytest
 from matplotlib.colors import to_hex
 
 import robot.cli as cli
-from robot.config.robot_file import load_gait, load_robot
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.gait.engine import GaitEngine
 from robot.previs.curves import curves_figure
 from robot.previs.plots import read_table, record_figure

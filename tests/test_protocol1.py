@@ -14,7 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from robot.bus.tables import MODELS, TABLES
+from robot.bus.tables import TABLES
+from robot.servo.models import MODELS
 from sim.emulator.chain import Emulator
 
 # e-Manual AX-12A: (address, size)
@@ -81,7 +82,8 @@ def test_the_emulator_answers_the_sdk_in_protocol_1() -> None:
 # ---------------------------------------------------------------------- the kit's robot
 def test_the_ax12_humanoid_loads_inside_the_ax_range() -> None:
     from robot.bus.servo_map import ServoMap
-    from robot.config.robot_file import ROBOTS_DIR, load_robot
+    from robot.config.bundled import ROBOTS_DIR
+    from robot.config.robot_file import load_robot
 
     robot = load_robot(ROBOTS_DIR / "biped18-ax12.toml")
     assert (robot.bus.kind, robot.bus.model, robot.bus.baud) == ("dynamixel1", "AX-12A",
@@ -108,7 +110,8 @@ TORQUE_ENABLE, GOAL_POSITION = 24, 30      # e-Manual AX-12A addresses
 
 @pytest.fixture
 def ax_emu() -> Iterator[Emulator]:
-    from robot.config.robot_file import ROBOTS_DIR, load_robot
+    from robot.config.bundled import ROBOTS_DIR
+    from robot.config.robot_file import load_robot
 
     with Emulator("dynamixel1", load_robot(ROBOTS_DIR / f"{AX_TOML}.toml")) as emu:
         yield emu

@@ -9,7 +9,9 @@ import numpy as np
 import pytest
 
 from robot.cli import main
-from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
+from robot.config.bundled import DEFAULT_ROBOT
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from sim.mujoco.render import ClipSpec, check_output, render_walk
 

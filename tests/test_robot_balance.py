@@ -10,8 +10,10 @@ from pathlib import Path
 import pytest
 
 from robot.commands.common import params_from
+from robot.config.bundled import ROBOTS_DIR
+from robot.config.gait_file import Gait, gait_to_toml, parse_gait
 from robot.config.params import SPECS
-from robot.config.robot_file import ROBOTS_DIR, Gait, gait_to_toml, load_robot, parse_gait, parse_robot
+from robot.config.robot_file import load_robot, parse_robot
 from robot.errors import ConfigError
 
 BASE = tomllib.loads((ROBOTS_DIR / "biped18-dynamixel.toml").read_text())

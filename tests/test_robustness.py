@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from robot.config.gait_file import load_gait
 from robot.config.params import SPECS
-from robot.config.robot_file import load_gait
 from robot.tuning.robustness import (
     PUSH_AT_S,
     STRAIGHT_S,

@@ -11,7 +11,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import ROBOTS_DIR, RobotConfig, load_robot
+from robot.config.bundled import ROBOTS_DIR
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from robot.errors import BipedError
 
 # The 18-joint robots (the property tests draw one vector length for all of them; the

@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 
 import robot.cli as cli
-from robot.bus.tables import BAUD_CODES, BUS_FAMILIES
 from robot.commands import setup_motors
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
+from robot.servo.models import BAUD_CODES, BUS_FAMILIES
 from robot.setup.motor_setup import FACTORY_BAUD, baud_order
 from sim.emulator.chain import Emulator
 

@@ -31,8 +31,10 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 
+from robot.config.bundled import ROBOTS_DIR
+from robot.config.gait_file import load_gait
 from robot.config.params import GaitParams
-from robot.config.robot_file import ROBOTS_DIR, load_gait, load_robot
+from robot.config.robot_file import load_robot
 from robot.gait import vectorised
 from robot.gait.engine import GaitEngine
 from robot.gait.targets import NO_TRIM, BodyTrim

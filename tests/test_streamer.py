@@ -15,7 +15,8 @@ from bus_harness import open_bus
 
 from robot.bus.servo_map import ServoMap
 from robot.bus.tables import TABLES
-from robot.config.robot_file import RobotConfig, load_gait
+from robot.config.gait_file import load_gait
+from robot.config.robot import RobotConfig
 from robot.gait.engine import GaitEngine
 from robot.loop.streamer import Streamer, Telemetry
 from robot.loop.watchdog import WatchdogConfig

@@ -18,11 +18,14 @@ import numpy as np
 import pytest
 
 import robot.cli as cli
-from robot.bus.tables import MODELS
-from robot.config.robot_file import DEFAULT_ROBOT, load_gait, load_robot
+from robot.config.bundled import DEFAULT_ROBOT
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
+from robot.errors import ConfigError
 from robot.motion.takes import read_take
 from robot.panel.controller import LoopOptions, make_controller
 from robot.panel.studio import Studio
+from robot.servo.models import MODELS
 from sim.emulator.chain import Emulator
 from sim.mujoco.bus import MujocoBus
 
@@ -175,3 +178,42 @@ def test_csv_record_still_written(tmp_path: Path) -> None:
     header = out.read_text().splitlines()[0].split(",")
     assert header[:6] == ["t", "state", "tick", "period_error_ms", "overruns", "amplitude"]
     assert "cmd_r_knee" in header and "present_r_knee" in header
+
+
+HEADER = {"take": 1, "joints": ["r_knee"], "rate_hz": 100, "params": {}}
+
+
+def test_read_take_by_hand(tmp_path: Path) -> None:
+    """A take written by hand: a stream line without ``t`` is at tick / rate_hz [s]; a set
+    line's alias is stored under its canonical name."""
+    path = tmp_path / "hand.take.jsonl"
+    rows = [HEADER, {"gait_tick": 2, "set": {"turn": 0.1}},
+            {"tick": 0, "t": 0.0, "q": [0.5]}, {"tick": 1, "q": [0.25]},
+            {"gait_tick": 4, "stop": True}]
+    path.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    take = read_take(path)
+    assert take.header.joints == ("r_knee",) and take.stop_tick == 4
+    assert take.changes == {2: {"turn": 0.1}}
+    assert take.t.tolist() == [0.0, 0.01] and take.q.tolist() == [[0.5], [0.25]]
+    assert take.gait_seconds == pytest.approx(0.04)
+
+
+@pytest.mark.parametrize("header, row, needle", [
+    ({**HEADER, "joints": ["r_knee", 3]}, None, "line 1: joints: expected a list of joint names"),
+    ({**HEADER, "note": 7}, None, "line 1: note: expected a string, got 7"),
+    (HEADER, {"tick": 0, "t": "soon", "q": [0.0]}, "line 2: t: expected a number, got 'soon'"),
+    (HEADER, {"tick": 0, "t": float("inf"), "q": [0.0]},
+     "line 2: t: expected a finite number, got inf"),
+    (HEADER, {"tick": 0, "q": [True]}, "line 2: q: expected 1 finite joint angles [rad]"),
+    (HEADER, {"tick": 0, "q": [float("nan")]}, "line 2: q: expected 1 finite joint angles"),
+    (HEADER, {"gait_tick": 1, "set": {"turn": "left"}}, "line 2: set: turn must be a number"),
+])
+def test_bad_take_values_are_one_line_errors(tmp_path: Path, header: dict[str, object],
+                                             row: dict[str, object] | None,
+                                             needle: str) -> None:
+    path = tmp_path / "bad.take.jsonl"
+    path.write_text("".join(json.dumps(r) + "\n" for r in (header, row) if r is not None))
+    with pytest.raises(ConfigError) as info:
+        read_take(path)
+    msg = str(info.value)
+    assert msg.startswith(f"{path}: ") and needle in msg and "\n" not in msg, msg

@@ -15,12 +15,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from robot.config.bundled import ROBOTS_DIR
 from robot.config.params import SPECS, GaitParams
-from robot.config.robot_file import ROBOTS_DIR, RobotConfig, load_robot
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from robot.gait import expressions as gait
-from robot.gait.engine import solve
 from robot.gait.targets import BodyTrim, body_targets
 from robot.gait.tick import TickKernel
+from robot.gait.vectorised import solve
 
 ROBOTS = {p.stem: load_robot(p) for p in sorted(ROBOTS_DIR.glob("*.toml"))}
 KERNELS = {name: TickKernel(r) for name, r in ROBOTS.items()}

@@ -12,8 +12,8 @@ from pathlib import Path
 import optuna
 import pytest
 
+from robot.config.gait_file import Gait, gait_to_toml, load_gait
 from robot.config.params import SPECS
-from robot.config.robot_file import Gait, gait_to_toml, load_gait
 from robot.errors import ConfigError
 from robot.tuning.objective import Setup, combined, quality
 from robot.tuning.space import DEFAULT_KNOBS, apply, parse_knob, search_space

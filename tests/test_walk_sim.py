@@ -12,7 +12,7 @@ import math
 import pytest
 
 from robot.cli import main
-from robot.config.robot_file import ROBOTS_DIR
+from robot.config.bundled import ROBOTS_DIR
 
 REQUIRED = ("distance_m", "speed_m_s", "fell", "heading_change_deg", "lateral_drift_m",
             "ticks", "rate_hz", "period_error_p50_ms", "period_error_p99_ms", "overruns",

@@ -23,7 +23,8 @@ import numpy as np
 from robot.bus.factory import make_bus
 from robot.bus.sdk_bus import SdkBus
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import ROBOTS_DIR, load_robot
+from robot.config.bundled import ROBOTS_DIR
+from robot.config.robot_file import load_robot
 
 #: Protocol minimum for a position sync write of n servos [bytes].
 MIN_WRITE_BYTES: dict[str, Callable[[int], int]] = {

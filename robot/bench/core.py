@@ -12,7 +12,8 @@ from typing import Any
 import numpy as np
 
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import load_gait, load_robot
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.gait import vectorised
 from robot.gait.engine import GaitEngine, within_steering_budget
 

@@ -11,7 +11,9 @@ from typing import Any
 
 from robot.bus.factory import make_bus
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import ROBOTS_DIR, load_gait, load_robot
+from robot.config.bundled import ROBOTS_DIR
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.gait.engine import GaitEngine
 from robot.loop.streamer import Streamer
 

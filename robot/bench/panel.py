@@ -26,7 +26,9 @@ from typing import Any
 import numpy as np
 
 from robot.bus.factory import make_bus
-from robot.config.robot_file import ROBOTS_DIR, load_gait, load_robot
+from robot.config.bundled import ROBOTS_DIR
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.loop.streamer import Telemetry
 from robot.panel.controller import LoopOptions, make_controller
 from robot.panel.server import build_server, serve_in_thread
@@ -85,7 +87,7 @@ def _window(mode: str, n: int, seconds: float) -> dict[str, Any]:
         server = build_server(controller, port=0, studio=Studio(
             controller, takes_dir=Path(tmp) / "t", keys_dir=Path(tmp) / "k"))
         _, base = serve_in_thread(server)
-        hub = server.hub  # type: ignore[attr-defined]
+        hub = server.hub
         try:
             controller.start(observer=observe)
             end = time.monotonic() + 20

@@ -16,7 +16,8 @@ from typing import Any
 from robot.balance.stage import Balance, attitude_reader
 from robot.bus.factory import make_bus
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import load_gait, load_robot
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
 from robot.gait.engine import GaitEngine
 from robot.imu import open_imu
 from robot.loop.streamer import Streamer

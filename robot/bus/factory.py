@@ -14,7 +14,7 @@ from collections.abc import Callable
 from importlib.metadata import entry_points
 
 from robot.bus.base import Bus
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 
 #: Entry-point group where bus plugins are declared.

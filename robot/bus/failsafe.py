@@ -15,7 +15,7 @@ from robot.bus.tables import CommWatchdog
 from robot.errors import BusError, ConfigError
 
 if TYPE_CHECKING:
-    from robot.bus.sdk_bus import SdkBus
+    from robot.bus.sdk_registers import SdkRegisters
 
 #: Slack for timeouts that are whole steps in decimal but not in binary (0.1 / 0.02) [steps].
 _EPS = 1e-9
@@ -34,7 +34,7 @@ def watchdog_steps(wd: CommWatchdog, timeout_s: float, kind: str) -> int:
     return min(wd.steps[1], max(wd.steps[0], math.ceil(timeout_s / wd.unit_s - _EPS)))
 
 
-def arm(bus: SdkBus, wd: CommWatchdog, ids: Iterable[int], timeout_s: float) -> float:
+def arm(bus: SdkRegisters, wd: CommWatchdog, ids: Iterable[int], timeout_s: float) -> float:
     """Arm ``wd`` on every id with ``timeout_s`` [s]; return the armed timeout [s]."""
     steps = watchdog_steps(wd, timeout_s, bus.kind)
 
@@ -53,7 +53,7 @@ def arm(bus: SdkBus, wd: CommWatchdog, ids: Iterable[int], timeout_s: float) -> 
     return steps * wd.unit_s
 
 
-def disarm(bus: SdkBus, wd: CommWatchdog, ids: Iterable[int]) -> None:
+def disarm(bus: SdkRegisters, wd: CommWatchdog, ids: Iterable[int]) -> None:
     """Write ``wd.off`` on every id: disarms the watchdog and clears a trip."""
     def one(sid: int) -> None:
         bus.write_register(sid, wd.register, wd.off)

@@ -14,11 +14,12 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from robot.bus.tables import BAUD_CODES, RETURN_DELAY_UNIT_S
+from robot.bus.tables import RETURN_DELAY_UNIT_S
 from robot.errors import BusError
+from robot.servo.models import BAUD_CODES
 
 if TYPE_CHECKING:
-    from robot.bus.sdk_bus import SdkBus
+    from robot.bus.sdk_registers import SdkRegisters
 
 log = logging.getLogger(__name__)
 
@@ -60,7 +61,7 @@ def latency_warning(port: str, *, sysfs: Path = SYSFS_USB_SERIAL) -> str | None:
             "ATTR{latency_timer}=\"1\")")
 
 
-def return_delay_warning(bus: SdkBus, sid: int, raw: int) -> str:
+def return_delay_warning(bus: SdkRegisters, sid: int, raw: int) -> str:
     us = raw * RETURN_DELAY_UNIT_S[bus.family] * 1e6
     reg = bus.table["return_delay_time"]
     return (f"{bus.who(sid)} has a return delay of {us:.0f} µs (return_delay_time = {raw}): "
@@ -69,7 +70,7 @@ def return_delay_warning(bus: SdkBus, sid: int, raw: int) -> str:
             f"= 0 at address {reg.address}, torque off)")
 
 
-def probe_baud(bus: SdkBus, ids: Sequence[int]) -> tuple[int, list[int]] | None:
+def probe_baud(bus: SdkRegisters, ids: Sequence[int]) -> tuple[int, list[int]] | None:
     """The first other standard baud rate at which one of ``ids[:PROBE_IDS]`` answers, with
     the ids that did; the bus is left at its original rate."""
     original = bus.baud
@@ -89,7 +90,7 @@ def probe_baud(bus: SdkBus, ids: Sequence[int]) -> tuple[int, list[int]] | None:
         bus.set_baud(original)
 
 
-def wrong_baud_error(bus: SdkBus, ids: Sequence[int]) -> BusError:
+def wrong_baud_error(bus: SdkRegisters, ids: Sequence[int]) -> BusError:
     """The error for "nothing answers": names the rate that does, if one does."""
     listed = ", ".join(bus.who(i) for i in ids[:4]) + (" ..." if len(ids) > 4 else "")
     probe = probe_baud(bus, ids)
@@ -105,7 +106,7 @@ def wrong_baud_error(bus: SdkBus, ids: Sequence[int]) -> BusError:
                     "the robot config), or set every servo to the configured rate")
 
 
-def check(bus: SdkBus) -> list[str]:
+def check(bus: SdkRegisters) -> list[str]:
     """All health checks for an open bus; returns (and logs) warnings, raises on wrong baud."""
     warnings: list[str] = []
     latency = latency_warning(bus.port_name)
@@ -132,7 +133,7 @@ def check(bus: SdkBus) -> list[str]:
     return warnings
 
 
-def fix_return_delay(bus: SdkBus, ids: Iterable[int]) -> list[int]:
+def fix_return_delay(bus: SdkRegisters, ids: Iterable[int]) -> list[int]:
     """Set return_delay_time to 0 (EEPROM, so torque off first) where it is not; returns the
     ids changed. Feetech EEPROM is unlocked for the write and locked again."""
     changed: list[int] = []

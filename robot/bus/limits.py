@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
-from robot.config.robot_file import RobotConfig
+from robot.bus.servo_map import ServoMap
+from robot.config.robot import RobotConfig
 from robot.errors import BusError
+from robot.servo import ticks as tick_math
 
 
 class TickLimits:
@@ -14,12 +16,10 @@ class TickLimits:
         self.robot = robot
         self.by_id: dict[int, tuple[int, int]] = {}
         if robot is not None:
-            from robot.bus.servo_map import ServoMap
-
             sm = ServoMap(robot)
-            for sid, lo, hi, res in zip(sm.ids, sm.tick_min.tolist(), sm.tick_max.tolist(),
-                                        sm.resolution.tolist(), strict=True):
-                self.by_id[sid] = (max(int(lo), 0), min(int(hi), int(res) - 1))
+            lo, hi = tick_math.accepted_range(sm.tick_min, sm.tick_max, sm.resolution)
+            for sid, a, b in zip(sm.ids, lo.tolist(), hi.tolist(), strict=True):
+                self.by_id[sid] = (int(a), int(b))
 
     def check(self, sid: int, ticks: int) -> int:
         """``ticks`` as an int if allowed for servo ``sid``, else BusError. Hot path: runs

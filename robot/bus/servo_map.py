@@ -13,8 +13,9 @@ from typing import NoReturn
 import numpy as np
 import numpy.typing as npt
 
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import BipedError
+from robot.servo import ticks as tick_math
 
 
 class ServoMap:
@@ -34,11 +35,9 @@ class ServoMap:
         self.q_min = np.array([j.min_rad for j in robot.joints])
         self.q_max = np.array([j.max_rad for j in robot.joints])
         self.max_speed = np.array([j.max_speed_rad_s for j in robot.joints])
-        a = self.zero + self.sign * self.q_min * self.ticks_per_rad
-        b = self.zero + self.sign * self.q_max * self.ticks_per_rad
         # Tick limits: the ticks strictly inside [q_min, q_max] after rounding.
-        self.tick_min = np.ceil(np.minimum(a, b) - 1e-9).astype(np.int64)
-        self.tick_max = np.floor(np.maximum(a, b) + 1e-9).astype(np.int64)
+        self.tick_min, self.tick_max = tick_math.tick_range(self.zero, self.sign, self.ticks_per_rad,
+                                                        self.q_min, self.q_max)
         self._rows = list(zip(self.ids, self.zero.tolist(),
                               (self.sign * self.ticks_per_rad).tolist(),
                               self.tick_min.tolist(), self.tick_max.tolist(), strict=True))
@@ -70,7 +69,7 @@ class ServoMap:
 
     def to_rad(self, ticks: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Ticks → joint angles [rad] (not clamped: a read-back may be outside limits)."""
-        return (np.asarray(ticks, dtype=float) - self.zero) * self.sign / self.ticks_per_rad
+        return tick_math.to_rad(ticks, self.zero, self.sign, self.ticks_per_rad)
 
     def goals(self, q: Sequence[float]) -> dict[int, int]:
         """Joint angles [rad] → ``{servo_id: ticks}`` ready for ``Bus.write_goals``,

@@ -5,17 +5,16 @@ gait exactly."""
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import logging
 from collections.abc import Callable
 
 from robot.balance.stage import Balance, attitude_reader
 from robot.bus.base import Bus
 from robot.commands.common import bounded_float
-from robot.config.robot_file import RobotConfig
-from robot.errors import ConfigError
+from robot.config.robot import RobotConfig
 from robot.gait.engine import GaitEngine
-from robot.imu import Imu, open_imu
+from robot.imu import Imu
+from robot.run.walk import walk_imu
 
 log = logging.getLogger(__name__)
 
@@ -33,24 +32,8 @@ def add_balance_args(p: argparse.ArgumentParser) -> None:
 
 
 def imu_for(args: argparse.Namespace, robot: RobotConfig, bus: Bus) -> Imu | None:
-    """The robot's IMU (not opened) when balance is on, else None."""
-    if args.no_balance or robot.imu is None:
-        if robot.imu is None and not args.no_balance:
-            log.info("%s has no [imu]: walking open loop", robot.name)
-        return None
-    config = robot.imu
-    if config.kind == "sim" and bus.kind != "sim":
-        # The bundled robots simulate their IMU: on real servos there is none to read.
-        log.warning("%s: imu.kind is \"sim\", which only exists in simulation: walking open "
-                    "loop on the %s bus (set [imu] kind to your device, docs/imu.md)",
-                    robot.source, bus.kind)
-        return None
-    if args.imu_noise is not None:
-        if config.kind != "sim":
-            raise ConfigError(f"--imu-noise applies to a simulated IMU; {robot.source}: "
-                              f"imu.kind is {config.kind!r}")
-        config = dataclasses.replace(config, noise=args.imu_noise, bias=args.imu_noise)
-    return open_imu(config, bus=bus)
+    """The robot's IMU (not opened) when balance is on, else None (robot.run.walk)."""
+    return walk_imu(robot, bus, balance=not args.no_balance, noise=args.imu_noise)
 
 
 def feedback_factory(imu: Imu | None) -> Callable[[GaitEngine], Balance | None] | None:

@@ -26,7 +26,7 @@ from robot.commands.common import (
     output_file,
     robot_from,
 )
-from robot.config.robot_file import JointConfig, RobotConfig
+from robot.config.robot import JointConfig, RobotConfig
 from robot.config.toml_edit import same_path, write_validated
 from robot.errors import ConfigError
 from robot.setup.calibration import (

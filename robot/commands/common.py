@@ -16,21 +16,12 @@ from typing import Any, NoReturn, TypeVar
 
 from robot.bus.base import Bus
 from robot.bus.factory import make_bus
-from robot.config.bundled import user_gaits_dir
+from robot.config.bundled import DEFAULT_GAIT, DEFAULT_ROBOT_NAME, gait_names, robot_names, user_gaits_dir
 from robot.config.checks import standard_bauds
+from robot.config.gait_file import Gait, load_gait
 from robot.config.params import GaitParams
-from robot.config.robot_file import (
-    DEFAULT_GAIT,
-    DEFAULT_ROBOT_NAME,
-    SERVO_ID,
-    SPEED,
-    Gait,
-    RobotConfig,
-    gait_names,
-    load_gait,
-    load_robot,
-    robot_names,
-)
+from robot.config.robot import SERVO_ID, SPEED, RobotConfig
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 
 T = TypeVar("T")

@@ -25,7 +25,8 @@ from robot.commands.common import (
     robot_from,
     seconds,
 )
-from robot.config.robot_file import DEFAULT_ROBOT_NAME, load_robot
+from robot.config.bundled import DEFAULT_ROBOT_NAME
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.motion.takes import SUFFIX, is_take, read_take

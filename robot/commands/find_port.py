@@ -4,8 +4,6 @@ Without options: list the adapters, ask you to unplug the robot's USB adapter (E
 again (the one that went away is the robot's), ask you to plug it back in (Enter) and print
 the name it came back under, which is the one to pass as ``--port``. ``--list`` only lists.
 ``--json``: one JSON value on stdout (the list, or the found port); prompts go to stderr.
-
-Test hook: ``BIPED_FAKE_PORTS`` (see ``robot.setup.serial_ports``) replaces the real device list.
 """
 
 from __future__ import annotations
@@ -24,7 +22,7 @@ from robot.setup.serial_ports import (
     PortSearchError,
     SerialPort,
     added_port,
-    lister_from_env,
+    list_ports,
     removed_port,
 )
 
@@ -78,9 +76,9 @@ def _settled(lister: PortLister, before: list[SerialPort],
 
 def run(args: argparse.Namespace, *, lister: PortLister | None = None,
         read_line: Callable[[], str] | None = None, settle_s: float = SETTLE_S) -> int:
-    """``lister`` (default: ``$BIPED_FAKE_PORTS`` or pyserial) lists the ports;
-    ``read_line`` (default: stdin) waits for Enter and returns '' at end of input."""
-    lister = lister or lister_from_env()
+    """``lister`` (default: pyserial's ``list_ports``) lists the ports; ``read_line``
+    (default: stdin) waits for Enter and returns '' at end of input."""
+    lister = lister or list_ports
     read_line = read_line or sys.stdin.readline
     ports = lister()
     if args.list:

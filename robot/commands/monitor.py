@@ -28,7 +28,7 @@ from robot.commands.common import (
     robot_from,
 )
 from robot.commands.signals import SignalLatch, stop_on_signals
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import BusError
 from robot.setup.monitor_table import format_table, rows
 

@@ -15,8 +15,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from robot.bus.servo_map import ServoMap
-from robot.commands.balance_args import add_balance_args, balance_for, imu_for
+from robot.commands.balance_args import add_balance_args, imu_for
 from robot.commands.common import (
     add_bus_args,
     bus_from,
@@ -27,16 +26,18 @@ from robot.commands.common import (
     rate_hz,
     seconds,
 )
-from robot.commands.signals import SignalLatch, stop_on_signals
-from robot.config.robot_file import DEFAULT_GAIT, RobotConfig, load_robot
+from robot.config.bundled import DEFAULT_GAIT
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.loop.recorder import Recorder
-from robot.loop.streamer import LoopStats, Streamer
 from robot.motion.keyframes import SUFFIXES, load_sequence, parse_sequence
 from robot.motion.layered import LayeredEngine
 from robot.motion.scripted import PlaybackEngine
 from robot.motion.takes import SUFFIX, Take, TakeHeader, TakeWriter, is_take, read_take
+from robot.run.run import Run
+from robot.run.spec import RunOptions, RunSpec
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
@@ -123,29 +124,18 @@ def run(args: argparse.Namespace) -> int:
     if args.record:
         writer = (TakeWriter(args.record, header) if is_take(args.record)
                   else Recorder(args.record, robot.joint_names, robot.ids))
-        writer.open()
+    spec = RunSpec(robot=robot, source=engine, bus=bus, imu=imu, recorder=writer,
+                   options=RunOptions(rate_hz=rate, read_every=read_every, hold=args.hold,
+                                      seconds=limit, signals=True, watch=False))
+    playing = Run(spec)
+    with playing:
         if isinstance(writer, TakeWriter) and isinstance(engine, PlaybackEngine):
             for k, step in sorted(take.changes.items()):
                 writer.event(k, set=dict(step))
             writer.event(stop, stop=True)
-    latch = SignalLatch()
-    stats: LoopStats | None = None
-    try:
-        bus.open()
-        if imu is not None:
-            imu.open()
-        streamer = Streamer(ServoMap(robot), bus, engine, rate_hz=rate,
-                            read_every=read_every, hold_at_end=args.hold, observer=writer,
-                            feedback=balance_for(imu, engine))
-        with stop_on_signals(streamer, latch):
-            stats = streamer.run(seconds=limit)
-    finally:
-        bus.close(torque_off=False)  # the streamer left the servos as the end requires
-        if imu is not None:
-            imu.close()
-        record_error = writer.close_quietly() if writer is not None else None
-    assert stats is not None
-    code = latch.exit_code(stats) or (1 if record_error else 0)
+        playing.stream()
+    done = playing.result
+    stats, record_error, code = done.stats, done.record_error, done.exit_code
     result = {"file": args.file, "robot": robot.name, "bus": kind, "ticks": stats.ticks,
               "rate_hz": rate, "gait_seconds": engine.time, "overruns": stats.overruns,
               "stop_reason": stats.stop_reason, "fault": stats.fault,

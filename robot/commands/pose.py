@@ -1,6 +1,6 @@
 """`biped pose rest|zero`: ramp smoothly from where the robot is to a named pose, then hold.
 
-Runs the one streaming loop (``Streamer.move_to``): reads the present pose, refuses to start
+Runs the one streaming loop (``Streamer.run`` of a ``PoseMove``): reads the present pose, refuses to start
 if a joint is outside its limits, sets goal := present and torque on (no snap to a stale
 goal), then a minimum-jerk ramp at a fixed rate on absolute deadlines, clamped and
 slew-limited, with the watchdog. Torque stays ON at the end. Ctrl-C (or SIGTERM) stops the
@@ -25,10 +25,9 @@ from robot.commands.common import (
     robot_from,
 )
 from robot.commands.signals import SignalLatch, stop_on_signals
-from robot.config.params import GaitParams
-from robot.config.robot_file import RobotConfig
-from robot.gait.engine import GaitEngine
+from robot.config.robot import RobotConfig
 from robot.loop.streamer import LoopStats, Streamer
+from robot.motion.posing import PoseMove
 
 log = logging.getLogger(__name__)
 
@@ -57,8 +56,8 @@ def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
     sm = ServoMap(robot)
     bus = bus_from(args, robot)
-    streamer = Streamer(sm, bus, GaitEngine(robot, GaitParams()), rate_hz=args.rate,
-                        hold_at_end=True)
+    move = PoseMove(robot, pose_target(robot, args.pose, sm), max_speed=args.speed)
+    streamer = Streamer(sm, bus, move, rate_hz=args.rate, hold_at_end=True)
     latch = SignalLatch()
     stats: LoopStats | None = None
     try:
@@ -66,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"torque ON; ramping to {args.pose} (peak {args.speed:g} rad/s, "
               f"{args.rate:g} Hz)", flush=True)
         with stop_on_signals(streamer, latch):
-            stats = streamer.move_to(pose_target(robot, args.pose, sm), max_speed=args.speed)
+            stats = streamer.run()
     finally:
         bus.close(torque_off=False)  # the streamer has left torque as its end requires
     if stats.fault or stats.estop:

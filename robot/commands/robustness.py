@@ -67,9 +67,8 @@ def run(args: argparse.Namespace) -> int:
             print(f"[{done[0]:3d}/{total}] {o.condition.name:<34} "
                   f"{'balance' if o.balance else 'open loop':<9} {state}"
                   + (f": {o.error}" if o.error else ""), file=sys.stderr, flush=True)
-    base = tuple(a for item in args.set for a in ("--set", item))
-    outcomes = run_suite(args.robot, args.gait, conds, seconds=secs, balance_modes=modes,
-                         jobs=args.jobs, progress=progress, base_args=base)
+    outcomes = run_suite(args.robot, gait.name, params, conds, seconds=secs,
+                         balance_modes=modes, jobs=args.jobs, progress=progress)
     wall = time.perf_counter() - wall0
     table = survival_table(outcomes)
     if args.out:

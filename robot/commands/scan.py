@@ -10,7 +10,9 @@ from robot.bus import health
 from robot.bus.base import ServoInfo
 from robot.bus.sdk_bus import SdkBus
 from robot.commands.common import HARDWARE_BUSES, add_bus_args, bus_from, id_list, one_line_errors
-from robot.config.robot_file import DEFAULT_ROBOT, ROBOTS_DIR, RobotConfig, load_robot
+from robot.config.bundled import DEFAULT_ROBOT, ROBOTS_DIR
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from robot.errors import BusError
 
 log = logging.getLogger(__name__)

@@ -16,10 +16,10 @@ from robot.bus.dynamixel import DynamixelBus
 from robot.bus.dynamixel1 import Dynamixel1Bus
 from robot.bus.feetech import FeetechBus
 from robot.bus.sdk_bus import SdkBus
-from robot.bus.tables import BUS_FAMILIES
 from robot.commands.common import HARDWARE_BUSES, add_robot_args, one_line_errors, robot_from
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
+from robot.servo.models import BUS_FAMILIES
 from robot.setup.motor_setup import (
     FACTORY_BAUD,
     answered,

@@ -1,6 +1,6 @@
 """`biped torque on|off`: enable torque holding the present position, or release it.
 
-`on` runs the streamer's start (``Streamer.move_to`` the present pose): it refuses, with
+`on` runs the streamer's start (a ``PoseMove`` to the present pose): it refuses, with
 torque untouched, if a joint is outside its limits, sets goal := present, then torque on.
 """
 
@@ -16,9 +16,8 @@ from robot.commands.common import (
     one_line_errors,
     robot_from,
 )
-from robot.config.params import GaitParams
-from robot.gait.engine import GaitEngine
 from robot.loop.streamer import Streamer
+from robot.motion.posing import PoseMove
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -40,8 +39,8 @@ def run(args: argparse.Namespace) -> int:
             print(f"torque OFF on {len(robot.ids)} servos: the robot is limp, support it")
             return 0
         sm = ServoMap(robot)
-        streamer = Streamer(sm, bus, GaitEngine(robot, GaitParams()), hold_at_end=True)
-        stats = streamer.move_to(sm.from_positions(bus.read_positions(sm.ids)))
+        here = PoseMove(robot, sm.from_positions(bus.read_positions(sm.ids)))
+        stats = Streamer(sm, bus, here, hold_at_end=True).run()
         if stats.fault or not stats.holding:
             print(f"stopped: {stats.stop_reason}; torque OFF")
             return 1

@@ -6,12 +6,9 @@ from __future__ import annotations
 import argparse
 import json
 import logging
-import time
-from collections.abc import Callable
 from typing import Any
 
-from robot.bus.servo_map import ServoMap
-from robot.commands.balance_args import add_balance_args, balance_for, imu_for
+from robot.commands.balance_args import add_balance_args, imu_for
 from robot.commands.common import (
     add_bus_args,
     add_robot_args,
@@ -25,16 +22,12 @@ from robot.commands.common import (
     robot_from,
     seconds,
 )
-from robot.commands.signals import SignalLatch, stop_on_signals
-from robot.commands.world_args import add_world_args, describe_world, world_from, world_summary
+from robot.commands.world_args import add_world_args, describe_world, world_from
 from robot.errors import ConfigError
-from robot.gait.engine import GaitEngine
-from robot.loop.recorder import Recorder
-from robot.loop.streamer import LoopStats, Streamer, Telemetry
 from robot.motion.keyframes import load_sequence
-from robot.motion.layered import LayeredEngine
-from robot.motion.scripted import RecordingEngine
-from robot.motion.takes import TakeHeader, TakeWriter, is_take
+from robot.run.run import execute
+from robot.run.spec import RunOptions
+from robot.run.walk import walk_spec, walk_summary
 
 log = logging.getLogger(__name__)
 
@@ -87,98 +80,16 @@ def run(args: argparse.Namespace) -> int:
     bus = bus_from(args, robot, kind=kind, **options)
     imu = imu_for(args, robot, bus)
     layer = load_sequence(args.keyframes, robot) if args.keyframes else None
-    recorder: Recorder | TakeWriter | None = None
-    engine: GaitEngine
-    if args.record and is_take(args.record):
-        recorder = TakeWriter(args.record, TakeHeader(
-            robot=robot.name, robot_file=robot.source, joints=robot.joint_names,
-            rate_hz=args.rate, read_every=args.read_every, gait=gait.name, params=params,
-            bus=kind, balance=imu is not None,
-            keyframes=layer.as_json() if layer else None))
-        engine = RecordingEngine(robot, params, sink=recorder.event, keyframes=layer)
-    else:
-        if args.record:
-            recorder = Recorder(args.record, robot.joint_names, robot.ids)
-        engine = LayeredEngine(robot, params, keyframes=layer) if layer else \
-            GaitEngine(robot, params)
-    smap = ServoMap(robot)
-    monitor = None
-    effort: Any = None
-    pushes = None
-    observers: list[Callable[[Telemetry], None]] = []
-    if recorder is not None:
-        observers.append(recorder.open())    # an unwritable path fails before the bus opens
-    latch = SignalLatch()
-    stats: LoopStats | None = None
-    wall0 = time.perf_counter()
-    try:
-        bus.open()
-        if kind == "sim":
-            from sim.mujoco.effort import EffortMonitor
-            from sim.mujoco.metrics import WalkMonitor
-
-            sim_bus: Any = bus
-            monitor = WalkMonitor(standing_height=sim_bus.standing_height,
-                                  floor_normal=sim_bus.floor_normal)
-            effort = EffortMonitor(sim_bus.model, sim_bus.data, robot)
-            qpos = sim_bus.data.qpos
-
-            def watch(tel: Telemetry) -> None:
-                monitor.update_qpos(tel.t, qpos[:7].tolist())
-                effort.update(tel.t)
-                if monitor.fell and args.stop_on_fall:
-                    streamer.emergency_stop("fell")
-            observers.insert(0, watch)
-            if world is not None and world.pushes:
-                from sim.mujoco.world import PushScheduler
-
-                pushes = PushScheduler(sim_bus, world.pushes)
-                observers.insert(1, pushes)
-
-        def observe(tel: Telemetry) -> None:
-            for o in observers:
-                o(tel)
-        if imu is not None:
-            imu.open()
-        streamer = Streamer(smap, bus, engine, rate_hz=args.rate, read_every=args.read_every,
-                            hold_at_end=args.hold, observer=observe,
-                            feedback=balance_for(imu, engine))
-        with stop_on_signals(streamer, latch):
-            stats = streamer.run(seconds=args.seconds)
-    finally:
-        # The streamer has already left the servos as its end requires (holding, or torque
-        # off); a refused start left them untouched. Closing must not undo either.
-        bus.close(torque_off=False)
-        if imu is not None:
-            imu.close()
-        record_error = recorder.close_quietly() if recorder is not None else None
-    assert stats is not None
-    wall = time.perf_counter() - wall0
-    result: dict[str, Any] = {"robot": robot.name, "gait": gait.name, "bus": kind,
-                              "seconds": args.seconds, "balance": imu is not None}
-    if monitor is not None:
-        result.update(monitor.summary(args.seconds))
-        result.update(effort.summary(result["distance_m"]))
-        result["world"] = world_summary(world, pushes)
-    result.update({
-        "ticks": stats.ticks, "rate_hz": stats.rate_hz, "achieved_hz": stats.achieved_hz,
-        "period_error_p50_ms": stats.period_error_p50_ms,
-        "period_error_p99_ms": stats.period_error_p99_ms,
-        "period_error_max_ms": stats.period_error_max_ms,
-        "overruns": stats.overruns, "bus_errors": stats.bus_errors,
-        "realtime_factor": stats.duration_s / wall if wall > 0 else 0.0,
-        "stop_reason": stats.stop_reason, "fault": stats.fault, "holding": stats.holding,
-    })
-    code = latch.exit_code(stats)
-    if record_error is not None:
-        result["record_error"] = record_error
-        code = code or 1
-    result["exit_code"] = code
+    spec = walk_spec(robot, params, bus, gait=gait.name, imu=imu, keyframes=layer,
+                     record=args.record, options=RunOptions(
+                         rate_hz=args.rate, read_every=args.read_every, hold=args.hold,
+                         seconds=args.seconds, stop_on_fall=args.stop_on_fall, signals=True))
+    result = walk_summary(spec, execute(spec), gait=gait.name)
     if args.json:
         print(json.dumps(result))
     else:
         print(format_summary(result))
-    return code
+    return int(result["exit_code"])
 
 
 def format_summary(r: dict[str, Any]) -> str:

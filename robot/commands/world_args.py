@@ -1,7 +1,7 @@
 """`biped walk` perturbation options (sim only): slope, bumps, pushes, latency, friction,
 mass. Parsed and range-checked here at parse time (one line, exit 2); turned into a
-``sim.mujoco.world.World`` by ``world_from`` (sim imported lazily, robot/ never imports sim at
-module level). Units and sign conventions: ``sim.mujoco.world`` and docs/robustness.md."""
+``robot.config.world.World`` by ``world_from``. Units and sign conventions:
+``robot.config.world`` and docs/robustness.md."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import argparse
 from typing import Any
 
 from robot.commands.common import bounded_float, bounded_int
+from robot.config.world import MS, Push, World
 from robot.config.world_ranges import RANGES
 from robot.errors import ConfigError
 
@@ -19,8 +20,6 @@ DEFAULTS: dict[str, tuple[str, Any]] = {
     "--latency": ("latency", 0.0), "--friction": ("friction", 1.0),
     "--mass-scale": ("mass_scale", 1.0),
 }
-MS = 1e-3  # [s/ms]
-
 
 def _float(key: str, what: str) -> Any:
     r = RANGES[key]
@@ -75,32 +74,19 @@ def given(args: argparse.Namespace) -> list[str]:
             if getattr(args, dest, default) != default]
 
 
-def world_from(args: argparse.Namespace, kind: str) -> Any:
-    """The ``sim.mujoco.world.World`` of the options, None if none is given; ConfigError (nothing
+def world_from(args: argparse.Namespace, kind: str) -> World | None:
+    """The ``robot.config.world.World`` of the options, None if none is given; ConfigError (nothing
     opened) if one is given for a bus other than sim."""
     options = given(args)
     if not options:
         return None
     if kind != "sim":
         raise ConfigError(f"{options[0]} applies to --bus sim only, not --bus {kind}")
-    from sim.mujoco.world import Push, World
-
     return World(slope_deg=args.slope, cross_slope_deg=args.cross_slope,
                  bumps_mm=args.bumps, terrain_seed=args.terrain_seed,
                  pushes=tuple(Push(t, jx, jy) for t, jx, jy in args.push),
                  latency_s=args.latency * MS, friction_scale=args.friction,
                  mass_scale=args.mass_scale)
-
-
-def world_summary(world: Any, pushes: Any = None) -> dict[str, Any]:
-    """The "world" object of the JSON summary: ``sim.mujoco.world.World.as_dict()`` (the defaults
-    when ``world`` is None) and each applied push with its sim start time
-    (``PushScheduler.as_list()``)."""
-    from sim.mujoco.world import World
-
-    out: dict[str, Any] = (world or World()).as_dict()
-    out["pushes_applied"] = [] if pushes is None else pushes.as_list()
-    return out
 
 
 def describe_world(w: dict[str, Any] | None) -> str | None:

@@ -1,25 +1,27 @@
 """Checks of a robot config that need more than one field: the bus settings of a servo
 family, and joint limits that must map onto ticks the bus accepts.
 
-The tick check uses ``ServoMap`` and ``TickLimits`` themselves, so "the config loads" and
-"every goal the map can produce is one the bus accepts" cannot drift apart.
+The tick check computes with the tick arithmetic that ``ServoMap`` and ``TickLimits`` use
+(robot/servo/ticks.py), so "the config loads" and "every goal the map can produce is one the
+bus accepts" cannot drift apart.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robot.bus.tables import BAUD_CODES, BUS_FAMILIES, MODELS
 from robot.config.joint_names import ARM_NAMES, EXTRA_NAME, HIP_YAW_NAMES, JOINT_NAMES, LEG_NAMES
-from robot.config.toml_io import show
+from robot.config.toml_io import TomlValue, show
 from robot.errors import ConfigError
+from robot.servo import ticks as tick_math
+from robot.servo.models import BAUD_CODES, BUS_FAMILIES, MODELS
 
 if TYPE_CHECKING:
-    from robot.config.robot_file import BusConfig, JointConfig, RobotConfig
+    from robot.config.robot import BusConfig, JointConfig, RobotConfig
 
 #: Decimal places of the radian ranges printed in messages (rounded inward, so a value
 #: copied from the message fits).
@@ -53,26 +55,32 @@ def _inward(lo: float, hi: float) -> tuple[float, float]:
 
 
 def check_ticks(robot: RobotConfig) -> None:
-    """Every joint's [min_rad, max_rad] maps (after ServoMap's rounding) onto a non-empty
-    tick range that the bus's TickLimits accept whole; else ConfigError naming the joint's
-    field and the radian range that fits its zero_ticks and sign."""
-    from robot.bus.limits import TickLimits
-    from robot.bus.servo_map import ServoMap
-
-    sm = ServoMap(robot)
-    allowed = TickLimits(robot).by_id
-    n = len(robot.joints)
-    q_at_0, q_at_top = sm.to_rad(np.zeros(n)), sm.to_rad(sm.resolution - 1.0)
+    """Every joint's [min_rad, max_rad] maps (after the servo map's rounding,
+    robot/servo/ticks.py) onto a non-empty tick range that the bus's limits accept whole;
+    else ConfigError naming the joint's field and the radian range that fits its zero_ticks
+    and sign."""
+    joints = robot.joints
+    servos = [robot.servo(j) for j in joints]
+    resolution = np.array([m.resolution for m in servos], dtype=float)
+    per_rad = np.array([m.ticks_per_rad for m in servos])
+    sign = np.array([j.sign for j in joints], dtype=float)
+    zero = np.array([j.zero_ticks for j in joints], dtype=float)
+    tick_min, tick_max = tick_math.tick_range(zero, sign, per_rad,
+                                              np.array([j.min_rad for j in joints]),
+                                              np.array([j.max_rad for j in joints]))
+    ok_min, ok_max = tick_math.accepted_range(tick_min, tick_max, resolution)
+    q_at_0 = tick_math.to_rad(np.zeros(len(joints)), zero, sign, per_rad)
+    q_at_top = tick_math.to_rad(resolution - 1.0, zero, sign, per_rad)
     for i, j in enumerate(robot.joints):
-        res = int(sm.resolution[i])
-        lo, hi = int(sm.tick_min[i]), int(sm.tick_max[i])
-        if lo <= hi and allowed[j.servo_id] == (lo, hi):
+        res = int(resolution[i])
+        lo, hi = int(tick_min[i]), int(tick_max[i])
+        if lo <= hi and (int(ok_min[i]), int(ok_max[i])) == (lo, hi):
             continue
         jp = f"joints.{j.name}"
         if lo > hi:
             raise ConfigError(f"{robot.source}: {jp}.min_rad/max_rad: [{j.min_rad:g}, "
                               f"{j.max_rad:g}] rad holds no whole servo tick; expected limits "
-                              f"at least one tick ({1 / sm.ticks_per_rad[i]:.5f} rad) apart")
+                              f"at least one tick ({1 / per_rad[i]:.5f} rad) apart")
         ends = sorted((float(q_at_0[i]), float(q_at_top[i])))
         fit_lo, fit_hi = _inward(max(ends[0], -math.pi), min(ends[1], math.pi))
         # The low tick end is min_rad's for sign +1, max_rad's for sign -1.
@@ -90,7 +98,7 @@ def check_ticks(robot: RobotConfig) -> None:
             "or another zero_ticks")
 
 
-def check_joint_set(src: str, jtab: Mapping[str, Any]) -> None:
+def check_joint_set(src: str, jtab: Mapping[str, TomlValue]) -> None:
     """Every leg joint (hip yaw on both sides or neither), all arm joints or none; any
     other name is an extra joint and needs ``fixed_rad``."""
     for name, entry in jtab.items():

@@ -8,15 +8,15 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from robot.config.bundled import DEFAULT_GAIT, resolve_gait_path
 from robot.config.params import SPECS, GaitParams, canonical_name, check_value
-from robot.config.toml_io import read_toml, show, table
+from robot.config.toml_io import TomlValue, read_toml, show, table
 from robot.errors import ConfigError
 
 if TYPE_CHECKING:
-    from robot.config.robot_file import RobotConfig
+    from robot.config.robot import RobotConfig
 
 
 @dataclass(frozen=True)
@@ -43,7 +43,9 @@ def load_gait(name_or_path: str | Path | None = None) -> Gait:
     return parse_gait(read_toml(p), source=str(p))
 
 
-def parse_gait(data: Mapping[str, Any], *, source: str = "<memory>") -> Gait:
+def parse_gait(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> Gait:
+    """A validated gait preset from a gait file's table (ConfigError, one line, on any
+    problem)."""
     src = source
     allowed = {"name", "fps", "description", "params", "mapping"}
     unknown = sorted(set(data) - allowed)

@@ -16,7 +16,8 @@ from pathlib import Path
 import tomlkit
 from tomlkit.exceptions import TOMLKitError
 
-from robot.config.robot_file import RobotConfig, parse_robot
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import parse_robot
 from robot.errors import ConfigError
 
 EDITABLE = ("sign", "zero_ticks", "min_rad", "max_rad")

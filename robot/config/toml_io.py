@@ -14,10 +14,24 @@ import sys
 import tomllib
 from collections.abc import Mapping
 from dataclasses import MISSING, fields
+from datetime import date, datetime, time
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Literal, NamedTuple, TypeAlias, TypeVar, overload
 
 from robot.errors import ConfigError
+
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
+#: A value as ``tomllib`` returns it (offset-aware and local date-times, dates, times).
+TomlValue: TypeAlias = (str | int | float | bool | datetime | date | time | list["TomlValue"]
+                        | dict[str, "TomlValue"])
+#: A TOML table (a whole file is one).
+TomlTable: TypeAlias = dict[str, TomlValue]
+#: A value as ``json.loads`` returns it.
+JsonValue: TypeAlias = None | str | int | float | bool | list["JsonValue"] | dict[str, "JsonValue"]
+#: A dataclass that ``build`` fills from a table.
+D = TypeVar("D", bound="DataclassInstance")
 
 #: Largest TOML file read [bytes]: a robot file is ~5 KiB; anything near this is not one.
 MAX_TOML_BYTES = 1 << 20
@@ -46,7 +60,7 @@ def spec(valid: Range) -> dict[str, Range]:
     return {"range": valid}
 
 
-def show(value: Any) -> str:
+def show(value: object) -> str:
     """``repr(value)``, abbreviated when long (a 400-digit integer stays readable)."""
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10 ** MAX_SHOWN:
         digits = math.floor(math.log10(abs(value))) + 1
@@ -55,7 +69,7 @@ def show(value: Any) -> str:
     return text if len(text) <= MAX_SHOWN else text[:MAX_SHOWN] + "..."
 
 
-def read_toml(path: Path) -> dict[str, Any]:
+def read_toml(path: Path) -> TomlTable:
     """Parse the TOML file ``path``; ConfigError (one line naming the file) if it is missing,
     not a regular file, unreadable, over MAX_TOML_BYTES, not UTF-8 or not valid TOML."""
     try:
@@ -92,14 +106,24 @@ def read_toml(path: Path) -> dict[str, Any]:
         raise ConfigError(f"{path}: not valid TOML: arrays or tables nested too deeply") from None
 
 
-def number(src: str, path: str, value: Any, valid: Range | None = None, *,
-           integer: bool = False) -> Any:
+@overload
+def number(src: str, path: str, value: object, valid: Range | None = None, *,
+           integer: Literal[False] = False) -> float: ...
+
+
+@overload
+def number(src: str, path: str, value: object, valid: Range | None = None, *,
+           integer: Literal[True]) -> int: ...
+
+
+def number(src: str, path: str, value: object, valid: Range | None = None, *,
+           integer: bool = False) -> int | float:
     """``value`` checked to be a finite number (an integer if ``integer``) inside ``valid``;
     returned as int or float."""
     kind = "an integer" if integer else "a number"
-    ok_type = isinstance(value, int) if integer else isinstance(value, (int, float))
     where = f" in {valid}" if valid else ""
-    if isinstance(value, bool) or not ok_type:
+    if isinstance(value, bool) or not isinstance(value, int | float) or (
+            integer and isinstance(value, float)):
         raise ConfigError(f"{src}: {path}: expected {kind}{where}, got {show(value)}")
     if isinstance(value, float) and not math.isfinite(value):
         raise ConfigError(f"{src}: {path}: expected a finite number{where}, got {show(value)}")
@@ -114,38 +138,41 @@ def number(src: str, path: str, value: Any, valid: Range | None = None, *,
         raise ConfigError(f"{src}: {path}: expected a finite number, got {show(value)}") from None
 
 
-def table(src: str, path: str, value: Any) -> dict[str, Any]:
+def table(src: str, path: str, value: TomlValue) -> TomlTable:
+    """``value`` checked to be a table."""
     if not isinstance(value, dict):
         raise ConfigError(f"{src}: {path}: expected a table, got {show(value)}")
     return value
 
 
-def build(cls: Any, src: str, path: str, data: Any, *,
-          overrides: Mapping[str, Any] | None = None) -> Any:
+def build(cls: type[D], src: str, path: str, data: TomlValue, *,
+          overrides: Mapping[str, object] | None = None) -> D:
     """Build a flat dataclass of numbers/strings from a TOML table, checking every field
-    (numbers against the ``Range`` in the field's metadata, if any)."""
+    (numbers against the ``Range`` in the field's metadata, if any); ``overrides``: fields
+    set by the caller, not the file."""
     overrides = overrides or {}
-    data = table(src, path, data)
+    tab = table(src, path, data)
     names = [f.name for f in fields(cls) if f.name not in overrides]
-    unknown = sorted(set(data) - set(names))
+    unknown = sorted(set(tab) - set(names))
     if unknown:
         raise ConfigError(f"{src}: {path}.{unknown[0]}: unknown key; valid: {', '.join(names)}")
-    kwargs: dict[str, Any] = dict(overrides)
+    kwargs: dict[str, object] = dict(overrides)
     for f in fields(cls):
         if f.name in overrides:
             continue
         fpath = f"{path}.{f.name}"
-        if f.name not in data:
+        if f.name not in tab:
             if f.default is not MISSING:
                 continue
             raise ConfigError(f"{src}: {fpath}: missing (expected {f.type})")
-        v = data[f.name]
+        v = tab[f.name]
         kind = f.type.removesuffix(" | None") if isinstance(f.type, str) else f.type
         if kind in ("str", str):
             if not isinstance(v, str) or not v:
                 raise ConfigError(f"{src}: {fpath}: expected a non-empty string, got {show(v)}")
             kwargs[f.name] = v
+        elif kind in ("int", int):
+            kwargs[f.name] = number(src, fpath, v, f.metadata.get("range"), integer=True)
         else:
-            kwargs[f.name] = number(src, fpath, v, f.metadata.get("range"),
-                                    integer=kind in ("int", int))
+            kwargs[f.name] = number(src, fpath, v, f.metadata.get("range"))
     return cls(**kwargs)

@@ -1,8 +1,9 @@
 """Gait engine: params + phase + envelope → channels → targets → IK → joint angles.
 
-Pure (no I/O). ``tick(dt)`` serves the control loop on floats; ``curves(times)`` serves
-previs on numpy arrays. Joint angles come out in ``robot.joints`` order, clamped to the
-joint limits; unreachable targets are clamped by the IK and counted, never NaN.
+Pure (no I/O). ``tick(dt)`` serves the control loop on floats (the engine is a motion
+source, robot.loop.source); ``curves(times)`` serves previs on numpy arrays. Joint angles
+come out in ``robot.joints`` order, clamped to the joint limits; unreachable targets are
+clamped by the IK and counted, never NaN.
 """
 
 from __future__ import annotations
@@ -11,13 +12,13 @@ import dataclasses
 import logging
 import math
 from collections.abc import Mapping
-from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
+from robot.config.joint_names import JOINT_NAMES
 from robot.config.params import SPECS, GaitParams
-from robot.config.robot_file import JOINT_NAMES, RobotConfig
+from robot.config.robot import RobotConfig
 from robot.gait import expressions as gait
 from robot.gait import vectorised
 from robot.gait.targets import NO_TRIM, BodyTrim, body_targets
@@ -115,7 +116,8 @@ class GaitEngine:
     def params(self) -> GaitParams:
         return self._params
 
-    def set_params(self, changes: Mapping[str, Any], *, where: str = "parameter") -> GaitParams:
+    def set_params(self, changes: Mapping[str, float], *, where: str = "parameter"
+                   ) -> GaitParams:
         """Validate and apply ``changes``; on error nothing changes (ConfigError)."""
         self.replace_params(self._params.replace(changes, where=where))
         return self._params
@@ -174,6 +176,22 @@ class GaitEngine:
     @property
     def running(self) -> bool:
         return self._running
+
+    # -- motion source (robot.loop.source) ----------------------------------------------
+    def entry(self, present: npt.NDArray[np.float64], dt: float) -> list[float]:
+        """Where a walk starts, whatever the present pose: ``start_pose()`` [rad]."""
+        return self.start_pose()
+
+    def exit_pose(self) -> npt.NDArray[np.float64]:
+        """Where a walk ends: the robot's rest pose (a joint it does not name: 0) [rad]."""
+        rest = self.robot.rest
+        return np.array([rest.get(n, 0.0) for n in self.robot.joint_names], dtype=float)
+
+    @property
+    def state(self) -> str:
+        """The loop's state while this engine drives it: "walking", or "ramp_out" after
+        ``stop()``."""
+        return "walking" if self._running else "ramp_out"
 
     # -- evaluation -------------------------------------------------------------------
     def pose(self, *, amplitude: float | None = None) -> list[float]:

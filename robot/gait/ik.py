@@ -21,7 +21,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from robot.config.robot_file import Geometry
+from robot.config.robot import Geometry
 from robot.gait import xmath as xm
 from robot.gait.xmath import Num, Rot, Vec
 

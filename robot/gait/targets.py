@@ -26,7 +26,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 from robot.config.params import SPECS, GaitParams
-from robot.config.robot_file import Geometry
+from robot.config.robot import Geometry
 from robot.gait import xmath as xm
 from robot.gait.xmath import Num, Rot, Vec
 

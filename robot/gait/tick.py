@@ -19,7 +19,7 @@ from math import atan2, cos, sin, sqrt
 from typing import NamedTuple
 
 from robot.config.params import GaitParams
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.gait import xmath as xm
 from robot.gait.expressions import FTAU_ALPHA, FTAU_DIVISOR, J_ERROR_STZ_IK, Phase
 from robot.gait.ik import REACH_TOL, SIDE_SIGN

@@ -24,7 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.config.params import GaitParams
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.gait import expressions as gait
 from robot.gait.ik import arm_ik, leg_ik
 from robot.gait.targets import BodyTargets, body_targets

@@ -21,6 +21,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from robot.config.imu_file import ImuConfig
 from robot.imu.base import Imu, ImuError, ImuSample, Quat
 from robot.imu.bno055_tables import (
     CHIP_ID,
@@ -29,7 +30,7 @@ from robot.imu.bno055_tables import (
     UART_STATUS,
     UART_STATUS_FIX,
 )
-from robot.imu.config import ImuConfig
+from robot.imu.frames import Mount
 
 #: pyserial's own timeouts: the library reads only what has arrived, so these only bound
 #: a write to a stuck adapter [s].
@@ -80,7 +81,7 @@ class Bno055Imu(Imu):
                  clock: Callable[[], float] = time.monotonic) -> None:
         self.config = config
         self.port = config.port
-        self._mount = config.mount
+        self._mount = Mount.from_rpy_deg(config.mount_rpy_deg)
         self._clock = clock
         self._serial: Any = None
         self._sensor: Any = None

@@ -9,35 +9,15 @@ So ``robot/`` never imports ``sim/``.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import TYPE_CHECKING
 
+from robot.config.imu_file import ENTRY_POINT_GROUP, ImuConfig, imu_kinds
 from robot.errors import ConfigError
 from robot.imu.base import Imu
-from robot.imu.registry import Registry
+from robot.imu.kinds import plugin
 
 if TYPE_CHECKING:
     from robot.bus.base import Bus
-    from robot.imu.config import ImuConfig
-
-#: Entry-point group where IMU plugins are declared.
-ENTRY_POINT_GROUP = "biped.imus"
-BUILTIN = ("bno055",)
-
-ImuFactory = Callable[..., Imu]   # (config: ImuConfig, *, bus: Bus | None) -> Imu
-
-_plugins: Registry[ImuFactory] = Registry(ENTRY_POINT_GROUP, BUILTIN, "imu.kind")
-
-
-def register_imu(kind: str, factory: ImuFactory) -> None:
-    """Make ``open_imu`` build IMUs of ``kind`` with ``factory(config, bus=...)``."""
-    _plugins.register(kind, factory)
-
-
-def imu_kinds() -> tuple[str, ...]:
-    """Every IMU kind ``open_imu`` accepts: plugins (registered or declared), then built-in."""
-    return _plugins.kinds()
-
 
 def open_imu(config: ImuConfig, *, bus: Bus | None = None) -> Imu:
     """The IMU backend for ``config`` (not yet opened: use ``with open_imu(...) as imu:``).
@@ -49,9 +29,13 @@ def open_imu(config: ImuConfig, *, bus: Bus | None = None) -> Imu:
         from robot.imu.bno055 import Bno055Imu
 
         return Bno055Imu(config)
-    factory = _plugins.plugin(config.kind)
+    factory = plugin(config.kind)
     if factory is None:
         raise ConfigError(f"imu.kind: unknown IMU {config.kind!r}; valid: "
                           f"{', '.join(imu_kinds())} (plugins are entry points in group "
                           f"{ENTRY_POINT_GROUP}; reinstall biped if 'sim' is missing)")
-    return factory(config, bus=bus)
+    imu = factory(config, bus=bus)
+    if not isinstance(imu, Imu):
+        raise ConfigError(f"imu.kind {config.kind}: its plugin returned a "
+                          f"{type(imu).__name__}, not an IMU (robot.imu.base.Imu)")
+    return imu

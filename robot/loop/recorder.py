@@ -28,7 +28,7 @@ class Recorder:
         self.names = joint_names
         self.ids = ids
         self._file: IO[str] | None = None
-        self._csv: Any = None
+        self._csv: Any = None  # a csv.writer (its type is private to the csv module)
         self._last_tick = -1
         self._t0: float | None = None
         self.error: str | None = None  # the first failed write, one line (e.g. disk full)

@@ -2,16 +2,16 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
+import numpy.typing as npt
 
 from robot.bus.servo_map import ServoMap
 from robot.errors import StartRefused
 
 
-def check_inside_limits(smap: ServoMap, present: np.ndarray, *, tolerance: Any,
-                        source: str) -> np.ndarray:
+def check_inside_limits(smap: ServoMap, present: npt.NDArray[np.float64], *,
+                        tolerance: float | npt.NDArray[np.float64],
+                        source: str) -> npt.NDArray[np.float64]:
     """``present`` [rad] clamped to the joint limits; StartRefused (naming the joint, how far
     out it is and the fix) if a joint is further outside than ``tolerance`` [rad] (scalar or
     per joint): its first goal would jump it."""

@@ -2,19 +2,22 @@
 
 There is one loop: ``_send`` (clamp to the joint limits, limit the slew rate to each
 servo's max speed, wait for the next absolute deadline, ONE sync write, every
-``read_every`` ticks a read-back for the watchdog). A walk (``run``) and a move to a pose
-(``move_to``) are sequences of ``_send``; both start and end the same way:
+``read_every`` ticks a read-back for the watchdog). ``run`` streams any motion source
+(robot.loop.source: a walk, a keyframe sequence, a take, a move to a pose) as a sequence
+of ``_send``: ramp to the source's entry, its ticks, ramp to its exit pose; every run
+starts and ends the same way:
 
 start: read the present pose → refuse (nothing moves, torque untouched) if a joint is
   outside its limits by more than one slew step → goal := present → torque on → arm the
   servos' own bus watchdog where they have one.
 end, by cause (docs/hardware.md, "What happens when"):
   completed / operator stop (``request_stop``, first Ctrl-C or SIGTERM): ramp the gait out,
-    ramp to rest, then torque off, or hold with ``hold_at_end``;
+    ramp to rest (a pose move: stop where it is), then torque off, or hold with
+    ``hold_at_end``;
   emergency stop (second signal, panel E-stop): torque off at once;
   a fault the robot can still be driven through (an observer raised, e.g. a full disk
     under ``--record``; the loop cannot keep its rate): ramp out, rest, torque off;
-  an exception in the gait engine: ramp straight to rest, torque off;
+  an exception in the gait engine (the source): ramp straight to rest, torque off;
   a fault that makes driving unsafe or impossible (hardware error flag, over-temperature,
     a servo not following, a dead bus, any other exception): torque off at once.
 A fault always ends with torque off, ``hold_at_end`` or not.
@@ -25,49 +28,39 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections.abc import Callable, Mapping
-from typing import Any, Protocol
+from collections.abc import Mapping
+from typing import Generic
 
 import numpy as np
 
 from robot.bus.base import Bus
 from robot.bus.servo_map import ServoMap
 from robot.config.params import GaitParams
-from robot.errors import BusDead, BusError, SafetyStop
-from robot.gait.engine import GaitEngine
+from robot.errors import BusDead, BusError, ConfigError, SafetyStop
 from robot.loop.clock import Clock, MonotonicClock
+from robot.loop.ending import arm_failsafe, finish
 from robot.loop.latency import SampleStats
+from robot.loop.source import Feedback, JointTargets, JointVector, MotionSource, SourceT
 from robot.loop.start_check import check_inside_limits
-from robot.loop.telemetry import LoopStats, Telemetry, TickObserver
-from robot.loop.watchdog import FAILSAFE_MARGIN, Watchdog, WatchdogConfig
+from robot.loop.telemetry import LoopStats, Telemetry, TickObserver, loop_stats
+from robot.loop.watchdog import Watchdog, WatchdogConfig
 from robot.motion.ramp import ramp
 
-__all__ = ["Feedback", "LoopStats", "Streamer", "Telemetry", "TickObserver",
-           "check_inside_limits"]
-
-
-class Feedback(Protocol):
-    """A stage between the engine and safety (robot.balance.Balance): ``start`` when the
-    gait starts, then called every tick with the joints [rad] and the tick [s]."""
-
-    def start(self) -> None: ...
-    def stop(self) -> None: ...
-    def __call__(self, q: np.ndarray, dt: float) -> np.ndarray: ...
+__all__ = ["Feedback", "LoopStats", "MotionSource", "Streamer", "Telemetry", "TickObserver"]
 
 log = logging.getLogger(__name__)
 
+class Streamer(Generic[SourceT]):
+    """Streams a motion source's joint angles to a bus at ``rate_hz`` [Hz]."""
 
-class Streamer:
-    """Streams an engine's joint angles to a bus at ``rate_hz`` [Hz]."""
-
-    def __init__(self, robot_map: ServoMap, bus: Bus, engine: GaitEngine, *,
+    def __init__(self, robot_map: ServoMap, bus: Bus, source: SourceT, *,
                  rate_hz: float = 200.0, read_every: int = 10, clock: Clock | None = None,
                  hold_at_end: bool = False, watchdog: WatchdogConfig | None = None,
                  observer: TickObserver | None = None,
                  feedback: Feedback | None = None) -> None:
         self.map = robot_map
         self.bus = bus
-        self.engine = engine
+        self.source = source
         self.rate_hz = rate_hz
         self.dt = 1.0 / rate_hz
         self._step = robot_map.max_speed * self.dt  # slew limit per tick [rad]
@@ -75,7 +68,7 @@ class Streamer:
         self.clock: Clock = clock or getattr(bus, "clock", None) or MonotonicClock()
         self.hold_at_end = hold_at_end
         self.watchdog_config = watchdog or WatchdogConfig()
-        self.watchdog = Watchdog(self.watchdog_config, robot_map, robot=engine.robot)
+        self.watchdog = Watchdog(self.watchdog_config, robot_map, robot=source.robot)
         self.observer = observer
         self.feedback = feedback
         self._feedback_on = False
@@ -86,20 +79,29 @@ class Streamer:
         self._estop = threading.Event()
         self._fault: str | None = None
         self._bus_dead = False
-        self._q_last: np.ndarray = np.zeros(len(robot_map.ids))
+        self._q_last: JointVector = np.zeros(len(robot_map.ids))
         self._lateness = SampleStats()
         self._overruns = 0
         self._bus_errors = 0
         self._next = 0.0
         self._ticks = 0
 
+    @property
+    def engine(self) -> SourceT:
+        """The source being streamed (the name from when it was always a gait engine)."""
+        return self.source
+
     # -- control from other threads ------------------------------------------------------
-    def set_params(self, changes: Mapping[str, Any], *, where: str = "parameter") -> GaitParams:
+    def set_params(self, changes: Mapping[str, float], *, where: str = "parameter"
+                   ) -> GaitParams:
         """Validate ``changes`` now (ConfigError, nothing changes) and apply them at the next
         tick. Returns the parameters as they will be."""
+        params = self.source.params
+        if params is None:
+            raise ConfigError(f"{where}: {type(self.source).__name__} has no parameters to set")
         with self._lock:
             merged = {**self._pending, **changes}
-            new = self.engine.params.replace(merged, where=where)
+            new = params.replace(merged, where=where)
             self._pending = {k: float(v) for k, v in merged.items()}
         return new
 
@@ -117,19 +119,8 @@ class Streamer:
 
     # -- runs ----------------------------------------------------------------------------
     def run(self, *, seconds: float | None = None) -> LoopStats:
-        """Walk until ``seconds`` of gait have passed or a stop is requested."""
-        return self._session(lambda: self._walk(seconds))
-
-    def move_to(self, q_goal: Any, *, max_speed: Any = None) -> LoopStats:
-        """Ramp (minimum jerk, slew-limited) from the present pose to ``q_goal`` [rad],
-        clamped to the limits; peak speed ``max_speed`` [rad/s] (capped by each joint's).
-        A stop request ends the ramp where it is."""
-        speed = self.map.max_speed if max_speed is None else np.minimum(self.map.max_speed,
-                                                                        max_speed)
-        return self._session(lambda: self._ramp_to(q_goal, state="pose", interruptible=True,
-                                                   max_speed=speed))
-
-    def _session(self, motion: Callable[[], None]) -> LoopStats:
+        """Stream the source until it has stopped, ``seconds`` of it have passed (then it
+        is stopped: a gait ramps out) or a stop is requested."""
         wall0 = time.perf_counter()
         t_start = self.clock.now()
         ids = list(self.map.ids)
@@ -140,8 +131,8 @@ class Streamer:
             self.bus.set_torque(ids, enabled=True)
             self._q_last = q0
             self._next = self.clock.now()
-            self._arm_failsafe()
-            motion()
+            arm_failsafe(self.bus, ids, self.watchdog_config.failsafe_s, dt=self.dt)
+            self._stream(seconds)
         except SafetyStop as e:                  # the watchdog: unsafe or impossible to drive
             self._bus_dead = isinstance(e, BusDead)
             self._set_fault(f"watchdog: {e}")
@@ -156,16 +147,23 @@ class Streamer:
         self._finish(torque_off=not holding)
         reason = self._fault or self.telemetry.stop_reason or "completed"
         self.telemetry.stop_reason = reason
-        return self._stats(t_start, wall0, reason, holding=holding, estop=estop)
+        return loop_stats(self._lateness, ticks=self._ticks, rate_hz=self.rate_hz,
+                          duration_s=max(self.clock.now() - t_start, 1e-9),
+                          overruns=self._overruns, bus_errors=self._bus_errors,
+                          wall_s=time.perf_counter() - wall0, stop_reason=reason,
+                          fault=self._fault is not None, holding=holding, estop=estop)
 
-    def _check_start(self, present: np.ndarray) -> np.ndarray:
+    def _check_start(self, present: JointVector) -> JointVector:
         return check_inside_limits(self.map, present, tolerance=self._step,
-                                   source=self.engine.robot.source)
+                                   source=self.source.robot.source)
 
-    def _walk(self, seconds: float | None) -> None:
-        self._ramp_to(self.engine.start_pose(), state="ramp_in", interruptible=True)
+    def _stream(self, seconds: float | None) -> None:
+        src = self.source
+        entry = src.entry(self._q_last.copy(), self.dt)
+        if entry is not None:
+            self._ramp_to(entry, state="ramp_in", interruptible=True)
         if not self._stop.is_set():
-            self.engine.start()
+            src.start()
             if self.feedback is not None:
                 self.feedback.start()
                 self._feedback_on = True
@@ -173,20 +171,21 @@ class Streamer:
             while not self._estop.is_set():
                 if self._stop.is_set() or (seconds is not None
                                            and self.clock.now() - t_gait >= seconds):
-                    self.engine.stop()
-                if self.engine.stopped:
+                    src.stop()
+                if src.stopped:
                     break
                 self._apply_pending()
                 try:
-                    q = self.engine.tick(self.dt)
+                    q = src.tick(self.dt)
                 except Exception as e:           # the gait is unusable: straight to rest
                     log.exception("the gait engine failed")
                     self._set_fault(f"exception in the gait engine: {type(e).__name__}: {e}")
                     break
-                self._send(np.asarray(q), state="walking" if self.engine.running
-                           else "ramp_out")
+                self._send(np.asarray(q, dtype=float), state=src.state)
         if not self._estop.is_set():
-            self._ramp_to(self.map.vector(self.engine.robot.rest), state="rest")
+            rest = src.exit_pose()
+            if rest is not None:
+                self._ramp_to(rest, state="rest")
         self._feedback_on = False
 
     def _set_fault(self, reason: str) -> None:
@@ -196,36 +195,10 @@ class Streamer:
             log.error("safe stop: %s", reason)
         self.request_stop(reason)
 
-    def _arm_failsafe(self) -> None:
-        timeout = self.watchdog_config.failsafe_s
-        if timeout:
-            timeout = max(timeout, FAILSAFE_MARGIN * self.bus.retry_span_s + 2 * self.dt)
-            armed = self.bus.arm_failsafe(self.map.ids, timeout_s=timeout)
-            if armed is not None:
-                log.info("servo bus watchdog armed: %.2f s", armed)
-
     def _finish(self, *, torque_off: bool) -> None:
-        """Torque off (one packet first, then confirmed servo by servo) or hold; disarm the
-        servos' watchdog. On a dead bus only the one packet is tried."""
         self.telemetry.state = "estop" if self._estop.is_set() else "stopped"
-        ids = list(self.map.ids)
-        steps: list[tuple[str, Callable[[], None]]] = []
-        if torque_off:
-            steps.append(("disable torque", lambda: self.bus.release(ids)))
-        if not self._bus_dead:
-            if self.watchdog_config.failsafe_s:
-                steps.append(("disarm the servos' bus watchdog",
-                              lambda: self.bus.disarm_failsafe(ids)))
-            if torque_off:
-                steps.append(("confirm torque off",
-                              lambda: self.bus.set_torque(ids, enabled=False)))
-        for what, step in steps:
-            try:
-                step()
-            except BusError as e:
-                log.error("could not %s: %s", what, e)
-        if not torque_off:
-            log.info("holding the last pose with torque on (hold_at_end)")
+        finish(self.bus, self.map.ids, torque_off=torque_off, bus_dead=self._bus_dead,
+               failsafe=bool(self.watchdog_config.failsafe_s))
         self._notify()
 
     def _apply_pending(self) -> None:
@@ -233,12 +206,11 @@ class Streamer:
             if not self._pending:
                 return
             changes, self._pending = self._pending, {}
-        self.engine.set_params(changes)
+        self.source.set_params(changes)
 
-    def _ramp_to(self, q_goal: Any, *, state: str, interruptible: bool = False,
-                 max_speed: Any = None) -> None:
-        speed = self.map.max_speed if max_speed is None else max_speed
-        path = ramp(self._q_last, self.map.clamp(q_goal), speed, self.rate_hz,
+    def _ramp_to(self, q_goal: JointTargets, *, state: str, interruptible: bool = False
+                 ) -> None:
+        path = ramp(self._q_last, self.map.clamp(q_goal), self.map.max_speed, self.rate_hz,
                     min_duration=0.3)
         for q in path[1:]:
             if self._estop.is_set() or (interruptible and self._stop.is_set()):
@@ -246,7 +218,7 @@ class Streamer:
             self._send(q, state=state)
 
     # -- the one loop --------------------------------------------------------------------
-    def _send(self, q: np.ndarray, *, state: str) -> None:
+    def _send(self, q: JointVector, *, state: str) -> None:
         """(Feedback,) clamp, slew-limit, wait for the deadline, write; read back every Nth
         tick."""
         if self._feedback_on:
@@ -264,7 +236,7 @@ class Streamer:
         self._ticks += 1
         tel = self.telemetry
         tel.tick, tel.state, tel.q_cmd = self._ticks, state, q_list
-        tel.amplitude = self.engine.amplitude
+        tel.amplitude = self.source.amplitude
         tel.fresh = False
         if self._ticks % self.read_every == 0:
             try:
@@ -280,7 +252,7 @@ class Streamer:
                 self.watchdog.bus_failed("read", e)
         self._notify()
 
-    def _feed_back(self, q: np.ndarray) -> np.ndarray:
+    def _feed_back(self, q: JointVector) -> JointVector:
         """``q`` corrected by the feedback stage; if it fails, the walk ends as a fault
         and goes on open loop (the servos are fine; only the sensor is not)."""
         assert self.feedback is not None
@@ -323,17 +295,3 @@ class Streamer:
             self.observer = None
             log.exception("an observer of the loop failed; it is detached")
             self._set_fault(f"exception in an observer: {type(e).__name__}: {e}")
-
-    def _stats(self, t_start: float, wall0: float, reason: str, *, holding: bool,
-               estop: bool) -> LoopStats:
-        lat = self._lateness
-        duration = max(self.clock.now() - t_start, 1e-9)
-        return LoopStats(
-            ticks=self._ticks, rate_hz=self.rate_hz, duration_s=duration,
-            achieved_hz=self._ticks / duration,
-            period_error_p50_ms=lat.percentile(50) * 1e3,
-            period_error_p99_ms=lat.percentile(99) * 1e3,
-            period_error_max_ms=max(lat.max, 0.0) * 1e3 if lat.count else 0.0,
-            overruns=self._overruns, bus_errors=self._bus_errors,
-            wall_s=time.perf_counter() - wall0, stop_reason=reason,
-            fault=self._fault is not None, holding=holding, estop=estop)

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from robot.bus.base import ServoState
+from robot.loop.latency import SampleStats
 
 
 @dataclass
@@ -59,3 +60,16 @@ class LoopStats:
 
     def as_dict(self) -> dict[str, Any]:
         return dict(self.__dict__)
+
+
+def loop_stats(lateness: SampleStats, *, ticks: int, rate_hz: float, duration_s: float,
+               overruns: int, bus_errors: int, wall_s: float, stop_reason: str,
+               fault: bool, holding: bool, estop: bool) -> LoopStats:
+    """The statistics of a run from the tick-start lateness samples [s] and its counts."""
+    return LoopStats(
+        ticks=ticks, rate_hz=rate_hz, duration_s=duration_s, achieved_hz=ticks / duration_s,
+        period_error_p50_ms=lateness.percentile(50) * 1e3,
+        period_error_p99_ms=lateness.percentile(99) * 1e3,
+        period_error_max_ms=max(lateness.max, 0.0) * 1e3 if lateness.count else 0.0,
+        overruns=overruns, bus_errors=bus_errors, wall_s=wall_s, stop_reason=stop_reason,
+        fault=fault, holding=holding, estop=estop)

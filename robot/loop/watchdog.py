@@ -6,10 +6,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from robot.bus.base import ServoState
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import BusDead, BusError, SafetyStop
 
 #: How many times the longest retried transaction the servos' bus watchdog must allow.
@@ -76,7 +77,7 @@ class Watchdog:
             raise SafetyStop(f"{self._overrun_streak} loop overruns in a row: the loop cannot "
                              f"keep its rate; lower --rate or the read-back frequency")
 
-    def check(self, states: Mapping[int, ServoState], q_cmd: np.ndarray) -> None:
+    def check(self, states: Mapping[int, ServoState], q_cmd: npt.NDArray[np.float64]) -> None:
         """Raise SafetyStop on a hardware fault, overheating, or a servo not following."""
         for sid, s in states.items():
             bad = sorted(s.errors & FAULTS)

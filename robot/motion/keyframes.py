@@ -27,13 +27,13 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TypeAlias
 
 import numpy as np
 import numpy.typing as npt
 
-from robot.config.robot_file import RobotConfig
-from robot.config.toml_io import number, read_toml, show
+from robot.config.robot import RobotConfig
+from robot.config.toml_io import JsonValue, TomlValue, number, read_toml, show
 from robot.errors import ConfigError
 from robot.motion.interp import METHODS, interpolate
 
@@ -43,6 +43,8 @@ SPEED_CHECK_S = 0.002
 #: Longest sequence [s] (an all-day show loops a shorter one).
 MAX_SECONDS = 3600.0
 MAX_KEYFRAMES = 10_000
+#: A value of a sequence file (TOML or JSON).
+Value: TypeAlias = TomlValue | JsonValue
 
 
 @dataclass(frozen=True)
@@ -69,14 +71,14 @@ class Sequence:
         out = interpolate(self.interpolation, self.times, self.poses, ts)
         return out[0] if np.ndim(t) == 0 else out
 
-    def as_json(self) -> dict[str, Any]:
+    def as_json(self) -> dict[str, JsonValue]:
         return {"name": self.name, "interpolation": self.interpolation, "loop": self.loop,
                 "keyframe": [{"t": float(t), **{j: float(v) for j, v in zip(
                     self.joints, pose, strict=True)}} for t, pose in zip(
                         self.times, self.poses, strict=True)]}
 
 
-def parse_sequence(data: Mapping[str, Any], robot: RobotConfig, *,
+def parse_sequence(data: Mapping[str, Value], robot: RobotConfig, *,
                    source: str = "<memory>") -> Sequence:
     """A validated Sequence for ``robot`` (ConfigError, one line, on any problem)."""
     src = source
@@ -88,7 +90,7 @@ def parse_sequence(data: Mapping[str, Any], robot: RobotConfig, *,
     if not isinstance(name, str) or not name:
         raise ConfigError(f"{src}: name: expected a non-empty string, got {show(name)}")
     method = data.get("interpolation", "min_jerk")
-    if method not in METHODS:
+    if not isinstance(method, str) or method not in METHODS:
         raise ConfigError(f"{src}: interpolation: expected one of {', '.join(METHODS)}, "
                           f"got {show(method)}")
     loop = data.get("loop", False)
@@ -174,7 +176,7 @@ def load_sequence(path: str | Path, robot: RobotConfig) -> Sequence:
         raise ConfigError(f"{p}: unknown keyframe format {p.suffix!r}; valid: "
                           f"{', '.join(SUFFIXES)}")
     if p.suffix == ".toml":
-        data = read_toml(p)
+        data: Mapping[str, Value] = read_toml(p)
     else:
         try:
             data = json.loads(p.read_text())

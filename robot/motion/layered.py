@@ -5,14 +5,16 @@ from the gait. Layered (``walk=True``), the legs walk while the arms and any ext
 (a head, a waist) play the keyframes; the legs cannot be keyframed then. Standalone
 (``walk=False``), the gait stays at its standing pose (amplitude 0) and the sequence may
 drive any joint; the engine stops itself at the end of a sequence that does not loop.
-Either way the output goes through the one streaming loop: ramp in to the first
+Either way it is a motion source (robot.loop.source; standalone, the keyframe player of
+`biped play`) and its output goes through the one streaming loop: ramp in to the first
 keyframe, clamp, slew, ramp to rest at the end.
 """
 
 from __future__ import annotations
 
+from robot.config.joint_names import LEG_NAMES
 from robot.config.params import GaitParams
-from robot.config.robot_file import LEG_NAMES, RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.motion.keyframes import Sequence

@@ -1,7 +1,8 @@
 """Gait engines that record or replay the parameter timeline, for the one streaming loop.
 
-Both are ``GaitEngine``s (with an optional keyframe layer, robot.motion.layered), so a recorded
-or replayed run goes through ``robot.loop.streamer`` exactly like a walk: ramp in from the
+Both are ``GaitEngine``s (with an optional keyframe layer, robot.motion.layered), so both
+are motion sources (robot.loop.source) and a recorded or replayed run (the take player)
+goes through ``robot.loop.streamer`` exactly like a walk: ramp in from the
 present pose, balance, clamp, slew, watchdog, ramp out, rest, torque off. They only count
 gait ticks (calls of ``tick``):
 
@@ -14,10 +15,9 @@ gait ticks (calls of ``tick``):
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import Any
 
 from robot.config.params import GaitParams, canonical_name
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.motion.keyframes import Sequence
 from robot.motion.layered import LayeredEngine
 
@@ -34,7 +34,8 @@ class RecordingEngine(LayeredEngine):
         self.gait_ticks = 0
         self._sink = sink
 
-    def set_params(self, changes: Mapping[str, Any], *, where: str = "parameter") -> GaitParams:
+    def set_params(self, changes: Mapping[str, float], *, where: str = "parameter"
+                   ) -> GaitParams:
         new = super().set_params(changes, where=where)  # raises (nothing recorded) if bad
         self._sink(self.gait_ticks, set={canonical_name(n): float(v)
                                          for n, v in changes.items()})

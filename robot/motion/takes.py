@@ -32,7 +32,8 @@ from typing import IO, Any
 import numpy as np
 import numpy.typing as npt
 
-from robot.config.params import GaitParams, canonical_name
+from robot.config.params import GaitParams, canonical_name, check_value
+from robot.config.toml_io import JsonValue, number
 from robot.errors import ConfigError
 from robot.loop.telemetry import Telemetry
 
@@ -62,7 +63,7 @@ class TakeHeader:
     balance: bool = False
     note: str = ""
     #: A keyframe sequence layered on the gait (robot.motion.keyframes.Sequence.as_json()).
-    keyframes: Mapping[str, Any] | None = None
+    keyframes: Mapping[str, JsonValue] | None = None
 
     def as_json(self) -> dict[str, Any]:
         return {"take": VERSION, "robot": self.robot, "robot_file": self.robot_file,
@@ -160,34 +161,49 @@ def _fail(where: str, what: str) -> ConfigError:
     return ConfigError(f"{where}: {what}")
 
 
-def _int(where: str, v: Any, name: str, lo: int = 0) -> int:
+def _int(where: str, v: JsonValue, name: str, lo: int = 0) -> int:
     if isinstance(v, bool) or not isinstance(v, int) or v < lo:
         raise _fail(where, f"{name}: expected an integer >= {lo}, got {v!r:.40}")
     return v
 
 
-def _header(where: str, h: Any) -> TakeHeader:
+def _string(where: str, h: Mapping[str, JsonValue], name: str) -> str:
+    v = h.get(name, "")
+    if not isinstance(v, str):
+        raise _fail(where, f"{name}: expected a string, got {v!r:.40}")
+    return v
+
+
+def _angles(where: str, qs: JsonValue, n: int) -> list[float]:
+    """``qs`` checked to be ``n`` finite joint angles [rad]."""
+    if isinstance(qs, list) and len(qs) == n:
+        ok = [float(v) for v in qs if isinstance(v, int | float) and not isinstance(v, bool)
+              and math.isfinite(v)]
+        if len(ok) == n:
+            return ok
+    raise _fail(where, f"q: expected {n} finite joint angles [rad]")
+
+
+def _header(where: str, h: JsonValue) -> TakeHeader:
     if not isinstance(h, dict) or h.get("take") != VERSION:
         raise _fail(where, f"not a take header (expected {{\"take\": {VERSION}, ...}}); "
                            f"record one with --record NAME{SUFFIX}")
     joints = h.get("joints")
-    if not (isinstance(joints, list) and joints and all(isinstance(j, str) for j in joints)):
+    names = tuple(j for j in joints if isinstance(j, str)) if isinstance(joints, list) else ()
+    if not (isinstance(joints, list) and names and len(names) == len(joints)):
         raise _fail(where, "joints: expected a list of joint names")
     rate = h.get("rate_hz")
-    if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not 1 <= rate <= 2000:
+    if isinstance(rate, bool) or not isinstance(rate, int | float) or not 1 <= rate <= 2000:
         raise _fail(where, f"rate_hz: expected a rate in [1, 2000] Hz, got {rate!r:.40}")
     params = h.get("params")
     if not isinstance(params, dict):
         raise _fail(where, "params: expected a table of gait parameters")
-    strings = {k: h.get(k, "") for k in ("robot", "robot_file", "gait", "bus", "note")}
-    for k, v in strings.items():
-        if not isinstance(v, str):
-            raise _fail(where, f"{k}: expected a string, got {v!r:.40}")
+    strings = {k: _string(where, h, k) for k in ("robot", "robot_file", "gait", "bus", "note")}
     keys = h.get("keyframes")
     if keys is not None and not isinstance(keys, dict):
         raise _fail(where, "keyframes: expected a keyframe sequence object or null")
     return TakeHeader(robot=strings["robot"], robot_file=strings["robot_file"],
-                      joints=tuple(joints), rate_hz=float(rate),
+                      joints=names, rate_hz=float(rate),
                       read_every=_int(where, h.get("read_every", 10), "read_every", 1),
                       gait=strings["gait"] or "take",
                       params=GaitParams().replace(params, where=f"{where}: params"),
@@ -195,9 +211,8 @@ def _header(where: str, h: Any) -> TakeHeader:
                       note=strings["note"], keyframes=keys)
 
 
-def read_take(path: str | Path) -> Take:
-    """Read and validate a take; ConfigError naming the file and line on any problem."""
-    p = Path(path)
+def _lines(p: Path) -> list[tuple[str, JsonValue]]:
+    """The take's non-blank lines as (where, parsed JSON)."""
     try:
         if p.stat().st_size > MAX_BYTES:
             raise ConfigError(f"{p}: larger than {MAX_BYTES >> 20} MiB; not a take")
@@ -206,7 +221,7 @@ def read_take(path: str | Path) -> Take:
         raise ConfigError(f"{p}: file not found") from None
     except (OSError, UnicodeDecodeError) as e:
         raise ConfigError(f"{p}: cannot read it: {e}") from None
-    rows: list[tuple[str, Any]] = []
+    rows: list[tuple[str, JsonValue]] = []
     for i, text in enumerate(lines, 1):
         if not text.strip():
             continue
@@ -216,8 +231,16 @@ def read_take(path: str | Path) -> Take:
             raise ConfigError(f"{p}: line {i}: not JSON: {e.msg}") from None
     if not rows:
         raise ConfigError(f"{p}: empty; expected a take header line")
+    return rows
+
+
+def read_take(path: str | Path) -> Take:
+    """Read and validate a take; ConfigError naming the file and line on any problem."""
+    p = Path(path)
+    rows = _lines(p)
     header = _header(*rows[0])
-    params, stop = header.params, None
+    n = len(header.joints)
+    stop: int | None = None
     changes: dict[int, dict[str, float]] = {}
     last_gait = -1
     t: list[float] = []
@@ -231,26 +254,22 @@ def read_take(path: str | Path) -> Take:
             if k < last_gait:
                 raise _fail(where, f"gait_tick {k} is before the previous one ({last_gait})")
             last_gait = k
+            new = row.get("set")
             if row.get("stop") is True:
                 stop = k if stop is None else stop
-            elif isinstance(row.get("set"), dict) and row["set"]:
-                params = params.replace(row["set"], where=f"{where}: set")  # validates
-                step = changes.setdefault(k, {})
-                step.update({canonical_name(n): float(v) for n, v in row["set"].items()})
+            elif isinstance(new, dict) and new:
+                w = f"{where}: set"
+                step = {canonical_name(m, where=w): check_value(m, v, where=w)
+                        for m, v in new.items()}
+                changes.setdefault(k, {}).update(step)
             else:
                 raise _fail(where, "expected \"set\": {name: value} or \"stop\": true")
         elif "tick" in row:
-            qs = row.get("q")
-            if not (isinstance(qs, list) and len(qs) == len(header.joints)
-                    and all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                            and math.isfinite(v) for v in qs)):
-                raise _fail(where, f"q: expected {len(header.joints)} finite joint angles "
-                                   "[rad]")
-            t.append(float(row.get("t", len(t) / header.rate_hz)))
-            q.append(qs)
+            q.append(_angles(where, row.get("q"), n))
+            t.append(number(where, "t", row.get("t", len(t) / header.rate_hz)))
             states.append(str(row.get("state", "")))
         else:
             raise _fail(where, "expected a timeline line (gait_tick) or a stream line (tick)")
-    q_arr = np.asarray(q, dtype=float).reshape(len(q), len(header.joints))
+    q_arr = np.asarray(q, dtype=float).reshape(len(q), n)
     return Take(header, changes, stop, np.asarray(t, dtype=float), q_arr, tuple(states),
                 source=str(p))

@@ -1,9 +1,11 @@
 """The panel's controller: owns the bus, the current parameters and at most one Streamer
 run in a worker thread; every HTTP request goes through it (thread-safe).
 
-A Streamer run is one-shot, so "start" after a stop starts a new run (a new GaitEngine
-with the current parameters) on the same open bus. The run's thread is not a daemon: the
-process cannot end under it before ``shutdown`` has stopped it and closed the bus.
+A run (robot.run.run.Run: its Streamer, observers and feedback) is one-shot, so "start"
+after a stop starts a new run (a new GaitEngine with the current parameters) on the same
+open bus, which the controller owns (its runs leave it open). The run's thread is not a
+daemon: the process cannot end under it before ``shutdown`` has stopped it and closed
+the bus.
 """
 
 from __future__ import annotations
@@ -12,46 +14,28 @@ import logging
 import math
 import threading
 import time
-from collections import deque
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from typing import Any
 
 from robot.bus.base import Bus
 from robot.bus.servo_map import ServoMap
-from robot.config.params import GROUPS, SPECS, GaitParams
-from robot.config.robot_file import RobotConfig
+from robot.config.params import GaitParams
+from robot.config.robot import RobotConfig
 from robot.errors import BipedError
 from robot.gait.engine import GaitEngine
-from robot.loop.streamer import Feedback, LoopStats, Streamer, Telemetry, TickObserver
-from robot.panel.figure import views
+from robot.loop.streamer import LoopStats, Streamer, Telemetry, TickObserver
 from robot.panel.idle_pose import IdlePose
-from robot.panel.labels import LABELS, SIMPLE
+from robot.panel.options import DEFAULT_OPTIONS, EngineFactory, LoopOptions, PanelStateError
 from robot.panel.presets import PresetStore
 from robot.panel.sim_monitor import sim_monitor_factory
-
-#: Builds a run's engine from the current parameters (a recording, a replay, keyframes).
-EngineFactory = Callable[[GaitParams], GaitEngine]
+from robot.panel.sim_reset import reset_to_home
+from robot.panel.snapshot import TickRate, describe_params, state_snapshot, telemetry_snapshot
+from robot.run.run import Run
+from robot.run.spec import RunOptions, RunSpec
 
 log = logging.getLogger(__name__)
 
 RATE_WINDOW = 50  # ticks over which the loop rate is measured
-
-
-class PanelStateError(BipedError):
-    """The request does not fit the loop's state (e.g. start while running)."""
-
-
-@dataclass(frozen=True)
-class LoopOptions:
-    """rate_hz: control rate [Hz]; read_every: read back every N ticks; hold: keep torque
-    on at the rest pose after a stop; feedback: builds each run's feedback stage (balance)
-    for its engine, after the bus is open (None: open loop)."""
-
-    rate_hz: float = 200.0
-    read_every: int = 10
-    hold: bool = False
-    feedback: Callable[[GaitEngine], Feedback | None] | None = None
 
 
 class PanelController:
@@ -62,7 +46,7 @@ class PanelController:
     """
 
     def __init__(self, robot: RobotConfig, bus: Bus, params: GaitParams, *,
-                 options: LoopOptions = LoopOptions(), presets: PresetStore | None = None,
+                 options: LoopOptions = DEFAULT_OPTIONS, presets: PresetStore | None = None,
                  monitor_factory: Callable[[], Callable[[Telemetry], dict[str, Any]]] | None
                  = None, preset: str | None = None) -> None:
         self.robot = robot
@@ -75,11 +59,11 @@ class PanelController:
         self._params = params
         self.preset = preset  # name of the last preset loaded (shown by the picker)
         self._lock = threading.RLock()
-        self._streamer: Streamer | None = None
+        self._streamer: Streamer[GaitEngine] | None = None
         self._thread: threading.Thread | None = None
         self._tel: dict[str, Any] = {"state": "idle"}
         self._sim: dict[str, Any] = {}
-        self._ticks: deque[tuple[int, float]] = deque(maxlen=RATE_WINDOW)
+        self._rate = TickRate(RATE_WINDOW)
         self.runs = 0
         self.last_stats: LoopStats | None = None  # of the last run that returned
         self._holding = False  # torque left on by the last run (hold, no fault or estop)
@@ -94,7 +78,7 @@ class PanelController:
         return self._params
 
     @property
-    def streamer(self) -> Streamer | None:
+    def streamer(self) -> Streamer[GaitEngine] | None:
         return self._streamer
 
     def set_params(self, changes: Mapping[str, Any]) -> GaitParams:
@@ -142,7 +126,7 @@ class PanelController:
             gait = engine(self._params) if engine is not None else \
                 GaitEngine(self.robot, self._params)
             monitor = self._monitor_factory() if self._monitor_factory else None
-            self._ticks.clear()
+            self._rate.clear()
             self._sim = {}
             self._idle.forget()
 
@@ -151,21 +135,27 @@ class PanelController:
                 if observer is not None:
                     observer(tel)
             o = self.options
-            self._streamer = Streamer(self._map, self.bus, gait, rate_hz=o.rate_hz,
-                                      read_every=o.read_every, hold_at_end=o.hold,
-                                      observer=observe,
-                                      feedback=o.feedback(gait) if o.feedback else None)
+            run = Run(RunSpec(robot=self.robot, source=gait, bus=self.bus, observer=observe,
+                              feedback=o.feedback(gait) if o.feedback else None,
+                              options=RunOptions(rate_hz=o.rate_hz, read_every=o.read_every,
+                                                 hold=o.hold, close_bus=False, watch=False)))
+            run.open()                 # the bus is open and stays so: builds the Streamer
+            self._streamer = run.streamer
             self.driver, self._on_end = driver, on_end
             self._tel = {"state": "starting"}
             self.runs += 1
             self._holding = self._estop_requested = False
-            self._thread = threading.Thread(target=self._run, args=(self._streamer,),
+            self._thread = threading.Thread(target=self._run, args=(run,),
                                             name=f"gait-run-{self.runs}", daemon=False)
             self._thread.start()
 
-    def _run(self, streamer: Streamer) -> None:
+    def _run(self, run: Run[GaitEngine]) -> None:
+        streamer = run.streamer
         try:
-            stats = streamer.run(seconds=None)
+            try:
+                stats = run.stream()
+            finally:
+                run.close()            # opened by start(); leaves the bus open
             log.info("run ended: %s", stats.stop_reason)
             with self._lock:
                 self.last_stats = stats
@@ -212,16 +202,8 @@ class PanelController:
                 raise PanelStateError("stop the gait before resetting the simulation")
             if getattr(self.bus, "kind", "") != "sim":
                 raise PanelStateError("reset applies to the simulated bus only")
-            import mujoco
-
-            bus: Any = self.bus
-            model, data = bus.model, bus.data
-            t = float(data.time)
-            self.bus.set_torque(list(self._map.ids), enabled=False)
+            reset_to_home(self.bus, list(self._map.ids))
             self._holding = False
-            mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
-            data.time = t
-            mujoco.mj_forward(model, data)
             self._sim = {}
             self._tel = {"state": "idle", "stop_reason": "simulation reset"}
 
@@ -271,13 +253,8 @@ class PanelController:
     def _observe(self, tel: Telemetry, monitor: Callable[[Telemetry], dict[str, Any]] | None
                  ) -> None:
         """Loop thread: copy what the panel shows (cheap; FK is done on request)."""
-        snap: dict[str, Any] = {
-            "t": tel.t, "state": tel.state, "tick": tel.tick, "q_cmd": tel.q_cmd,
-            "q_present": tel.q_present, "servo": tel.servo,
-            "period_error_ms": tel.period_error_ms, "overruns": tel.overruns,
-            "amplitude": tel.amplitude, "stop_reason": tel.stop_reason}
-        if not self._ticks or self._ticks[-1][0] != tel.tick:
-            self._ticks.append((tel.tick, tel.t))
+        snap = telemetry_snapshot(tel)
+        self._rate.add(tel.tick, tel.t)
         sim = monitor(tel) if monitor is not None else None
         with self._lock:
             self._tel = snap
@@ -286,10 +263,7 @@ class PanelController:
 
     def loop_rate_hz(self) -> float:
         """Measured ticks per second of the loop's clock over the last ticks [Hz]."""
-        ticks = list(self._ticks)
-        if len(ticks) < 2 or ticks[-1][1] <= ticks[0][1]:
-            return 0.0
-        return (ticks[-1][0] - ticks[0][0]) / (ticks[-1][1] - ticks[0][1])
+        return self._rate.hz()
 
     def state(self) -> dict[str, Any]:
         """A JSON-ready snapshot: loop state and timing, servos, sim metrics, stick figure."""
@@ -299,41 +273,16 @@ class PanelController:
                 idle = self._idle.poll()  # reads (never writes), at most 5 times a second
                 if idle is not None:
                     tel["q_present"], tel["servo"] = idle
-        names = self.robot.joint_names
-        servos = [{"id": j.servo_id, "joint": j.name,
-                   "temperature": s.temperature if s else None,
-                   "load": s.load if s else None,
-                   "errors": sorted(s.errors) if s else []}
-                  for j in self.robot.joints
-                  for s in [tel.get("servo", {}).get(j.servo_id)]]
-        q_cmd, q_present = tel.get("q_cmd") or [], tel.get("q_present")
-        figure = {"cmd": views(self.robot, q_cmd) if len(q_cmd) == len(names) else None,
-                  "present": views(self.robot, q_present)
-                  if q_present and len(q_present) == len(names) else None}
-        return {
-            "running": running, "state": tel.get("state", "idle"), "t": tel.get("t", 0.0),
-            "tick": tel.get("tick", 0), "rate_hz": self.options.rate_hz,
-            "loop_hz": self.loop_rate_hz(), "period_error_ms": tel.get("period_error_ms", 0.0),
-            "overruns": tel.get("overruns", 0), "amplitude": tel.get("amplitude", 0.0),
-            "stop_reason": tel.get("stop_reason"), "joints": list(names),
-            "q_cmd": q_cmd, "q_present": q_present, "servos": servos, "sim": sim or None,
-            "figure": figure, "wall_time": time.time()}
+        return state_snapshot(self.robot, tel, sim, running=running,
+                              rate_hz=self.options.rate_hz, loop_hz=self.loop_rate_hz())
 
     def describe(self) -> dict[str, Any]:
         """Parameters with their specs, grouped as the paper groups its sliders."""
-        p = self._params.as_dict()
-        return {
-            "params": p, "preset": self.preset,
-            "groups": [{"name": g, "params": [
-                {"name": n, "value": p[n], "lo": s.lo, "hi": s.hi, "unit": s.unit,
-                 "default": s.default, "doc": s.doc, "paper": s.paper,
-                 "label": LABELS.get(n, n), "simple": n in SIMPLE}
-                for n, s in SPECS.items() if s.group == g]} for g in GROUPS],
-        }
+        return describe_params(self._params, self.preset)
 
 
 def make_controller(robot: RobotConfig, bus: Bus, params: GaitParams, *,
-                    options: LoopOptions = LoopOptions(),
+                    options: LoopOptions = DEFAULT_OPTIONS,
                     presets: PresetStore | None = None,
                     preset: str | None = None) -> PanelController:
     """A controller for ``bus``, with fall detection when it is the simulated bus."""

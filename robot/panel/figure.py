@@ -11,7 +11,8 @@ import dataclasses
 from collections.abc import Sequence
 from typing import Any
 
-from robot.config.robot_file import ARM_JOINTS, LEG_JOINTS, Geometry, RobotConfig
+from robot.config.joint_names import ARM_JOINTS, LEG_JOINTS
+from robot.config.robot import Geometry, RobotConfig
 from robot.gait.ik import arm_fk_local, hip_centre, leg_fk_full, shoulder_centre
 from robot.gait.xmath import Vec
 

@@ -8,6 +8,8 @@ hold whatever serves the panel:
 - Origin (when a browser sends one): must be the page's own, ``http://<Host>``: 403.
   Comparing with the Host header (already checked) rather than the bound port keeps an
   SSH tunnel (``ssh -L 9000:localhost:8080``) working.
+- Token (when the panel has one): every ``/api/`` path needs ``Authorization: Bearer
+  <token>`` or ``?token=<token>`` (401); the page and its assets are public.
 - POST bodies: ``Content-Type: application/json`` (415; a cross-site form or a no-cors
   fetch cannot send it), a plain ``Content-Length`` of at most ``MAX_BODY`` bytes (400 for
   a malformed one, 413 when larger), no ``Transfer-Encoding`` (411).
@@ -15,8 +17,10 @@ hold whatever serves the panel:
 
 from __future__ import annotations
 
+import hmac
 import re
 import socket
+from collections.abc import Mapping
 from dataclasses import dataclass
 from urllib.parse import urlsplit
 
@@ -95,18 +99,44 @@ def machine_names() -> set[str]:
 
 @dataclass(frozen=True)
 class Guard:
-    """The request checks of one panel. ``names``: Host names it answers to (lowercase)."""
+    """The request checks of one panel. ``names``: Host names it answers to (lowercase);
+    ``token``: the secret every /api request must carry (None: no token asked)."""
 
     names: frozenset[str]
     max_body: int = MAX_BODY
+    token: str | None = None
 
     @classmethod
-    def for_bind(cls, host: str, *, max_body: int = MAX_BODY) -> Guard:
+    def for_bind(cls, host: str, *, token: str | None = None,
+                 max_body: int = MAX_BODY) -> Guard:
         """Loopback names and ``host``; beyond loopback also the machine's names."""
         names = set(LOOPBACK) | {host.lower().strip("[]")}
         if not is_loopback(host):
             names |= machine_names()
-        return cls(frozenset(names - WILDCARD), max_body)
+        return cls(frozenset(names - WILDCARD), max_body, token or None)
+
+    def admit(self, method: str, path: str, query: Mapping[str, list[str]],
+              headers: Mapping[str, str], local_address: str) -> None:
+        """Every check a request passes before any route sees it: Host, Origin, the token
+        (for /api paths), the content type (for POST). ``headers``: lowercase names."""
+        host = headers.get("host")
+        self.check_host(host, local_address)
+        self.check_origin(headers.get("origin"), host or "")
+        if path.startswith("/api/"):
+            self.check_token(query.get("token", [""])[0], headers.get("authorization", ""))
+        if method == "POST":
+            self.check_content_type(headers.get("content-type"))
+
+    def check_token(self, query_token: str, authorization: str) -> None:
+        """Refused 401 unless the Bearer header (else the ``?token=`` query) is the token."""
+        if not self.token:
+            return
+        given = query_token
+        if authorization.startswith("Bearer "):
+            given = authorization[len("Bearer "):].strip()
+        if not hmac.compare_digest(given.encode(), self.token.encode()):
+            raise Refused(401, "missing or wrong token; use Authorization: Bearer <token> "
+                               "or ?token=<token>")
 
     def check_host(self, header: str | None, local_address: str = "") -> str:
         """The request's host name if it is this panel's (or the address the client

@@ -16,9 +16,9 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from robot.config.bundled import user_gaits_dir
+from robot.config.bundled import GAITS_DIR, gait_names, user_gaits_dir
+from robot.config.gait_file import Gait, gait_to_toml, load_gait, parse_gait
 from robot.config.params import GaitParams
-from robot.config.robot_file import GAITS_DIR, Gait, gait_names, gait_to_toml, load_gait, parse_gait
 from robot.errors import ConfigError
 
 log = logging.getLogger(__name__)

@@ -21,7 +21,7 @@ from typing import Any
 import platformdirs
 
 from robot.config.params import GaitParams
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.motion.keyframes import Sequence, load_sequence, parse_sequence, sequence_to_toml

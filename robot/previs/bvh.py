@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.gait.ik import leg_fk_full
 
 Array = npt.NDArray[np.float64]

@@ -22,7 +22,7 @@ import numpy as np
 import numpy.typing as npt
 import pygltflib as gl
 
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.previs.bvh import Bone, root_motion, skeleton, to_bvh
 
 Array = npt.NDArray[np.float64]

@@ -11,7 +11,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from robot.config.robot_file import ANGLE, RobotConfig
+from robot.config.robot import ANGLE, RobotConfig
 
 #: A hand move counts when the joint turned at least this far [rad] (about 6 degrees).
 MOVE_THRESHOLD_RAD = 0.1

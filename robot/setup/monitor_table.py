@@ -13,7 +13,7 @@ from typing import Any
 
 from robot.bus.base import ServoState
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 
 #: Marker for a joint below its min_rad / above its max_rad.
 BELOW, ABOVE = "<MIN", ">MAX"

@@ -19,9 +19,10 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 from robot.bus.sdk_bus import SdkBus
-from robot.bus.tables import BAUD_CODES, BUS_FAMILIES, RETURN_DELAY_UNIT_S, model_name
-from robot.config.robot_file import SERVO_ID, JointConfig, RobotConfig
+from robot.bus.tables import RETURN_DELAY_UNIT_S
+from robot.config.robot import SERVO_ID, JointConfig, RobotConfig
 from robot.errors import BusError, ConfigError
+from robot.servo.models import BAUD_CODES, BUS_FAMILIES, model_name
 
 log = logging.getLogger(__name__)
 

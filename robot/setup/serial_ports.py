@@ -1,27 +1,16 @@
 """Serial adapters on this machine, and which one went away (pure comparison logic).
 
-``list_ports()`` asks pyserial (``serial.tools.list_ports``); everything else is pure and
-works on ``SerialPort`` lists, so tests use fake device lists.
-
-Test hook: when the environment variable ``BIPED_FAKE_PORTS`` names a JSON file,
-``lister_from_env()`` returns a lister that serves its listings instead of the real ones:
-the file holds a list of listings (each a list of ``SerialPort.as_dict()`` objects); each
-call returns the next listing, and the last one again once they run out.
+``list_ports()`` asks pyserial (``serial.tools.list_ports.comports``); everything else is
+pure and works on ``SerialPort`` lists.
 """
 
 from __future__ import annotations
 
-import itertools
-import json
-import os
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, fields
-from pathlib import Path
 from typing import Any
 
 from robot.errors import BipedError
-
-FAKE_PORTS_ENV = "BIPED_FAKE_PORTS"
 
 #: USB vendor ids of common USB-serial chips, for adapters that do not name their maker.
 VENDORS: dict[int, str] = {
@@ -95,29 +84,6 @@ def list_ports() -> list[SerialPort]:
                               manufacturer=p.manufacturer, product=p.product,
                               location=p.location)
                    for p in lp.comports()), key=lambda p: p.device)
-
-
-def fake_lister(path: str | Path) -> PortLister:
-    """A lister serving the listings in the JSON file ``path`` (see the module doc)."""
-    try:
-        data = json.loads(Path(path).read_text())
-        listings = [[SerialPort.from_dict(d) for d in listing] for listing in data]
-    except (OSError, ValueError, TypeError) as e:
-        raise BipedError(f"{FAKE_PORTS_ENV}={path}: expected a JSON list of port "
-                         f"listings ({e})") from e
-    if not listings:
-        raise BipedError(f"{FAKE_PORTS_ENV}={path}: the file holds no listing")
-    calls = itertools.count()
-
-    def lister() -> list[SerialPort]:
-        return list(listings[min(next(calls), len(listings) - 1)])
-    return lister
-
-
-def lister_from_env() -> PortLister:
-    """``fake_lister`` of ``$BIPED_FAKE_PORTS`` when it is set, else ``list_ports``."""
-    path = os.environ.get(FAKE_PORTS_ENV)
-    return fake_lister(path) if path else list_ports
 
 
 def _names(ports: Sequence[SerialPort]) -> str:

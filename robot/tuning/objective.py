@@ -2,8 +2,9 @@
 walk at the requested speed, straight, with low knee load and little energy.
 
 ``evaluate`` walks every condition of the robustness suite (robot.tuning.robustness: `--quick`
-or the full one) in this process, one after the other, through ``robot.cli.main`` (the
-same `biped walk --stop-on-fall` a user runs), with balance on, and scores
+or the full one) in this process, one after the other, through the same run as the
+`biped walk --stop-on-fall` a user runs (robot.tuning.robustness.run_condition: in
+process, a typed result, no files), with balance on, and scores
 
     score = survived + 0.9 * quality,   quality in [0, 1] from the flat walk:
     quality = 0.4 speed + 0.3 straightness + 0.15 (1 - knee load) + 0.15 energy
@@ -19,16 +20,13 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 from robot.config.params import GaitParams
-from robot.config.robot_file import Gait, gait_to_toml
 from robot.errors import ConfigError
-from robot.tuning.robustness import Condition, Outcome, conditions, outcome, run_walk
+from robot.tuning.robustness import Condition, Outcome, WalkJob, conditions, run_condition
 
 QUALITY_WEIGHT = 0.9
 
@@ -113,27 +111,24 @@ def combined(terms: dict[str, float]) -> float:
             + 0.15 * terms["energy"])
 
 
+#: The preset name of a candidate's walks (their summaries' "gait").
+CANDIDATE = "candidate"
+
+
 def evaluate(setup: Setup, params: GaitParams, *,
-             report: Callable[[int, float], None] | None = None,
-             workdir: Path | None = None) -> Evaluation:
+             report: Callable[[int, float], None] | None = None) -> Evaluation:
     """Walk ``params`` through the suite. report(step, running score) after each
     condition may raise to stop early (a pruned trial)."""
     ev = Evaluation()
-    with tempfile.TemporaryDirectory(dir=workdir) as tmp:
-        preset = Path(tmp) / "candidate.toml"
-        preset.write_text(gait_to_toml(Gait(name="candidate", params=params,
-                                            source=str(preset))))
-        for step, c in enumerate(suite_for(setup, params)):
-            secs = setup.seconds if c.seconds is None else c.seconds
-            argv = ["walk", "--json", "--stop-on-fall", "--robot", setup.robot, "--gait",
-                    str(preset), "--seconds", f"{secs:g}", *c.args]
-            ev.outcomes.append(outcome(c, True, *run_walk(argv)))
-            if c.group == "flat":
-                ev.terms = quality(ev.outcomes[-1].summary, setup)
-            ev.score = ev.survived + QUALITY_WEIGHT * combined(ev.terms) if ev.terms else \
-                float(ev.survived)
-            if report is not None:
-                report(step, ev.score)
+    for step, c in enumerate(suite_for(setup, params)):
+        ev.outcomes.append(run_condition(WalkJob(setup.robot, CANDIDATE, params,
+                                                 setup.seconds, c, balance=True)))
+        if c.group == "flat":
+            ev.terms = quality(ev.outcomes[-1].summary, setup)
+        ev.score = ev.survived + QUALITY_WEIGHT * combined(ev.terms) if ev.terms else \
+            float(ev.survived)
+        if report is not None:
+            report(step, ev.score)
     return ev
 
 

@@ -12,8 +12,8 @@ from typing import Any
 
 import optuna
 
+from robot.config.gait_file import Gait, gait_to_toml, load_gait
 from robot.config.params import SPECS, GaitParams
-from robot.config.robot_file import Gait, gait_to_toml, load_gait
 from robot.errors import ConfigError
 from robot.tuning.space import Knob
 

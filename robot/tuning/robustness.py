@@ -1,60 +1,51 @@
 """The robustness suite: simulated walks under perturbations, with and without balance.
 
-Each condition is one ``biped walk --json`` run (``robot.cli.main``: the same code path a
-user runs, so the suite measures the product, not a copy of it), in a pool of worker
-processes, one per core, each running one walk after the other (no interpreter start
-and imports per run). A condition survives when the walk does not fall (sim.mujoco.metrics: torso low or
-tilted past the fall threshold) in ``seconds`` of gait.
+Each condition (robot.tuning.conditions) is one walk built as `biped walk --json
+--stop-on-fall` builds it (robot.run.walk: the same engine, IMU, balance and run, so the
+suite measures the product, not a copy of it), run in this process through
+``robot.run.run.execute``; ``run_suite`` spreads them over a pool of worker processes,
+one per core, each running one walk after the other (no interpreter start and imports
+per run). A condition survives when the walk does not fall (the simulated bus's watch:
+torso low or tilted past the fall threshold) in ``seconds`` of gait.
 """
 
 from __future__ import annotations
 
-import contextlib
-import io
-import json
 import logging
 import math
 import multiprocessing
 import os
-import sys
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from typing import Any
 
-from robot.config.params import SPECS, GaitParams
+from robot.bus.factory import make_bus
+from robot.config.params import GaitParams
+from robot.config.robot_file import load_robot
+from robot.config.world import PUSH_AT_S, PUSH_NS, PUSH_PHASES
+from robot.errors import BipedError
+from robot.run.run import execute
+from robot.run.spec import RunOptions
+from robot.run.walk import walk_imu, walk_spec, walk_summary
+from robot.tuning.conditions import (
+    AFTER_PUSH_S,
+    IMU_NOISE,
+    PARAM_SCALE,
+    SKIP_PARAMS,
+    STRAIGHT_DEG,
+    STRAIGHT_DRIFT,
+    STRAIGHT_S,
+    Condition,
+    check_seconds,
+    conditions,
+    scaled_params,
+)
 
-#: Push impulse of the full suite [N*s] (issue 10's goal) and the gait time of the first
-#: push [s]: well after the ramp-in.
-PUSH_NS = 1.0
-PUSH_AT_S = 8.0
-#: Phases of the step at which pushes land (fractions of a gait cycle).
-PUSH_PHASES = (0.0, 0.25, 0.5, 0.75)
-#: Parameters the +/-20 % conditions change: every non-zero parameter of the preset that
-#: shapes the motion (steering and balance gains are covered by their own conditions).
-PARAM_SCALE = 0.2
-SKIP_PARAMS = frozenset({"speed", "turn", "side_step", "ramp_cycles", "rig_leg", "fps"})
-
-
-#: The straightness goal's walk [s]: heading within STRAIGHT_DEG and lateral drift within
-#: STRAIGHT_DRIFT of the distance over this long on flat ground.
-STRAIGHT_S = 60.0
-STRAIGHT_DEG = 5.0
-STRAIGHT_DRIFT = 0.05
-#: Scales of the sim IMU's datasheet noise and offsets (every run has x1, the robot
-#: file's "realistic" BNO055).
-IMU_NOISE = (2.0, 3.0)
-
-
-@dataclass(frozen=True)
-class Condition:
-    """One perturbation: a name, a group (one bar of the picture) and walk options;
-    seconds: this condition's walk [s] (None: the suite's)."""
-
-    group: str
-    name: str
-    args: tuple[str, ...] = ()
-    seconds: float | None = None
+__all__ = ["AFTER_PUSH_S", "IMU_NOISE", "PARAM_SCALE", "PUSH_AT_S", "PUSH_NS", "PUSH_PHASES",
+           "SKIP_PARAMS", "STRAIGHT_DEG", "STRAIGHT_DRIFT", "STRAIGHT_S", "Condition",
+           "Outcome", "WalkJob", "check_seconds", "conditions", "run_condition", "run_suite",
+           "scaled_params", "straightness", "survival_table", "worker_init"]
 
 
 @dataclass
@@ -71,137 +62,57 @@ class Outcome:
     summary: dict[str, Any] = field(default_factory=dict)
 
 
-def conditions(params: GaitParams, *, quick: bool = False) -> list[Condition]:
-    """The suite for a preset with ``params`` (``quick``: a few cases for CI)."""
-    cycle = params.cycle_s
-    out = [Condition("flat", "flat")]
-    slopes = (5.0, -5.0) if quick else (2.0, 5.0, -2.0, -5.0)
-    out += [Condition("slope", f"slope {s:+g} deg", ("--slope", f"{s:g}")) for s in slopes]
-    crosses = (4.0,) if quick else (4.0, -4.0)
-    out += [Condition("cross slope", f"cross slope {s:+g} deg", ("--cross-slope", f"{s:g}"))
-            for s in crosses]
-    heights, seeds = ((5.0,), (0,)) if quick else ((1.0, 3.0, 5.0), (0, 1, 2))
-    out += [Condition("bumps", f"bumps {h:g} mm seed {s}",
-                      ("--bumps", f"{h:g}", "--terrain-seed", str(s)))
-            for h in heights for s in seeds]
-    phases = (0.0,) if quick else PUSH_PHASES
-    pushes = {"forward": (1, 0), "backward": (-1, 0), "left": (0, 1), "right": (0, -1)}
-    for direction, (ux, uy) in pushes.items():
-        for ph in phases:
-            t = PUSH_AT_S + ph * cycle
-            out.append(Condition(f"push {direction}",
-                                 f"push {PUSH_NS:g} N*s {direction} at phase {ph:g}",
-                                 ("--push", f"{t:.3f}:{ux * PUSH_NS:g},{uy * PUSH_NS:g}")))
-    if not quick:
-        out += scaled_params(params)
-    for ms in ((20.0,) if quick else (10.0, 20.0)):
-        out.append(Condition("latency", f"latency {ms:g} ms", ("--latency", f"{ms:g}")))
-    for scale in (IMU_NOISE[-1:] if quick else IMU_NOISE):
-        out.append(Condition("imu noise", f"imu noise x{scale:g}", ("--imu-noise", f"{scale:g}")))
-    if not quick:
-        out.append(Condition("flat 60 s", f"flat {STRAIGHT_S:g} s", seconds=STRAIGHT_S))
-        out += [Condition("friction", f"friction x{f:g}", ("--friction", f"{f:g}"))
-                for f in (0.5, 2.0)]
-        out += [Condition("mass", f"mass x{m:g}", ("--mass-scale", f"{m:g}"))
-                for m in (0.8, 1.2)]
-    return out
+@dataclass(frozen=True)
+class WalkJob:
+    """One walk of the suite: robot (bundled name or path), the preset's name (for the
+    summary) and its parameters (the condition's changes go on top), the gait seconds
+    unless the condition has its own, the condition, balance on or off."""
 
-
-#: A push needs this long after it [s] to tell a recovery from a slow fall.
-AFTER_PUSH_S = 2.0
-
-
-def check_seconds(conds: Iterable[Condition], seconds: float) -> None:
-    """Refuse runs too short for the latest push to land and be recovered from."""
-    from robot.errors import ConfigError
-
-    last = max((float(c.args[c.args.index("--push") + 1].split(":")[0])
-                for c in conds if "--push" in c.args and c.seconds is None), default=None)
-    if last is not None and seconds < last + AFTER_PUSH_S:
-        raise ConfigError(f"--seconds {seconds:g}: the suite's pushes land up to "
-                          f"{last:.2f} s into the gait; give at least "
-                          f"{last + AFTER_PUSH_S:.1f} s (or leave the pushes out)")
-
-
-def scaled_params(params: GaitParams) -> list[Condition]:
-    """Every shaping parameter of ``params`` +/- PARAM_SCALE, clipped to its documented
-    range (a clipped change is named; one that the range leaves at the preset's value is
-    left out)."""
-    out = []
-    for name, v in params.as_dict().items():
-        if name in SKIP_PARAMS or name.startswith("bal_") or v == 0.0:
-            continue
-        spec = SPECS[name]
-        for sign in (1, -1):
-            want = v * (1 + sign * PARAM_SCALE)
-            got = min(max(want, spec.lo), spec.hi)
-            if got == v:
-                continue
-            label = f"{name} {sign * 20:+d} %" + ("" if got == want else f" (range: {got:g})")
-            out.append(Condition("params +/-20 %", label, ("--set", f"{name}={got!r}")))
-    return out
-
-
-def walk_argv(robot: str, gait: str, seconds: float, condition: Condition, *,
-              balance: bool, base_args: Sequence[str] = ()) -> list[str]:
-    """The ``biped walk`` arguments of one run (``base_args``: e.g. ``--set`` items,
-    before the condition's own, which win)."""
-    argv = ["walk", "--json", "--stop-on-fall", "--robot", robot, "--gait", gait,
-            "--seconds", f"{seconds:g}", *base_args, *condition.args]
-    return argv if balance else [*argv, "--no-balance"]
-
-
-class _Stderr:
-    """A log stream that writes to whatever ``sys.stderr`` is at the time."""
-
-    def write(self, text: str) -> int:
-        return sys.stderr.write(text)
-
-    def flush(self) -> None:
-        sys.stderr.flush()
+    robot: str
+    gait: str
+    params: GaitParams
+    seconds: float
+    condition: Condition
+    balance: bool = True
 
 
 def worker_init() -> None:
+    """A worker process: headless MuJoCo; only errors are logged (the walks' warnings,
+    e.g. a target out of reach, would flood the terminal)."""
     os.environ.setdefault("MUJOCO_GL", "egl")
-    logging.basicConfig(level=logging.WARNING, stream=_Stderr(),  # type: ignore[arg-type]
-                        format="%(levelname)s %(name)s: %(message)s")
+    logging.basicConfig(level=logging.ERROR, format="%(levelname)s %(name)s: %(message)s")
 
 
-def run_walk(argv: Sequence[str]) -> tuple[int, str, str]:
-    """``biped <argv>`` in this process: (exit code, stdout, stderr)."""
-    from robot.cli import main
-
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            code = main(list(argv))
-        except Exception as e:      # a bug in a run must not take the suite down
-            print(f"{type(e).__name__}: {e}", file=sys.stderr)
-            code = 1
-    return code, out.getvalue(), err.getvalue()
-
-
-def outcome(condition: Condition, balance: bool, code: int, stdout: str,
-            stderr: str) -> Outcome:
-    """The ``Outcome`` of one run from its exit code and output."""
-    line = stdout.strip().splitlines()[-1] if stdout.strip() else ""
+def run_condition(job: WalkJob) -> Outcome:
+    """Walk ``job`` in this process (`biped walk --json --stop-on-fall` with the
+    condition's options); a failed run is an Outcome with ``error`` set, never raised."""
+    c = job.condition
     try:
-        r = json.loads(line)
-    except json.JSONDecodeError:
-        err = stderr.strip().splitlines()
-        return Outcome(condition, balance, None,
-                       error=err[-1] if err else f"exit {code}, no summary")
-    return Outcome(condition, balance, bool(r.get("fell")), r.get("fell_at_s"),
+        robot = load_robot(job.robot)
+        params = (job.params.replace(dict(c.changes), where="--set") if c.changes
+                  else job.params)
+        bus = make_bus("sim", robot=robot, realtime=False, view=False, world=c.world)
+        imu = walk_imu(robot, bus, balance=job.balance, noise=c.imu_noise)
+        secs = job.seconds if c.seconds is None else c.seconds
+        spec = walk_spec(robot, params, bus, gait=job.gait, imu=imu,
+                         options=RunOptions(seconds=secs, stop_on_fall=True))
+        r = walk_summary(spec, execute(spec), gait=job.gait)
+    except BipedError as e:
+        return Outcome(c, job.balance, None, error=str(e))
+    except Exception as e:      # a bug in a run must not take the suite down
+        logging.getLogger(__name__).exception("walk %s failed", c.name)
+        return Outcome(c, job.balance, None, error=f"{type(e).__name__}: {e}")
+    return Outcome(c, job.balance, bool(r.get("fell")), r.get("fell_at_s"),
                    float(r.get("distance_m", 0.0)), float(r.get("heading_change_deg", 0.0)),
                    summary=r)
 
 
-def run_suite(robot: str, gait: str, conds: Iterable[Condition], *, seconds: float,
-              balance_modes: Sequence[bool] = (True, False), jobs: int | None = None,
-              progress: Callable[[Outcome], None] | None = None,
-              base_args: Sequence[str] = ()) -> list[Outcome]:
-    """Every condition in every balance mode, ``jobs`` at a time (default: the cores),
-    in suite order."""
+def run_suite(robot: str, gait: str, params: GaitParams, conds: Iterable[Condition], *,
+              seconds: float, balance_modes: Sequence[bool] = (True, False),
+              jobs: int | None = None,
+              progress: Callable[[Outcome], None] | None = None) -> list[Outcome]:
+    """Every condition in every balance mode for preset ``gait`` with ``params`` (its
+    ``--set`` items applied), ``jobs`` at a time (default: the cores), in suite order."""
     work = [(c, b) for c in conds for b in balance_modes]
     jobs = jobs or os.cpu_count() or 1
     # Longest first, so that a long run does not start last and idle the other cores.
@@ -213,15 +124,14 @@ def run_suite(robot: str, gait: str, conds: Iterable[Condition], *, seconds: flo
         futures = {}
         for i in order:
             c, b = work[i]
-            secs = seconds if c.seconds is None else c.seconds
-            argv = walk_argv(robot, gait, secs, c, balance=b, base_args=base_args)
-            futures[pool.submit(run_walk, argv)] = i
+            job = WalkJob(robot, gait, params, seconds, c, balance=b)
+            futures[pool.submit(run_condition, job)] = i
         try:
             for f in as_completed(futures):
                 i = futures[f]
                 c, b = work[i]
                 try:
-                    done[i] = outcome(c, b, *f.result())
+                    done[i] = f.result()
                 except Exception as e:   # the worker died (e.g. killed)
                     done[i] = Outcome(c, b, None, error=f"{type(e).__name__}: {e}")
                 if progress is not None:

@@ -20,7 +20,7 @@ adapter and talk Dynamixel Protocol 2.0 (``sim.emulator.dxl_protocol``) or Feete
   addressed to it; armed, torque on and silent for longer than the setting, it stops
   (goal := present), the register reads -1 and goal writes get a Data Range Error until
   0 is written; torque stays on. Evaluated lazily like motion, so ``registers()`` after a
-  silent gap shows the trip. Feetech STS has no such register (see ``tables.COMM_WATCHDOG``).
+  silent gap shows the trip. Feetech STS has no such register (see ``servo_status.BUS_WATCHDOG``).
 - Log: one :class:`Packet` per instruction packet with a valid checksum that at least one
   servo heard. Broadcast writes log id 254. Written values are decoded little-endian
   (signed for Dynamixel's signed registers); for bulk reads ``values`` maps id → address.
@@ -43,7 +43,6 @@ adapter and talk Dynamixel Protocol 2.0 (``sim.emulator.dxl_protocol``) or Feete
 from __future__ import annotations
 
 import logging
-import math
 import os
 import socket
 import subprocess
@@ -57,11 +56,12 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
-from robot.bus.tables import BUS_FAMILIES, ERROR_BITS, MODELS
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
+from sim.emulator.chain_specs import FACTORY_BAUD, FACTORY_ID, factory_servos, plan_chain
 from sim.emulator.control_tables import BAUD_CODES, TABLES
 from sim.emulator.server import ChainSpec, EmulatorError, Packet
-from sim.emulator.servo import ServoSpec
+from sim.emulator.servo_models import PROTOCOL_FAMILY
+from sim.emulator.servo_status import ERROR_BITS
 
 __all__ = ["ChainSpec", "Emulator", "EmulatorError", "Packet"]
 
@@ -69,31 +69,8 @@ log = logging.getLogger(__name__)
 
 ROOT = Path(__file__).resolve().parents[2]  # puts `sim` and `robot` on the child's path
 
-DEFAULT_MODEL = {"dynamixel": "XL430-W250", "dynamixel1": "AX-12A", "feetech": "STS3215"}
-DEFAULT_BAUD = 1_000_000
-# As shipped: ROBOTIS e-Manual XL430-W250 (Baud Rate(8) initial 1 = 57600, Return Delay
-# Time(9) initial 250 = 500 us, ID(7) initial 1); Feetech STS memory table (ID(5) 1, Baud
-# Rate(6) 0 = 1 Mbps, Return Delay Time(7) 0); e-Manual AX-12A (ID(3) 1, Baud Rate(4) 1 =
-# 1 Mbps, Return Delay Time(5) 250 = 500 us).
-FACTORY_BAUD = {"dynamixel": 57_600, "dynamixel1": 1_000_000, "feetech": 1_000_000}
-FACTORY_RETURN_DELAY = {"dynamixel": 250, "dynamixel1": 250, "feetech": 0}
-FACTORY_ID = 1
 REPLY_TIMEOUT_S = 5.0        # control-channel answer [s]
 START_TIMEOUT_S = 20.0       # child start-up [s]
-
-
-def _limits(robot: RobotConfig | None, servo_id: int, model: str) -> tuple[int, int, int]:
-    """(zero, min, max) [ticks] for ``servo_id`` from the robot's joint, else the full range
-    with the horn at its middle (2048 of 4096; 512 of the AX's 1024)."""
-    resolution = MODELS[model].resolution
-    joint = robot.joint_by_id(servo_id) if robot is not None else None
-    if joint is None:
-        return resolution // 2, 0, resolution - 1
-    per_rad = MODELS[model].ticks_per_rad
-    ends = [joint.zero_ticks + joint.sign * q * per_rad for q in (joint.min_rad, joint.max_rad)]
-    lo = max(0, math.floor(min(ends)))
-    hi = min(resolution - 1, math.ceil(max(ends)))
-    return joint.zero_ticks, lo, hi
 
 
 class Emulator:
@@ -102,36 +79,11 @@ class Emulator:
     def __init__(self, protocol: str, robot: RobotConfig | None = None, *,
                  ids: Sequence[int] | None = None, model: str | None = None, seed: int = 0,
                  baud: int | None = None) -> None:
-        if protocol not in BUS_FAMILIES:
-            raise EmulatorError(f"protocol: expected one of {', '.join(BUS_FAMILIES)}, "
-                                f"got {protocol!r}")
+        choice = plan_chain(protocol, robot, ids=ids, model=model, baud=baud)
         self.protocol = protocol
-        self.family = BUS_FAMILIES[protocol]
-        same_kind = robot is not None and robot.bus.kind == protocol
-        model = model or (robot.bus.model if robot is not None and same_kind
-                          else DEFAULT_MODEL[protocol])
-        if model not in MODELS or MODELS[model].family != self.family:
-            valid = [m for m, s in MODELS.items() if s.family == self.family]
-            raise EmulatorError(f"model: {model!r} is not a {protocol} servo; valid: "
-                                f"{', '.join(valid)}")
-        if ids is None:
-            if robot is None:
-                raise EmulatorError("Emulator needs a robot config or ids=[...]")
-            ids = robot.ids
-        baud = baud or (robot.bus.baud if robot is not None and same_kind else DEFAULT_BAUD)
-        if baud not in BAUD_CODES[self.family].values():
-            raise EmulatorError(f"baud: {baud} is not a {protocol} rate; valid: "
-                                f"{sorted(BAUD_CODES[self.family].values())}")
-        specs = []
-        for sid in ids:
-            joint = robot.joint_by_id(sid) if robot is not None and same_kind else None
-            own = joint.model if joint is not None and joint.model else model  # mixed models
-            zero, lo, hi = _limits(robot, sid, own)
-            specs.append(ServoSpec(sid, own, zero, lo, hi, baud))
-        self.model = model
-        self.baud = baud
-        self.ids = tuple(ids)
-        self.spec = ChainSpec(protocol, tuple(specs), seed)
+        self.family = PROTOCOL_FAMILY[protocol]
+        self.model, self.baud, self.ids = choice.model, choice.baud, choice.ids
+        self.spec = ChainSpec(protocol, choice.servos, seed)
         self._proc: subprocess.Popen[bytes] | None = None
         self._conn: Connection | None = None
         self._port: str | None = None
@@ -151,9 +103,7 @@ class Emulator:
             raise EmulatorError(f"count: expected at least 1 servo, got {count}")
         emu = cls(protocol, ids=[FACTORY_ID] * count, model=model,
                   baud=FACTORY_BAUD[protocol])
-        delay = FACTORY_RETURN_DELAY[protocol]
-        emu.spec = replace(emu.spec, plugged=(),
-                           servos=tuple(replace(s, return_delay=delay) for s in emu.spec.servos))
+        emu.spec = replace(emu.spec, plugged=(), servos=factory_servos(protocol, emu.spec.servos))
         return emu
 
     # ------------------------------------------------------------------ lifecycle
@@ -263,7 +213,7 @@ class Emulator:
         drop_rate / corrupt_rate: share of replies lost / sent with a bad checksum [0..1];
         missing_ids: ids that never answer (replaces the set); vanish: id → seconds from now
         after which it stops answering; hw_error: id → "overheating" | "overload" |
-        "voltage" | ... (names in tables.ERROR_BITS) or None to end the condition;
+        "voltage" | ... (names in servo_status.ERROR_BITS) or None to end the condition;
         stuck_ids: ids whose horn is jammed from now on (they answer, take goals and
         report no error, but do not move; replaces the set);
         close_port: close the pty (the SDK then gets an error; the log stays readable).

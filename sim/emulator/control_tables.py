@@ -199,6 +199,18 @@ TABLES: dict[str, dict[str, Entry]] = {
 }
 EEPROM_END: dict[str, int] = {"dynamixel_x": 64, "dynamixel_p1": 24, "feetech_sts": 40}
 
+#: Values where the manual prints "-" (firmware, sensors, tuning the factory sets per
+#: unit): what this emulator reports. The manual's initial values are in the tables.
+UNPRINTED: dict[str, dict[str, int]] = {
+    "dynamixel_x": {"firmware_version": 46, "present_input_voltage": 115,
+                    "present_temperature": 35},
+    "dynamixel_p1": {"firmware_version": 24, "present_voltage": 120,
+                     "present_temperature": 35, "torque_limit": 1023, "moving_speed": 0},
+    "feetech_sts": {"firmware_major": 3, "firmware_minor": 10, "max_voltage_limit": 140,
+                    "p_coefficient": 32, "d_coefficient": 32, "present_voltage": 74,
+                    "present_temperature": 35},
+}
+
 #: Registers the X manual gives in two's complement.
 DXL_SIGNED: frozenset[str] = frozenset({
     "homing_offset", "bus_watchdog", "goal_pwm", "goal_velocity", "goal_position",

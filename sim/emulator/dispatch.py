@@ -16,7 +16,8 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import NamedTuple
 
-from sim.emulator.servo import EmulatedServo, WriteError, decode_value
+from sim.emulator.servo import EmulatedServo
+from sim.emulator.servo_state import WriteError, decode_value
 from sim.emulator.wire import Handled, Reply, chain_replies, sync_write
 
 PING, READ, WRITE, REG_WRITE, ACTION, FACTORY_RESET, REBOOT, CLEAR = 1, 2, 3, 4, 5, 6, 8, 0x10

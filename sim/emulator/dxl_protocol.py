@@ -13,7 +13,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from sim.emulator import dispatch
-from sim.emulator.servo import EmulatedServo, WriteError
+from sim.emulator.servo import EmulatedServo
+from sim.emulator.servo_state import WriteError
 from sim.emulator.wire import FrameParser, Handled, Reply
 
 HEADER = b"\xff\xff\xfd\x00"

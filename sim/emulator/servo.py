@@ -10,53 +10,28 @@ Motion is evaluated lazily: call :meth:`EmulatedServo.update` with the current t
 before touching the table; present position then moves toward goal position
 (``sim.emulator.servo_motion``) while torque is enabled.
 
-Communication watchdog (Dynamixel X "Bus Watchdog", ``tables.COMM_WATCHDOG``): the chain
-calls :meth:`EmulatedServo.hear` for every instruction packet addressed to the servo (its id,
-broadcast, or listed in a sync/bulk packet; the manual counts "all the Instruction Packet",
-which may include packets for other ids: the stricter reading is modelled, so a host that
-forgets a servo sees it trip). When the register is armed (1..127), torque is on and the gap
-since the last packet exceeds the setting, :meth:`update` stops the servo at the moment the
-gap ran out (goal := present), the register reads -1 and goal writes are refused with a
-range error until 0 (or a new setting) is written. Torque is left as it was.
+Communication watchdog (``servo_status.BUS_WATCHDOG``): the chain calls
+:meth:`EmulatedServo.hear` for every instruction packet addressed to the servo (its id,
+broadcast, or listed in a sync/bulk packet); :meth:`update` trips it (goal := present where
+the gap ran out, register -1, goal writes refused) and leaves torque as it was.
 """
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass
 
-from robot.bus.tables import COMM_WATCHDOG, ERROR_BITS, MODELS, RETURN_DELAY_UNIT_S
 from sim.emulator import servo_motion, servo_write
-from sim.emulator.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, Entry
-
-#: Values where the manual prints "-" (firmware, sensors, tuning the factory sets per
-#: unit): what this emulator reports. The manual's initial values come from the table.
-UNPRINTED: dict[str, dict[str, int]] = {
-    "dynamixel_x": {"firmware_version": 46, "present_input_voltage": 115,
-                    "present_temperature": 35},
-    "dynamixel_p1": {"firmware_version": 24, "present_voltage": 120,
-                     "present_temperature": 35, "torque_limit": 1023, "moving_speed": 0},
-    "feetech_sts": {"firmware_major": 3, "firmware_minor": 10, "max_voltage_limit": 140,
-                    "p_coefficient": 32, "d_coefficient": 32, "present_voltage": 74,
-                    "present_temperature": 35},
-}
-
-
-class WriteError(enum.Enum):
-    """Why a write was refused; each codec maps it to its protocol's error code."""
-
-    NONE = 0
-    ACCESS = 1       # read-only, unknown or EEPROM-while-torque-on address
-    RANGE = 2        # value outside the register's allowed range
-    LIMIT = 3        # goal outside the position limits
-    LENGTH = 4       # the write covers part of a register
+from sim.emulator.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, UNPRINTED, Entry
+from sim.emulator.servo_models import MODELS
+from sim.emulator.servo_state import WriteError
+from sim.emulator.servo_status import BUS_WATCHDOG, ERROR_BITS, RETURN_DELAY_UNIT_S
 
 
 @dataclass(frozen=True)
 class ServoSpec:
     """What the emulator needs to build one servo.
 
-    servo_id: bus id; model: key of ``tables.MODELS``; zero_ticks: initial present
+    servo_id: bus id; model: key of ``servo_models.MODELS``; zero_ticks: initial present
     position [ticks]; min_ticks/max_ticks: position limits [ticks]; baud: [bit/s];
     return_delay: Return Delay Time register [raw steps] (0: a chain already set up).
     """
@@ -79,10 +54,10 @@ class EmulatedServo:
         self.family = self.model.family
         self.table: dict[str, Entry] = TABLES[self.family]
         self.mem = bytearray(max(r.address + r.size for r in self.table.values()))
-        self._owner = bytearray(len(self.mem))  # 0: no register; else index+1
-        self._regs = list(self.table.items())
-        for i, (_, reg) in enumerate(self._regs):
-            self._owner[reg.address:reg.address + reg.size] = bytes([i + 1]) * reg.size
+        self.owner = bytearray(len(self.mem))  # 0: no register; else index+1
+        self.regs = list(self.table.items())
+        for i, (_, reg) in enumerate(self.regs):
+            self.owner[reg.address:reg.address + reg.size] = bytes([i + 1]) * reg.size
         self.conditions: set[str] = set()   # injected hardware faults (names of ERROR_BITS)
         self.stuck = False                  # injected jam: the horn does not move
         self.speed_tps = self.model.no_load_speed * self.model.ticks_per_rad
@@ -106,7 +81,7 @@ class EmulatedServo:
             self.set(name, v)
         self._pos = float(spec.zero_ticks)
         self._t = now
-        self.watchdog = COMM_WATCHDOG[self.family]
+        self.watchdog = BUS_WATCHDOG[self.family]
         self.heard = now    # time of the last instruction packet addressed to this servo [s]
         self.eeprom_end = EEPROM_END[self.family]   # EEPROM below, RAM from here
         self._saved = bytes(self.mem[:self.eeprom_end])   # EEPROM as kept over power-off
@@ -134,10 +109,7 @@ class EmulatedServo:
 
     def set(self, name: str, value: int) -> None:
         """Store a register by name without any check (the emulator's back door)."""
-        reg = self.table[name]
-        bits = 8 * reg.size
-        self.mem[reg.address:reg.address + reg.size] = (value % (1 << bits)).to_bytes(
-            reg.size, "little")
+        self.set_raw(name, value)
         if name == "present_position":
             self._pos = float(self.get(name))
 
@@ -175,24 +147,16 @@ class EmulatedServo:
         wd = self.watchdog
         return wd is not None and self.get(wd.register) == wd.tripped
 
-    def _watchdog_deadline(self) -> float | None:
-        """When the armed watchdog trips if nothing is heard [s], else None."""
-        wd = self.watchdog
-        if wd is None or not self.get("torque_enable"):
-            return None
-        steps = self.get(wd.register)
-        if not wd.steps[0] <= steps <= wd.steps[1]:
-            return None
-        return self.heard + steps * wd.unit_s
-
     def update(self, now: float) -> None:
         """Advance the position model (and the watchdog) to ``now`` [s, time.monotonic()]."""
         self._assert_faults()
-        deadline = self._watchdog_deadline()
-        if self.watchdog is not None and deadline is not None and deadline < now:
+        wd = self.watchdog
+        deadline = None if wd is None else wd.deadline(
+            self.get(wd.register), torque_on=bool(self.get("torque_enable")), heard=self.heard)
+        if wd is not None and deadline is not None and deadline < now:
             self._advance(max(deadline, self._t))
             self.set("goal_position", round(self._pos))   # stop where it is
-            self.set(self.watchdog.register, self.watchdog.tripped)
+            self.set(wd.register, wd.tripped)
         self._advance(now)
 
     def _advance(self, now: float) -> None:
@@ -227,7 +191,7 @@ class EmulatedServo:
         bytes read the byte their Indirect Address points at."""
         if address < 0 or length < 0 or address + length > len(self.mem):
             return None
-        if length and not any(self._owner[address:address + length]):
+        if length and not any(self.owner[address:address + length]):
             return None
         out = bytearray(self.mem[address:address + length])
         for i in range(length):
@@ -329,10 +293,3 @@ class EmulatedServo:
         self.pending = None
         self._assert_faults()
 
-
-def decode_value(family: str, address: int, data: bytes) -> int:
-    """A written value as the log shows it: little-endian, signed for signed registers."""
-    signed = family == "dynamixel_x" and any(
-        reg.address == address and reg.size == len(data) and name in DXL_SIGNED
-        for name, reg in TABLES[family].items())
-    return int.from_bytes(data, "little", signed=signed)

@@ -11,12 +11,9 @@ Position, Moving, Present Velocity (X, signed, 0.229 rev/min) / Present Speed (S
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 from sim.emulator.control_tables import DXL_VELOCITY_UNIT_RPM, STS_SPEED_UNIT_TICKS_S
-
-if TYPE_CHECKING:
-    from sim.emulator.servo import EmulatedServo
+from sim.emulator.servo_state import ServoState
 
 STS_DIRECTION_BIT = 0x8000
 #: AX-12A Moving Speed(32) / Present Speed(38): 0.111 rev/min per unit, bits 0-9; bit 10
@@ -33,7 +30,7 @@ def dxl_velocity_unit_ticks_s(resolution: int) -> float:
     return DXL_VELOCITY_UNIT_RPM * resolution / 60.0
 
 
-def speed_ticks_s(servo: EmulatedServo) -> float:
+def speed_ticks_s(servo: ServoState) -> float:
     """How fast the horn travels now [ticks/s]."""
     top = servo.speed_tps
     if servo.family == "dynamixel_x":
@@ -49,7 +46,7 @@ def speed_ticks_s(servo: EmulatedServo) -> float:
     return min(top, gs * STS_SPEED_UNIT_TICKS_S) if gs > 0 else top
 
 
-def advance(servo: EmulatedServo, pos: float, dt: float) -> float:
+def advance(servo: ServoState, pos: float, dt: float) -> float:
     """Move from ``pos`` [ticks] for ``dt`` [s]; update the feedback registers; new pos."""
     goal = servo.get("goal_position")
     torque = bool(servo.get("torque_enable"))

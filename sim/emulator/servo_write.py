@@ -11,12 +11,8 @@ on a goal with Torque Enable 0, which Feetech's own examples rely on).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 from sim.emulator.control_tables import BAUD_CODES, INDIRECT_TARGET_RANGE, Entry, read_only
-
-if TYPE_CHECKING:
-    from sim.emulator.servo import EmulatedServo, WriteError
+from sim.emulator.servo_state import ServoState, WriteError, decode_value
 
 READ_ONLY: dict[str, frozenset[str]] = {
     fam: read_only(fam) for fam in ("dynamixel_x", "dynamixel_p1", "feetech_sts")}
@@ -31,19 +27,17 @@ VALID_RANGE: dict[str, tuple[int, int]] = {
 POSITION_MODE = {"dynamixel_x": 3, "feetech_sts": 0}
 
 
-def plan(servo: EmulatedServo, address: int, data: bytes) -> tuple[WriteError, dict[str, int]]:
+def plan(servo: ServoState, address: int, data: bytes) -> tuple[WriteError, dict[str, int]]:
     """(error, name -> value to store); nothing is changed."""
-    from sim.emulator.servo import WriteError, decode_value
-
     end = address + len(data)
     if address < 0 or end > len(servo.mem) or not data:
         return WriteError.ACCESS, {}
     touched: list[tuple[str, Entry]] = []
     for a in range(address, end):
-        owner = servo._owner[a]
+        owner = servo.owner[a]
         if not owner:
             return WriteError.ACCESS, {}
-        name, reg = servo._regs[owner - 1]
+        name, reg = servo.regs[owner - 1]
         if not touched or touched[-1][0] != name:
             touched.append((name, reg))
     if touched[0][1].address < address or touched[-1][1].address + touched[-1][1].size > end:
@@ -68,9 +62,7 @@ def plan(servo: EmulatedServo, address: int, data: bytes) -> tuple[WriteError, d
     return WriteError.NONE, values
 
 
-def check(servo: EmulatedServo, name: str, value: int) -> WriteError:
-    from sim.emulator.servo import WriteError
-
+def check(servo: ServoState, name: str, value: int) -> WriteError:
     lo_hi = VALID_RANGE.get(name)
     if name.startswith("indirect_address"):
         lo_hi = INDIRECT_TARGET_RANGE
@@ -79,8 +71,7 @@ def check(servo: EmulatedServo, name: str, value: int) -> WriteError:
     if name == "baud_rate" and value not in BAUD_CODES[servo.family]:
         return WriteError.RANGE
     wd = servo.watchdog
-    if wd is not None and name == wd.register and not (
-            value == wd.off or wd.steps[0] <= value <= wd.steps[1]):
+    if wd is not None and name == wd.register and not wd.accepts(value):
         return WriteError.RANGE
     if name == "goal_position" and servo.watchdog_tripped:
         return WriteError.RANGE     # goals are read-only until the watchdog is cleared
@@ -94,7 +85,7 @@ def check(servo: EmulatedServo, name: str, value: int) -> WriteError:
     return WriteError.NONE
 
 
-def apply(servo: EmulatedServo, values: dict[str, int]) -> None:
+def apply(servo: ServoState, values: dict[str, int]) -> None:
     """Store planned values (torque stays off while an X servo is in shutdown)."""
     shutdown = servo.family == "dynamixel_x" and servo.get("hardware_error_status") != 0
     for name, v in values.items():

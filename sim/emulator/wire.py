@@ -10,7 +10,8 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from typing import NamedTuple
 
-from sim.emulator.servo import EmulatedServo, decode_value
+from sim.emulator.servo import EmulatedServo
+from sim.emulator.servo_state import decode_value
 
 
 class Reply(NamedTuple):

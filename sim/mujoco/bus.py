@@ -24,12 +24,15 @@ import numpy.typing as npt
 
 from robot.bus.base import Bus, ServoInfo, ServoState
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
+from robot.config.world import World
 from robot.errors import BusError
 from sim.mujoco.mjcf import FOOT_GEOMS, build_mjcf, standing_qpos
+from sim.mujoco.observation import BodyObservation
+from sim.mujoco.run_watch import SimRunWatch
 from sim.mujoco.servos import AMBIENT_C, SimServos
 from sim.mujoco.view import OffscreenRenderer, SimClock, WallPacer, check_display, launch_viewer
-from sim.mujoco.world import PUSH_WINDOW_S, TimedForces, World
+from sim.mujoco.world import PUSH_WINDOW_S, TimedForces
 from sim.mujoco.world_scene import apply_world_to_model, place_on_floor
 
 __all__ = ["AMBIENT_C", "MujocoBus", "SimClock"]
@@ -41,13 +44,13 @@ _OVERLOAD = frozenset({"overload"})
 _NO_ERRORS: frozenset[str] = frozenset()
 
 
-class MujocoBus(Bus):
+class MujocoBus(BodyObservation, Bus):
     """Simulated servo chain for ``robot`` (see the module docstring for the servo model).
 
     realtime: also wait on the wall clock so the sim runs at 1x; view: open the passive
     viewer (needs a display); timestep: physics step [s] (default 0.002); pose: start pose
     {joint: rad} instead of the ``home`` keyframe (standing, soles on the floor); world:
-    perturbations (``sim.mujoco.world.World``: slope, bumps, latency, friction, mass; pushes via
+    perturbations (``robot.config.world.World``: slope, bumps, latency, friction, mass; pushes via
     ``push`` / ``sim.mujoco.world.PushScheduler``), None for the plain scene.
     """
 
@@ -144,6 +147,12 @@ class MujocoBus(Bus):
     def floor_normal(self) -> tuple[float, float, float]:
         """Unit normal of the floor plane through the origin (world frame)."""
         return self.world.floor_normal() if self.world is not None else (0.0, 0.0, 1.0)
+
+    def run_watch(self) -> SimRunWatch:
+        """A watch for one run on the open bus (robot.run.spec.WatchedBus)."""
+        return SimRunWatch(self.model, self.data, self.robot, world=self.world,
+                           standing_height=self.standing_height,
+                           floor_normal=self.floor_normal, push_target=self)
 
     @property
     def model(self) -> mujoco.MjModel:
@@ -285,33 +294,3 @@ class MujocoBus(Bus):
                     opt.timestep = dt
             else:
                 mujoco.mj_step(m, d, int(remaining / dt + 1e-6) if servos.settled else 1)
-
-    # ------------------------------------------------------------------ observation
-
-    def base_pose(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-        """Torso (pelvis frame) position [m] and orientation quaternion (w, x, y, z)."""
-        q = self.data.qpos
-        return q[0:3].copy(), q[3:7].copy()
-
-    def upright_angle(self) -> float:
-        """Angle between the torso's z axis and world z [rad] (0 upright, pi/2 lying)."""
-        _, x, y, _ = self.data.qpos[3:7]
-        qn = float(np.dot(self.data.qpos[3:7], self.data.qpos[3:7]))
-        return math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (x * x + y * y) / qn)))
-
-    def contacts_feet(self) -> tuple[bool, bool]:
-        """(right, left): is each foot box touching the ground (floor or a bump; as of the
-        last step)."""
-        d = self.data
-        pairs = d.contact.geom[: d.ncon]
-        ground = np.isin(pairs, self._ground)
-        touching = []
-        for foot in self._feet:
-            hit = ((pairs[:, 0] == foot) & ground[:, 1]) | ((pairs[:, 1] == foot) & ground[:, 0])
-            touching.append(bool(hit.any()))
-        return touching[0], touching[1]
-
-    def render(self, width: int, height: int, camera: str = "track") -> npt.NDArray[np.uint8]:
-        """An offscreen RGB frame (height, width, 3) of the current state (needs MUJOCO_GL
-        set, e.g. egl, before mujoco is imported). Reuses one renderer per size."""
-        return self._renderer.render(self.model, self.data, width, height, camera)

@@ -25,10 +25,11 @@ import mujoco
 import numpy as np
 
 from robot.bus.servo_map import ServoMap
-from robot.config.robot_file import load_gait, load_robot
+from robot.config.gait_file import load_gait
+from robot.config.robot_file import load_robot
+from robot.config.world import PUSH_AT_S, PUSH_PHASES
 from robot.gait.engine import GaitEngine
 from robot.loop.streamer import Streamer, Telemetry
-from robot.tuning.robustness import PUSH_AT_S, PUSH_PHASES
 from sim.mujoco.bus import FOOT_GEOMS, MujocoBus
 from sim.mujoco.world import PUSH_WINDOW_S
 

@@ -13,7 +13,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 
 KNEES = ("r_knee", "l_knee")
 

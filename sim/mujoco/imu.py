@@ -34,10 +34,10 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from robot.config.imu_file import ImuConfig
 from robot.errors import BipedError, ConfigError
 from robot.imu.base import STANDARD_GRAVITY, Imu, ImuError, ImuSample, Quat
-from robot.imu.config import ImuConfig
-from robot.imu.frames import quat_mul, quat_normalize
+from robot.imu.frames import Mount, quat_mul, quat_normalize
 
 #: Sensor names in the MJCF (sim/mjcf_robot.add_actuators_and_sensors) and their sizes.
 SENSORS = {"gyro": ("imu_gyro", 3), "accel": ("imu_accelerometer", 3),
@@ -72,7 +72,7 @@ class SimImu(Imu):
     def __init__(self, bus: Any, config: ImuConfig) -> None:
         self.bus = bus
         self.config = config
-        self._mount = config.mount
+        self._mount = Mount.from_rpy_deg(config.mount_rpy_deg)
         self._adr: dict[str, int] | None = None
         self._buffer: deque[ImuSample] = deque()
         self._rng = np.random.default_rng(config.seed)

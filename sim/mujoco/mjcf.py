@@ -27,7 +27,7 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from sim.mujoco.mjcf_robot import add_actuators_and_sensors, add_assets, add_defaults, add_worldbody, fmt
 

@@ -1,6 +1,6 @@
 """The robot's MJCF element tree: defaults (servo model + joint groups), bodies, actuators.
 
-Kinematic chain exactly as ``robot.config.robot_file.Geometry`` documents it; every body frame is
+Kinematic chain exactly as ``robot.config.robot.Geometry`` documents it; every body frame is
 parallel to the pelvis frame at zero pose, so every joint axis is +x, +y or +z of the
 pelvis frame (right-hand rule). Link masses come from ``Masses`` as explicit
 ``<inertial>`` elements (solid boxes sized by the geometry and the servo's size).
@@ -11,8 +11,9 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from typing import NamedTuple
 
-from robot.bus.tables import ServoModel
-from robot.config.robot_file import JOINT_NAMES, RobotConfig
+from robot.config.joint_names import JOINT_NAMES
+from robot.config.robot import RobotConfig
+from robot.servo.models import ServoModel
 
 AXES = {"hip_yaw": "0 0 1", "hip_roll": "1 0 0", "hip_pitch": "0 1 0", "knee": "0 1 0",
         "ankle_pitch": "0 1 0", "ankle_roll": "1 0 0", "shoulder_pitch": "0 1 0",

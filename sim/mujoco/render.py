@@ -19,7 +19,7 @@ import numpy.typing as npt
 
 from robot.bus.servo_map import ServoMap
 from robot.config.params import GaitParams
-from robot.config.robot_file import RobotConfig
+from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.loop.streamer import Streamer, Telemetry

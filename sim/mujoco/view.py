@@ -6,7 +6,7 @@ from __future__ import annotations
 import logging
 import os
 import time
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import mujoco
 import numpy as np
@@ -14,19 +14,25 @@ import numpy.typing as npt
 
 from robot.errors import BusError
 
-if TYPE_CHECKING:
-    from sim.mujoco.bus import MujocoBus
-
 log = logging.getLogger(__name__)
 
 VIEW_SYNC_S = 1 / 60  # viewer refresh period [wall s]
 REANCHOR_LAG_S = 0.25  # realtime: behind the wall clock by more than this → re-anchor [s]
 
 
+class Stepped(Protocol):
+    """What the clock needs of the MuJoCo bus: its data (``time`` [s]) and ``advance``."""
+
+    @property
+    def data(self) -> mujoco.MjData: ...
+
+    def advance(self, deadline: float) -> None: ...
+
+
 class SimClock:
     """``robot.loop.clock.Clock`` on simulation time: ``sleep_until`` steps the physics."""
 
-    def __init__(self, bus: MujocoBus) -> None:
+    def __init__(self, bus: Stepped) -> None:
         self._bus = bus
 
     def now(self) -> float:

@@ -16,13 +16,12 @@ fusion = true                # sim: report the fused quaternion (false: gyro+acc
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
 
-from robot.config.toml_io import Range, build, number, show, spec, table
+from robot.config.plugins import Registry
+from robot.config.toml_io import Range, TomlValue, build, number, show, spec, table
 from robot.errors import ConfigError
-from robot.imu.frames import Mount
 
 #: noise / bias: a scale of the BNO055 datasheet figures; 0 turns it off, 100 is absurd.
 SCALE = Range(0.0, 100.0)
@@ -38,6 +37,19 @@ SIM_ONLY = ("noise", "bias", "latency_ms", "seed", "fusion")
 SERIAL_ONLY = ("port",)
 #: The built-in serial device kinds.
 SERIAL_KINDS = ("bno055",)
+#: Entry-point group where IMU plugins are declared.
+ENTRY_POINT_GROUP = "biped.imus"
+
+#: IMU backends by kind: the built-in ones, the entry points of group ``biped.imus`` and the
+#: ones registered at run time (``robot.imu.kinds.register_imu``). Each is a callable
+#: ``(config: ImuConfig, *, bus) -> robot.imu.base.Imu``; the factory checks what it returns.
+IMU_BACKENDS: Registry[Callable[..., object]] = Registry(ENTRY_POINT_GROUP, SERIAL_KINDS,
+                                                       "imu.kind")
+
+
+def imu_kinds() -> tuple[str, ...]:
+    """Every IMU kind a robot file may name: plugins (registered or declared), then built-in."""
+    return IMU_BACKENDS.kinds()
 
 
 @dataclass(frozen=True)
@@ -61,16 +73,10 @@ class ImuConfig:
     seed: int = field(default=0, metadata=spec(SEED))
     fusion: bool = True
 
-    @property
-    def mount(self) -> Mount:
-        return Mount.from_rpy_deg(self.mount_rpy_deg)
 
-
-def parse_imu(src: str, data: Any) -> ImuConfig:
+def parse_imu(src: str, data: TomlValue) -> ImuConfig:
     """The ``[imu]`` table of robot file ``src``, validated."""
-    from robot.imu.factory import imu_kinds
-
-    tab: Mapping[str, Any] = table(src, "imu", data)
+    tab = table(src, "imu", data)
     valid = [f for f in ImuConfig.__dataclass_fields__]
     unknown = sorted(set(tab) - set(valid))
     if unknown:
@@ -98,15 +104,13 @@ def parse_imu(src: str, data: Any) -> ImuConfig:
     if not isinstance(fusion, bool):
         raise ConfigError(f"{src}: imu.fusion: expected true or false, got {show(fusion)}")
     flat = {k: v for k, v in tab.items() if k not in ("mount_rpy_deg", "fusion")}
-    cfg: ImuConfig = build(ImuConfig, src, "imu", flat,
-                           overrides={"mount_rpy_deg": mount, "fusion": fusion})
-    return cfg
+    return build(ImuConfig, src, "imu", flat, overrides={"mount_rpy_deg": mount, "fusion": fusion})
 
 
-def _mount(src: str, value: Any) -> tuple[float, float, float]:
+def _mount(src: str, value: TomlValue) -> tuple[float, float, float]:
     path = "imu.mount_rpy_deg"
     if not isinstance(value, list) or len(value) != 3:
         raise ConfigError(f"{src}: {path}: expected [roll, pitch, yaw] in degrees, each in "
                           f"{MOUNT_DEG}, got {show(value)}")
     r, p, y = (number(src, f"{path}[{i}]", v, MOUNT_DEG) for i, v in enumerate(value))
-    return (float(r), float(p), float(y))
+    return (r, p, y)

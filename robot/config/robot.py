@@ -1,0 +1,190 @@
+"""The robot file's contents as frozen dataclasses: bus, geometry, masses, joints, and the
+robot that holds them (read and validated by robot/config/robot_file.py).
+
+Frames: REP-103 (x forward, y left, z up); lengths [m], masses [kg], angles [rad].
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from functools import cached_property
+
+from robot.config.imu_file import ImuConfig
+from robot.config.joint_names import ARM_NAMES, JOINT_NAMES, LEG_NAMES
+from robot.config.toml_io import Range, spec
+from robot.errors import ConfigError
+from robot.servo.models import MODELS, ServoModel
+
+# Valid ranges of the numeric fields (checked at load; see robot/config/toml_io.py).
+#: bus.retries: extra attempts per transaction; more than 10 only hides a broken bus.
+RETRIES = Range(0, 10)
+#: bus.timeout_ms: reply timeout; under 1 ms nothing answers, over 1 s the loop is dead.
+TIMEOUT_MS = Range(1.0, 1000.0, "ms")
+#: Geometry: 1 mm (no servo link is smaller; 0 divides by zero in IK) to 2 m.
+LENGTH = Range(0.001, 2.0, "m")
+#: Link masses: 1 g to 100 kg.
+MASS = Range(0.001, 100.0, "kg")
+#: Joint limits: one turn, centred on zero.
+ANGLE = Range(-math.pi, math.pi, "rad", label="[-pi, pi]")
+#: Slew limit: 0.05 rad/s (3 deg/s: a 2 pi ramp still ends within 4 min) to 20 rad/s (above
+#: the no-load speed of every hobby servo in tables.MODELS).
+SPEED = Range(0.05, 20.0, "rad/s")
+#: Servo ids: 0..252 (253..255 are broadcast / reserved in both protocols).
+SERVO_ID = Range(0, 252)
+
+
+@dataclass(frozen=True)
+class BusConfig:
+    """kind: "dynamixel" | "feetech"; model: servo model name; port: device; baud [bit/s]."""
+
+    kind: str
+    model: str
+    port: str = "/dev/ttyUSB0"
+    baud: int = 1_000_000
+    retries: int = field(default=2, metadata=spec(RETRIES))
+    timeout_ms: float = field(default=20.0, metadata=spec(TIMEOUT_MS))
+
+    @property
+    def servo(self) -> ServoModel:
+        return MODELS[self.model]
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Kinematic dimensions [m]. Frames: REP-103 (x forward, y left, z up).
+
+    The pelvis frame's origin is midway between the two hip joint centres. All three hip
+    axes (yaw z, roll x, pitch y) meet at the hip centre; the knee is ``thigh`` below it,
+    the ankle (pitch y, roll x) ``shin`` below the knee, the sole ``ankle_height`` below
+    the ankle. Shoulders (pitch y, roll x) sit ``torso_height`` above the pelvis origin and
+    ``shoulder_width / 2`` to each side; the elbow (y) is ``upper_arm`` below, the hand
+    ``forearm`` below the elbow.
+    """
+
+    hip_width: float = field(metadata=spec(LENGTH))
+    thigh: float = field(metadata=spec(LENGTH))
+    shin: float = field(metadata=spec(LENGTH))
+    ankle_height: float = field(metadata=spec(LENGTH))
+    foot_length: float = field(metadata=spec(LENGTH))
+    foot_width: float = field(metadata=spec(LENGTH))
+    foot_forward: float = field(metadata=spec(LENGTH))
+    torso_height: float = field(metadata=spec(LENGTH))
+    torso_depth: float = field(metadata=spec(LENGTH))
+    shoulder_width: float = field(default=0.0, metadata=spec(LENGTH))  # arms only
+    upper_arm: float = field(default=0.0, metadata=spec(LENGTH))       # arms only
+    forearm: float = field(default=0.0, metadata=spec(LENGTH))         # arms only
+
+    @property
+    def leg_length(self) -> float:
+        """Hip centre to ankle with straight knee [m]."""
+        return self.thigh + self.shin
+
+
+@dataclass(frozen=True)
+class Masses:
+    """Link masses including the servos they carry [kg]."""
+
+    torso: float = field(metadata=spec(MASS))
+    hip_yaw_link: float = field(metadata=spec(MASS))
+    hip_roll_link: float = field(metadata=spec(MASS))
+    thigh: float = field(metadata=spec(MASS))
+    shin: float = field(metadata=spec(MASS))
+    ankle_link: float = field(metadata=spec(MASS))
+    foot: float = field(metadata=spec(MASS))
+    upper_arm: float = field(default=0.0, metadata=spec(MASS))   # arms only
+    forearm: float = field(default=0.0, metadata=spec(MASS))     # arms only
+    shoulder_link: float = field(default=0.03, metadata=spec(MASS))
+
+    @property
+    def total(self) -> float:
+        leg = (self.hip_yaw_link + self.hip_roll_link + self.thigh + self.shin
+               + self.ankle_link + self.foot)
+        arm = self.shoulder_link + self.upper_arm + self.forearm if self.upper_arm else 0.0
+        return self.torso + 2 * leg + 2 * arm
+
+
+@dataclass(frozen=True)
+class JointConfig:
+    """One joint and its servo.
+
+    servo_id: bus id; sign: +1/-1 (servo direction vs joint axis); zero_ticks: ticks at
+    0 rad; min_rad, max_rad: joint limits [rad]; max_speed_rad_s: slew limit [rad/s];
+    model: this joint's servo model when it differs from ``bus.model`` (same family, e.g.
+    stronger knees); fixed_rad: an extra joint (head pan, tilt, ...) held at this angle
+    [rad] while the gait runs (only for joints the gait does not drive).
+    """
+
+    name: str
+    servo_id: int = field(metadata=spec(SERVO_ID))
+    sign: int
+    zero_ticks: int
+    min_rad: float = field(metadata=spec(ANGLE))
+    max_rad: float = field(metadata=spec(ANGLE))
+    max_speed_rad_s: float = field(metadata=spec(SPEED))
+    model: str | None = None
+    fixed_rad: float | None = field(default=None, metadata=spec(ANGLE))
+
+
+@dataclass(frozen=True)
+class RobotConfig:
+    name: str
+    bus: BusConfig
+    geometry: Geometry
+    mass: Masses
+    joints: tuple[JointConfig, ...]
+    rest: Mapping[str, float] = field(default_factory=dict)
+    source: str = "<memory>"
+    #: The ``[imu]`` section (optional; robot.config.imu_file): None when the robot has no IMU.
+    imu: ImuConfig | None = None
+    #: The ``[balance]`` section (optional): balance gains (robot/config/params.py group
+    #: "balance feedback") for this robot; a gait preset that names a gain itself, and
+    #: --set, take precedence.
+    balance: Mapping[str, float] = field(default_factory=dict)
+
+    def joint(self, name: str) -> JointConfig:
+        for j in self.joints:
+            if j.name == name:
+                return j
+        raise ConfigError(f"{self.source}: no joint {name!r}; valid: "
+                          f"{', '.join(j.name for j in self.joints)}")
+
+    @cached_property
+    def joint_names(self) -> tuple[str, ...]:
+        return tuple(j.name for j in self.joints)
+
+    @cached_property
+    def has_arms(self) -> bool:
+        return any(j.name in ARM_NAMES for j in self.joints)
+
+    @cached_property
+    def has_hip_yaw(self) -> bool:
+        """False for 5-DoF legs (no hip yaw: the gait cannot turn by yawing the feet)."""
+        return "r_hip_yaw" in self.joint_names
+
+    def servo(self, joint: JointConfig) -> ServoModel:
+        """The servo model of ``joint`` (its own ``model``, else the bus's)."""
+        return MODELS[joint.model or self.bus.model]
+
+    @cached_property
+    def layout(self) -> tuple[tuple[int, float], ...] | None:
+        """How the engine's full joint vector (``JOINT_NAMES`` order, legs then arms) maps
+        onto this robot's joints: per joint (index into it, or -1 and the fixed angle).
+        None when the robot is exactly the leading part of ``JOINT_NAMES`` (no mapping)."""
+        full = JOINT_NAMES if self.has_arms else LEG_NAMES
+        if self.joint_names == full:
+            return None
+        index = {n: i for i, n in enumerate(full)}
+        return tuple((index[j.name], 0.0) if j.fixed_rad is None else (-1, j.fixed_rad)
+                     for j in self.joints)
+
+    @cached_property
+    def ids(self) -> tuple[int, ...]:
+        return tuple(j.servo_id for j in self.joints)
+
+    def joint_by_id(self, servo_id: int) -> JointConfig | None:
+        for j in self.joints:
+            if j.servo_id == servo_id:
+                return j
+        return None

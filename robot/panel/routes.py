@@ -1,0 +1,177 @@
+"""The panel's endpoints as a table: (method, path) → a small handler.
+
+A handler takes a :class:`Request` (already admitted by the guard, its JSON body parsed)
+and returns a :class:`Response` or an :class:`Upgrade` (hand the connection to the live
+hub). Handlers never see sockets or headers they do not need, and none of them checks
+Host, Origin, token or content type: ``robot.panel.server`` does that once, through
+``robot.panel.guard``, before it looks a route up. Errors are raised, not returned:
+``Refused`` (its status), ``PresetExistsError`` / ``PanelStateError`` (409), any other
+``BipedError`` (400); the server turns them into ``{"error": "..."}``.
+"""
+
+from __future__ import annotations
+
+import json
+import socket
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from http import HTTPStatus
+from importlib import resources
+from typing import Any
+
+from robot.panel.controller import PanelController
+from robot.panel.guard import Refused
+from robot.panel.live import LiveHub
+from robot.panel.studio import Studio
+
+#: A JSON object as the client sent it.
+Body = Mapping[str, object]
+
+_HTML, _JS = "text/html; charset=utf-8", "text/javascript; charset=utf-8"
+#: URL path → (file in robot/panel/static/, Content-Type).
+STATIC = {"/": ("index.html", _HTML), "/index.html": ("index.html", _HTML),
+          "/panel.js": ("panel.js", _JS), "/panel.css": ("panel.css", "text/css; charset=utf-8"),
+          "/input.js": ("input.js", _JS), "/studio.js": ("studio.js", _JS)}
+
+
+@dataclass(frozen=True)
+class Request:
+    """One admitted request: ``headers`` by lowercase name (the first of repeats)."""
+
+    method: str
+    path: str
+    query: Mapping[str, list[str]] = field(default_factory=dict)
+    headers: Mapping[str, str] = field(default_factory=dict)
+    body: Body = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Response:
+    status: int
+    body: bytes
+    content_type: str
+
+
+@dataclass(frozen=True)
+class Upgrade:
+    """Hand the connection over: ``accept(sock, request_line, headers)`` serves it."""
+
+    accept: Callable[[socket.socket, str, list[tuple[str, str]]], None]
+
+
+Reply = Response | Upgrade
+Handler = Callable[[Request], Reply]
+Routes = Mapping[tuple[str, str], Handler]
+
+
+def json_response(status: int, obj: Mapping[str, object]) -> Response:
+    return Response(int(status), json.dumps(obj).encode(), "application/json")
+
+
+def ok(obj: Mapping[str, object]) -> Response:
+    return json_response(HTTPStatus.OK, obj)
+
+
+def dispatch(routes: Routes, request: Request) -> Reply:
+    """The route's reply, or 404 naming the path."""
+    handler = routes.get((request.method, request.path))
+    if handler is not None:
+        return handler(request)
+    what = "page" if request.method == "GET" else "endpoint"
+    return json_response(HTTPStatus.NOT_FOUND, {"error": f"no such {what}: {request.path}"})
+
+
+def static_file(name: str) -> bytes:
+    """A file of robot/panel/static/ (package data)."""
+    return resources.files("robot.panel").joinpath("static", name).read_bytes()
+
+
+def live_snapshot(controller: PanelController, studio: Studio) -> dict[str, Any]:
+    """What the WebSocket pushes: the state, the parameters in effect, the studio."""
+    streamer = controller.streamer
+    params = streamer.engine.params if controller.running and streamer is not None \
+        else controller.params
+    return {**controller.state(), "params": params.as_dict(), "preset": controller.preset,
+            "driver": controller.driver if controller.running else None,
+            "studio": studio.status()}
+
+
+def _static(name: str, ctype: str) -> Handler:
+    return lambda _: Response(HTTPStatus.OK, static_file(name), ctype)
+
+
+def _live(hub: LiveHub) -> Handler:
+    def live(request: Request) -> Reply:
+        if request.headers.get("upgrade", "").lower() != "websocket":
+            raise Refused(HTTPStatus.BAD_REQUEST, "/api/live is a WebSocket: send "
+                          "Upgrade: websocket")
+        if hub.full():
+            raise Refused(HTTPStatus.SERVICE_UNAVAILABLE, f"{hub.max_clients} live "
+                          "clients already; close one")
+        return Upgrade(hub.serve)
+    return live
+
+
+def _action(controller: PanelController, act: Callable[[], object]) -> Handler:
+    """start / stop / estop / reset: run it, answer the state it left."""
+    def action(_: Request) -> Reply:
+        act()
+        return ok({"ok": True, "state": controller.state()["state"]})
+    return action
+
+
+def _studio(studio: Studio, act: Callable[[Body], Mapping[str, object]]) -> Handler:
+    """A studio action: its reply fields, with ok and the studio's status."""
+    return lambda r: ok({"ok": True, **act(r.body), "studio": studio.status()})
+
+
+def _panel_routes(c: PanelController) -> dict[tuple[str, str], Handler]:
+    def set_params(r: Request) -> Reply:
+        return ok({"params": c.set_params(r.body).as_dict()})
+
+    def load_preset(r: Request) -> Reply:
+        name = r.body.get("name")
+        return ok({"preset": name, "params": c.load_preset(name).as_dict()})
+
+    def save_preset(r: Request) -> Reply:
+        saved = c.save_preset(r.body.get("name"), overwrite=r.body.get("overwrite") is True)
+        return ok({"saved": saved, "presets": c.presets.names()})
+
+    return {
+        ("GET", "/api/state"): lambda _: ok(c.state()),
+        ("GET", "/api/params"): lambda _: ok(c.describe()),
+        ("GET", "/api/presets"): lambda _: ok({"presets": c.presets.names()}),
+        ("POST", "/api/params"): set_params,
+        ("POST", "/api/preset"): load_preset,
+        ("POST", "/api/save"): save_preset,
+        ("POST", "/api/start"): _action(c, c.start),
+        ("POST", "/api/stop"): _action(c, c.stop),
+        ("POST", "/api/estop"): _action(c, c.emergency_stop),
+        ("POST", "/api/reset"): _action(c, c.reset_sim),
+    }
+
+
+def _studio_routes(s: Studio) -> dict[tuple[str, str], Handler]:
+    def sequences(_: Request) -> Reply:
+        return ok({"sequences": s.sequences(), "dir": str(s.keys_dir), **s.status()})
+
+    return {
+        ("GET", "/api/takes"): lambda _: ok({"takes": s.takes(), "dir": str(s.takes_dir)}),
+        ("GET", "/api/sequences"): sequences,
+        ("POST", "/api/record"): _studio(s, lambda b: {"take": s.record(b.get("name"))}),
+        ("POST", "/api/play"): _studio(s, lambda b: s.play(b.get("name"))),
+        ("POST", "/api/pose/release"): _studio(s, lambda b: s.release(b.get("limb"))),
+        ("POST", "/api/pose/capture"): _studio(s, lambda b: s.capture(b.get("t"))),
+        ("POST", "/api/pose/clear"): _studio(s, lambda _: s.clear()),
+        ("POST", "/api/pose/save"): _studio(s, lambda b: {"saved": s.save(b.get("name")),
+                                                          "sequences": s.sequences()}),
+        ("POST", "/api/sequence/play"): _studio(
+            s, lambda b: s.play_sequence(b.get("name"), layer=b.get("layer") is True)),
+    }
+
+
+def route_table(controller: PanelController, studio: Studio, hub: LiveHub) -> Routes:
+    """Every endpoint of the panel: the page and its assets, the API, the live socket."""
+    static = {("GET", path): _static(name, ctype) for path, (name, ctype) in STATIC.items()}
+    return {**static, **_panel_routes(controller), **_studio_routes(studio),
+            ("GET", "/api/live"): _live(hub)}

@@ -1,0 +1,83 @@
+"""A walk as `biped walk` runs it, from plain values (no argparse): its IMU, its engine
+and recorder, its spec and its JSON summary. The CLI and the tuner (robot.tuning) build
+walks here, so a tuned walk is the walk a user runs."""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+from typing import Any
+
+from robot.bus.base import Bus
+from robot.config.params import GaitParams
+from robot.config.robot import RobotConfig
+from robot.errors import ConfigError
+from robot.gait.engine import GaitEngine
+from robot.imu import Imu, open_imu
+from robot.loop.recorder import Recorder
+from robot.motion.keyframes import Sequence
+from robot.motion.layered import LayeredEngine
+from robot.motion.scripted import RecordingEngine
+from robot.motion.takes import TakeHeader, TakeWriter, is_take
+from robot.run.result import RunResult
+from robot.run.spec import Recording, RunOptions, RunSpec
+
+log = logging.getLogger(__name__)
+
+
+def walk_imu(robot: RobotConfig, bus: Bus, *, balance: bool = True,
+             noise: float | None = None) -> Imu | None:
+    """The robot's IMU (not opened) when balance is on, else None; ``noise``: scale of a
+    simulated IMU's datasheet noise and offsets (None: the robot file's)."""
+    if not balance or robot.imu is None:
+        if robot.imu is None and balance:
+            log.info("%s has no [imu]: walking open loop", robot.name)
+        return None
+    config = robot.imu
+    if config.kind == "sim" and bus.kind != "sim":
+        # The bundled robots simulate their IMU: on real servos there is none to read.
+        log.warning("%s: imu.kind is \"sim\", which only exists in simulation: walking open "
+                    "loop on the %s bus (set [imu] kind to your device, docs/imu.md)",
+                    robot.source, bus.kind)
+        return None
+    if noise is not None:
+        if config.kind != "sim":
+            raise ConfigError(f"--imu-noise applies to a simulated IMU; {robot.source}: "
+                              f"imu.kind is {config.kind!r}")
+        config = dataclasses.replace(config, noise=noise, bias=noise)
+    return open_imu(config, bus=bus)
+
+
+def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
+              imu: Imu | None = None, keyframes: Sequence | None = None,
+              record: str | None = None, options: RunOptions | None = None) -> RunSpec[GaitEngine]:
+    """The run of a walk with ``params`` (preset ``gait``, for a take's header), a
+    keyframe layer on the arms, and a recording (NAME.take.jsonl: the parameter
+    timeline; .csv or .jsonl: the joint stream)."""
+    options = options or RunOptions()
+    recorder: Recording | None = None
+    engine: GaitEngine
+    if record and is_take(record):
+        take = TakeWriter(record, TakeHeader(
+            robot=robot.name, robot_file=robot.source, joints=robot.joint_names,
+            rate_hz=options.rate_hz, read_every=options.read_every, gait=gait,
+            params=params, bus=bus.kind, balance=imu is not None,
+            keyframes=keyframes.as_json() if keyframes else None))
+        engine = RecordingEngine(robot, params, sink=take.event, keyframes=keyframes)
+        recorder = take
+    else:
+        if record:
+            recorder = Recorder(record, robot.joint_names, robot.ids)
+        engine = (LayeredEngine(robot, params, keyframes=keyframes) if keyframes
+                  else GaitEngine(robot, params))
+    return RunSpec(robot=robot, source=engine, bus=bus, options=options, imu=imu,
+                   recorder=recorder)
+
+
+def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *,
+                 gait: str) -> dict[str, Any]:
+    """The JSON object of `biped walk --json`: robot, gait, bus, seconds, balance, then
+    the result (RunResult.as_dict)."""
+    return {"robot": spec.robot.name, "gait": gait, "bus": spec.bus.kind,
+            "seconds": spec.options.seconds, "balance": spec.imu is not None,
+            **result.as_dict()}

@@ -1,0 +1,1 @@
+"""Servo facts below every other layer: models (datasheets) and tick arithmetic."""

@@ -1,0 +1,99 @@
+"""Servo models and families as data: datasheet facts per model, the bus kinds' families,
+and the baud rates each family's Baud Rate register encodes.
+
+Sources are named per entry (ROBOTIS e-Manual, Feetech datasheets and memory table). This
+module sits below the robot config and the buses (it imports nothing of the project), so
+both can check a model or a baud rate against it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+# Baud-rate register codes.
+DYNAMIXEL_X_BAUD: dict[int, int] = {
+    0: 9600, 1: 57600, 2: 115200, 3: 1000000, 4: 2000000, 5: 3000000, 6: 4000000,
+}
+FEETECH_STS_BAUD: dict[int, int] = {
+    0: 1000000, 1: 500000, 2: 250000, 3: 128000, 4: 115200, 5: 76800, 6: 57600, 7: 38400,
+}
+# AX-12A "Baud Rate(4)": rate = 2000000 / (code + 1); the manual's table of the usual codes
+# (1 Mbps is 1, the factory value; 57600 is 34, 3.5 % off but within tolerance).
+DYNAMIXEL_P1_BAUD: dict[int, int] = {
+    1: 1000000, 3: 500000, 4: 400000, 7: 250000, 9: 200000, 16: 115200, 34: 57600,
+    103: 19200, 207: 9600,
+}
+BAUD_CODES: dict[str, dict[int, int]] = {
+    "dynamixel_x": DYNAMIXEL_X_BAUD,
+    "dynamixel_p1": DYNAMIXEL_P1_BAUD,
+    "feetech_sts": FEETECH_STS_BAUD,
+}
+
+
+class ServoModel(NamedTuple):
+    """Datasheet facts about one servo model.
+
+    number: model number as reported by ping / the model_number register
+    family: key into TABLES
+    resolution: number of positions (goal/present ticks run 0..resolution-1)
+    stall_torque: stall torque at the nominal voltage [N m]
+    no_load_speed: no-load speed at the nominal voltage [rad/s]
+    mass: [kg]
+    nominal_voltage: [V]
+    """
+
+    name: str
+    number: int
+    family: str
+    resolution: int
+    stall_torque: float
+    no_load_speed: float
+    mass: float
+    nominal_voltage: float
+    #: angle the ``resolution`` positions span [deg]: 360 for a full turn, 300 for the AX
+    #: series (1024 ticks over 300 deg, i.e. an effective 1228.8 ticks per turn)
+    span_deg: float = 360.0
+
+    @property
+    def ticks_per_rad(self) -> float:
+        """Ticks per radian of output shaft."""
+        return self.resolution / math.radians(self.span_deg)
+
+
+_RPM = 2.0 * math.pi / 60.0
+
+MODELS: dict[str, ServoModel] = {
+    # ROBOTIS XL430-W250-T: 1.4 N m, 57 rpm at 11.1 V; 57.2 g.
+    "XL430-W250": ServoModel("XL430-W250", 1060, "dynamixel_x", 4096, 1.4, 57 * _RPM, 0.0572, 11.1),
+    # ROBOTIS XM430-W350: 4.1 N m, 46 rpm at 12 V; 82 g.
+    "XM430-W350": ServoModel("XM430-W350", 1020, "dynamixel_x", 4096, 4.1, 46 * _RPM, 0.082, 12.0),
+    # ROBOTIS XC430-W150: 1.6 N m (12 V stall), 70 rpm; 65 g.
+    "XC430-W150": ServoModel("XC430-W150", 1070, "dynamixel_x", 4096, 1.6, 70 * _RPM, 0.065, 12.0),
+    # ROBOTIS e-Manual AX-12A: 1.5 N m (12 V, 1.5 A), 59 rpm (12 V), 54.6 g; 0..300 deg in
+    # 1024 steps (0.29 deg); model number 12.
+    "AX-12A": ServoModel("AX-12A", 12, "dynamixel_p1", 1024, 1.5, 59 * _RPM, 0.0546, 12.0, 300.0),
+    # ROBOTIS e-Manual AX-18A: 1.8 N m (12 V, 2.2 A), 97 rpm (12 V), 54.5 g; model 18.
+    "AX-18A": ServoModel("AX-18A", 18, "dynamixel_p1", 1024, 1.8, 97 * _RPM, 0.0545, 12.0, 300.0),
+    # ROBOTIS e-Manual MX-28 (Protocol 1.0 firmware): 2.5 N m, 55 rpm at 12 V, 72 g;
+    # 4096 steps per turn; model number 29.
+    "MX-28": ServoModel("MX-28", 29, "dynamixel_p1", 4096, 2.5, 55 * _RPM, 0.072, 12.0),
+    # Feetech STS3215 (7.4 V): 19.5 kg cm = 1.91 N m, 0.222 s/60 deg; 55 g.
+    "STS3215": ServoModel("STS3215", 777, "feetech_sts", 4096, 1.91, (math.pi / 3) / 0.222, 0.055, 7.4),
+    # Feetech STS3032: 4.5 kg cm = 0.44 N m, 0.1 s/60 deg at 6 V; 17 g.
+    "STS3032": ServoModel("STS3032", 1288, "feetech_sts", 4096, 0.44, (math.pi / 3) / 0.1, 0.017, 6.0),
+}
+
+MODELS_BY_NUMBER: dict[str, dict[int, ServoModel]] = {}
+for _m in MODELS.values():
+    MODELS_BY_NUMBER.setdefault(_m.family, {})[_m.number] = _m
+
+BUS_FAMILIES: dict[str, str] = {
+    "dynamixel": "dynamixel_x", "dynamixel1": "dynamixel_p1", "feetech": "feetech_sts",
+}
+
+
+def model_name(family: str, number: int) -> str:
+    """Human name of a model number within a family, or ``"unknown(<number>)"``."""
+    model = MODELS_BY_NUMBER.get(family, {}).get(number)
+    return model.name if model else f"unknown({number})"

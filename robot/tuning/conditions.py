@@ -1,0 +1,132 @@
+"""The robustness suite's conditions: perturbations of a flat walk (slopes, bumps, pushes,
+parameter changes, latency, IMU noise, friction, mass), each as the world, parameter
+changes and IMU noise of one walk (``args``: the `biped walk` options that reproduce it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from robot.config.params import SPECS, GaitParams
+from robot.config.world import MS, PUSH_AT_S, PUSH_NS, PUSH_PHASES, Push, World
+from robot.errors import ConfigError
+
+#: Parameters the +/-20 % conditions change: every non-zero parameter of the preset that
+#: shapes the motion (steering and balance gains are covered by their own conditions).
+PARAM_SCALE = 0.2
+SKIP_PARAMS = frozenset({"speed", "turn", "side_step", "ramp_cycles", "rig_leg", "fps"})
+#: The straightness goal's walk [s]: heading within STRAIGHT_DEG and lateral drift within
+#: STRAIGHT_DRIFT of the distance over this long on flat ground.
+STRAIGHT_S = 60.0
+STRAIGHT_DEG = 5.0
+STRAIGHT_DRIFT = 0.05
+#: Scales of the sim IMU's datasheet noise and offsets (every run has x1, the robot
+#: file's "realistic" BNO055).
+IMU_NOISE = (2.0, 3.0)
+#: A push needs this long after it [s] to tell a recovery from a slow fall.
+AFTER_PUSH_S = 2.0
+
+
+@dataclass(frozen=True)
+class Condition:
+    """One perturbation: a name, a group (one bar of the picture), the walk's world (None:
+    the plain scene), its parameter changes (name, value), its IMU noise scale (None: the
+    robot file's); seconds: this condition's walk [s] (None: the suite's)."""
+
+    group: str
+    name: str
+    world: World | None = None
+    changes: tuple[tuple[str, float], ...] = ()
+    imu_noise: float | None = None
+    seconds: float | None = None
+
+    @property
+    def args(self) -> tuple[str, ...]:
+        """The `biped walk` options that reproduce this condition."""
+        out: list[str] = []
+        w = self.world or World()
+        if w.slope_deg:
+            out += ["--slope", f"{w.slope_deg:g}"]
+        if w.cross_slope_deg:
+            out += ["--cross-slope", f"{w.cross_slope_deg:g}"]
+        if w.bumps_mm:
+            out += ["--bumps", f"{w.bumps_mm:g}", "--terrain-seed", str(w.terrain_seed)]
+        for p in w.pushes:
+            out += ["--push", f"{p.at_s:.3f}:{p.jx:g},{p.jy:g}"]
+        if w.latency_s:
+            out += ["--latency", f"{w.latency_s / MS:g}"]
+        if w.friction_scale != 1.0:
+            out += ["--friction", f"{w.friction_scale:g}"]
+        if w.mass_scale != 1.0:
+            out += ["--mass-scale", f"{w.mass_scale:g}"]
+        for name, value in self.changes:
+            out += ["--set", f"{name}={value!r}"]
+        if self.imu_noise is not None:
+            out += ["--imu-noise", f"{self.imu_noise:g}"]
+        return tuple(out)
+
+
+def conditions(params: GaitParams, *, quick: bool = False) -> list[Condition]:
+    """The suite for a preset with ``params`` (``quick``: a few cases for CI)."""
+    cycle = params.cycle_s
+    out = [Condition("flat", "flat")]
+    slopes = (5.0, -5.0) if quick else (2.0, 5.0, -2.0, -5.0)
+    out += [Condition("slope", f"slope {s:+g} deg", World(slope_deg=s)) for s in slopes]
+    crosses = (4.0,) if quick else (4.0, -4.0)
+    out += [Condition("cross slope", f"cross slope {s:+g} deg", World(cross_slope_deg=s))
+            for s in crosses]
+    heights, seeds = ((5.0,), (0,)) if quick else ((1.0, 3.0, 5.0), (0, 1, 2))
+    out += [Condition("bumps", f"bumps {h:g} mm seed {s}", World(bumps_mm=h, terrain_seed=s))
+            for h in heights for s in seeds]
+    phases = (0.0,) if quick else PUSH_PHASES
+    pushes = {"forward": (1, 0), "backward": (-1, 0), "left": (0, 1), "right": (0, -1)}
+    for direction, (ux, uy) in pushes.items():
+        for ph in phases:
+            # The gait time to the millisecond, as the `--push` option gives it.
+            t = float(f"{PUSH_AT_S + ph * cycle:.3f}")
+            push = Push(t, ux * PUSH_NS, uy * PUSH_NS)
+            out.append(Condition(f"push {direction}",
+                                 f"push {PUSH_NS:g} N*s {direction} at phase {ph:g}",
+                                 World(pushes=(push,))))
+    if not quick:
+        out += scaled_params(params)
+    for ms in ((20.0,) if quick else (10.0, 20.0)):
+        out.append(Condition("latency", f"latency {ms:g} ms", World(latency_s=ms * MS)))
+    for scale in (IMU_NOISE[-1:] if quick else IMU_NOISE):
+        out.append(Condition("imu noise", f"imu noise x{scale:g}", imu_noise=scale))
+    if not quick:
+        out.append(Condition("flat 60 s", f"flat {STRAIGHT_S:g} s", seconds=STRAIGHT_S))
+        out += [Condition("friction", f"friction x{f:g}", World(friction_scale=f))
+                for f in (0.5, 2.0)]
+        out += [Condition("mass", f"mass x{m:g}", World(mass_scale=m)) for m in (0.8, 1.2)]
+    return out
+
+
+def check_seconds(conds: Iterable[Condition], seconds: float) -> None:
+    """Refuse runs too short for the latest push to land and be recovered from."""
+    last = max((p.at_s for c in conds if c.world is not None and c.seconds is None
+                for p in c.world.pushes), default=None)
+    if last is not None and seconds < last + AFTER_PUSH_S:
+        raise ConfigError(f"--seconds {seconds:g}: the suite's pushes land up to "
+                          f"{last:.2f} s into the gait; give at least "
+                          f"{last + AFTER_PUSH_S:.1f} s (or leave the pushes out)")
+
+
+def scaled_params(params: GaitParams) -> list[Condition]:
+    """Every shaping parameter of ``params`` +/- PARAM_SCALE, clipped to its documented
+    range (a clipped change is named; one that the range leaves at the preset's value is
+    left out)."""
+    out = []
+    for name, v in params.as_dict().items():
+        if name in SKIP_PARAMS or name.startswith("bal_") or v == 0.0:
+            continue
+        spec = SPECS[name]
+        for sign in (1, -1):
+            want = v * (1 + sign * PARAM_SCALE)
+            got = min(max(want, spec.lo), spec.hi)
+            if got == v:
+                continue
+            label = f"{name} {sign * 20:+d} %" + ("" if got == want else f" (range: {got:g})")
+            out.append(Condition("params +/-20 %", label, changes=((name, got),)))
+    return out

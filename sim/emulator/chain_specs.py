@@ -1,0 +1,89 @@
+"""Which servos an emulated chain holds: model, baud, ids and each servo's limits.
+
+From a robot config (its bus kind, model and baud, each joint's zero and limits in ticks)
+or from explicit ids; checked against the emulator's own model list and baud codes.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+from robot.config.robot import RobotConfig
+from sim.emulator.control_tables import BAUD_CODES
+from sim.emulator.server import EmulatorError
+from sim.emulator.servo import ServoSpec
+from sim.emulator.servo_models import MODELS, PROTOCOL_FAMILY
+
+DEFAULT_MODEL = {"dynamixel": "XL430-W250", "dynamixel1": "AX-12A", "feetech": "STS3215"}
+DEFAULT_BAUD = 1_000_000
+# As shipped: ROBOTIS e-Manual XL430-W250 (Baud Rate(8) initial 1 = 57600, Return Delay
+# Time(9) initial 250 = 500 us, ID(7) initial 1); Feetech STS memory table (ID(5) 1, Baud
+# Rate(6) 0 = 1 Mbps, Return Delay Time(7) 0); e-Manual AX-12A (ID(3) 1, Baud Rate(4) 1 =
+# 1 Mbps, Return Delay Time(5) 250 = 500 us).
+FACTORY_BAUD = {"dynamixel": 57_600, "dynamixel1": 1_000_000, "feetech": 1_000_000}
+FACTORY_RETURN_DELAY = {"dynamixel": 250, "dynamixel1": 250, "feetech": 0}
+FACTORY_ID = 1
+
+
+@dataclass(frozen=True)
+class ChainChoice:
+    """model: the chain's default model; baud [bit/s]; ids in bus order; one spec each."""
+
+    model: str
+    baud: int
+    ids: tuple[int, ...]
+    servos: tuple[ServoSpec, ...]
+
+
+def _limits(robot: RobotConfig | None, servo_id: int, model: str) -> tuple[int, int, int]:
+    """(zero, min, max) [ticks] for ``servo_id`` from the robot's joint, else the full range
+    with the horn at its middle (2048 of 4096; 512 of the AX's 1024)."""
+    resolution = MODELS[model].resolution
+    joint = robot.joint_by_id(servo_id) if robot is not None else None
+    if joint is None:
+        return resolution // 2, 0, resolution - 1
+    per_rad = MODELS[model].ticks_per_rad
+    ends = [joint.zero_ticks + joint.sign * q * per_rad for q in (joint.min_rad, joint.max_rad)]
+    lo = max(0, math.floor(min(ends)))
+    hi = min(resolution - 1, math.ceil(max(ends)))
+    return joint.zero_ticks, lo, hi
+
+
+def plan_chain(protocol: str, robot: RobotConfig | None, *, ids: Sequence[int] | None,
+               model: str | None, baud: int | None) -> ChainChoice:
+    """The chain ``Emulator(protocol, robot, ids=, model=, baud=)`` serves; EmulatorError
+    (one line, naming the argument and its valid values) when something does not fit."""
+    if protocol not in PROTOCOL_FAMILY:
+        raise EmulatorError(f"protocol: expected one of {', '.join(PROTOCOL_FAMILY)}, "
+                            f"got {protocol!r}")
+    family = PROTOCOL_FAMILY[protocol]
+    same_kind = robot is not None and robot.bus.kind == protocol
+    model = model or (robot.bus.model if robot is not None and same_kind
+                      else DEFAULT_MODEL[protocol])
+    if model not in MODELS or MODELS[model].family != family:
+        valid = [m for m, s in MODELS.items() if s.family == family]
+        raise EmulatorError(f"model: {model!r} is not a {protocol} servo; valid: "
+                            f"{', '.join(valid)}")
+    if ids is None:
+        if robot is None:
+            raise EmulatorError("Emulator needs a robot config or ids=[...]")
+        ids = robot.ids
+    baud = baud or (robot.bus.baud if robot is not None and same_kind else DEFAULT_BAUD)
+    if baud not in BAUD_CODES[family].values():
+        raise EmulatorError(f"baud: {baud} is not a {protocol} rate; valid: "
+                            f"{sorted(BAUD_CODES[family].values())}")
+    specs = []
+    for sid in ids:
+        joint = robot.joint_by_id(sid) if robot is not None and same_kind else None
+        own = joint.model if joint is not None and joint.model else model  # mixed models
+        zero, lo, hi = _limits(robot, sid, own)
+        specs.append(ServoSpec(sid, own, zero, lo, hi, baud))
+    return ChainChoice(model, baud, tuple(ids), tuple(specs))
+
+
+def factory_servos(protocol: str, servos: Sequence[ServoSpec]) -> tuple[ServoSpec, ...]:
+    """The same servos with the factory return delay (new out of the box)."""
+    delay = FACTORY_RETURN_DELAY[protocol]
+    return tuple(replace(s, return_delay=delay) for s in servos)

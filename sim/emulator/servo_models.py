@@ -1,0 +1,70 @@
+"""The servo models the emulator can be, from the vendors' datasheets.
+
+The emulator's own transcription (the driver's ``robot.servo.models.MODELS`` holds the same
+facts; ``tests/test_emulator_tables.py`` makes the two agree). Only what the emulator uses:
+the model number a ping reports, the family (which control table), the position
+resolution and the angle it spans, and the no-load speed the horn travels at.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+#: ``Emulator(protocol)`` -> control-table family.
+PROTOCOL_FAMILY: dict[str, str] = {
+    "dynamixel": "dynamixel_x", "dynamixel1": "dynamixel_p1", "feetech": "feetech_sts",
+}
+
+
+@dataclass(frozen=True)
+class ServoModel:
+    """name; number: Model Number register / ping; family: key of the control tables;
+    resolution: positions (0..resolution-1); span_deg: angle they cover [deg];
+    no_load_speed: at the nominal voltage [rad/s]."""
+
+    name: str
+    number: int
+    family: str
+    resolution: int
+    no_load_speed: float
+    span_deg: float = 360.0
+
+    @property
+    def ticks_per_rad(self) -> float:
+        return self.resolution / math.radians(self.span_deg)
+
+
+def _rpm(rev_per_min: float) -> float:
+    """rev/min -> rad/s."""
+    return rev_per_min * 2.0 * math.pi / 60.0
+
+
+def _per_60deg(seconds: float) -> float:
+    """Feetech's "s/60 deg" -> rad/s."""
+    return math.radians(60.0) / seconds
+
+
+MODELS: dict[str, ServoModel] = {
+    # ROBOTIS e-Manual XL430-W250: Model Number 1060; 4096 pulses/rev; no-load speed
+    # 57 rev/min at 11.1 V.
+    "XL430-W250": ServoModel("XL430-W250", 1060, "dynamixel_x", 4096, _rpm(57)),
+    # ROBOTIS e-Manual XM430-W350: Model Number 1020; 4096 pulses/rev; 46 rev/min at 12 V.
+    "XM430-W350": ServoModel("XM430-W350", 1020, "dynamixel_x", 4096, _rpm(46)),
+    # ROBOTIS e-Manual XC430-W150: Model Number 1070; 4096 pulses/rev; 70 rev/min at 12 V.
+    "XC430-W150": ServoModel("XC430-W150", 1070, "dynamixel_x", 4096, _rpm(70)),
+    # ROBOTIS e-Manual AX-12A: Model Number 12; 0..1023 over 0..300 deg (0.29 deg);
+    # 59 rev/min at 12 V.
+    "AX-12A": ServoModel("AX-12A", 12, "dynamixel_p1", 1024, _rpm(59), 300.0),
+    # ROBOTIS e-Manual AX-18A: Model Number 18; 0..1023 over 300 deg; 97 rev/min at 12 V.
+    "AX-18A": ServoModel("AX-18A", 18, "dynamixel_p1", 1024, _rpm(97), 300.0),
+    # ROBOTIS e-Manual MX-28 (Protocol 1.0 firmware; the 2.0 firmware reports 30): Model
+    # Number 29; 4096 steps/rev; 55 rev/min at 12 V.
+    "MX-28": ServoModel("MX-28", 29, "dynamixel_p1", 4096, _rpm(55)),
+    # Feetech STS3215 (7.4 V): memory table Model(3-4) reads 777 (= 3 * 256 + 9); 4096
+    # steps/rev (12-bit magnetic encoder, 0.088 deg/step); no-load 0.222 s/60 deg.
+    "STS3215": ServoModel("STS3215", 777, "feetech_sts", 4096, _per_60deg(0.222)),
+    # Feetech STS3032 (6 V): 4096 steps/rev; no-load 0.1 s/60 deg. Model 1288 (= 5 * 256 +
+    # 8) is the value the driver lists; no Feetech page here prints it.
+    "STS3032": ServoModel("STS3032", 1288, "feetech_sts", 4096, _per_60deg(0.1)),
+}

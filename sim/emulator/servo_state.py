@@ -1,0 +1,59 @@
+"""What the servo's helpers (``servo_motion``, ``servo_write``) see of an emulated servo.
+
+A leaf module: ``sim.emulator.servo`` builds on it, the helpers use only it, so no module
+imports ``servo`` back. :class:`ServoState` is the part of ``EmulatedServo`` they touch.
+"""
+
+from __future__ import annotations
+
+import enum
+from typing import Protocol
+
+from sim.emulator.control_tables import DXL_SIGNED, TABLES, Entry
+from sim.emulator.servo_models import ServoModel
+from sim.emulator.servo_status import BusWatchdog
+
+
+class WriteError(enum.Enum):
+    """Why a write was refused; each codec maps it to its protocol's error code."""
+
+    NONE = 0
+    ACCESS = 1       # read-only, unknown or EEPROM-while-torque-on address
+    RANGE = 2        # value outside the register's allowed range
+    LIMIT = 3        # goal outside the position limits
+    LENGTH = 4       # the write covers part of a register
+
+
+class ServoState(Protocol):
+    """One servo's table and settings, as the motion and write checks use them.
+
+    mem: the control table's bytes; owner: per byte, 0 (no register) or the index + 1 of
+    its register in ``regs``; regs: the table's (name, entry) rows in order.
+    """
+
+    family: str
+    model: ServoModel
+    stuck: bool
+    speed_tps: float
+    mem: bytearray
+    owner: bytearray
+    regs: list[tuple[str, Entry]]
+    eeprom_end: int
+    watchdog: BusWatchdog | None
+
+    @property
+    def watchdog_tripped(self) -> bool: ...
+
+    def get(self, name: str) -> int: ...
+
+    def set(self, name: str, value: int) -> None: ...
+
+    def set_raw(self, name: str, value: int) -> None: ...
+
+
+def decode_value(family: str, address: int, data: bytes) -> int:
+    """A written value as the log shows it: little-endian, signed for signed registers."""
+    signed = family == "dynamixel_x" and any(
+        reg.address == address and reg.size == len(data) and name in DXL_SIGNED
+        for name, reg in TABLES[family].items())
+    return int.from_bytes(data, "little", signed=signed)

@@ -92,9 +92,8 @@ class TickKernel:
     def _leg(self, side: str) -> _Leg:
         g = self._g
         a, b = g.thigh, g.shin
-        return _Leg(0.0, SIDE_SIGN[side] * g.hip_width / 2, 0.0, a, b, g.ankle_height,
-                    a + b, abs(a - b), 4.0 * a * b, abs(a - b) - REACH_TOL,
-                    a + b + REACH_TOL)
+        return _Leg(0.0, SIDE_SIGN[side] * g.hip_width / 2, 0.0, a, b, g.ankle_height, a + b,
+                    abs(a - b), 4.0 * a * b, abs(a - b) - REACH_TOL, a + b + REACH_TOL)
 
     def _arm(self, py: float) -> _Arm:
         u, f = self._g.upper_arm, self._g.forearm
@@ -209,8 +208,9 @@ class TickKernel:
 
 
 def _rz_ry(yaw: float, pitch: float) -> Rot:
-    """xmath.rz_ry on floats."""
-    cz, sz, cy, sy = cos(yaw), sin(yaw), cos(pitch), sin(pitch)
+    """xmath.rz_ry on floats (a zero angle is common: cos(+-0) = 1, sin(+-0) = +-0)."""
+    cz, sz = (1.0, yaw) if yaw == 0.0 else (cos(yaw), sin(yaw))
+    cy, sy = (1.0, pitch) if pitch == 0.0 else (cos(pitch), sin(pitch))
     return (cz * cy, -sz, cz * sy, sz * cy, cz, sz * sy, -sy, 0.0, cy)
 
 

@@ -20,8 +20,10 @@ from robot.config.joint_names import JOINT_NAMES
 from robot.config.params import SPECS, GaitParams
 from robot.config.robot import RobotConfig
 from robot.gait import expressions as gait
-from robot.gait.ik import arm_ik, leg_ik
-from robot.gait.targets import NO_TRIM, BodyTargets, body_targets
+from robot.gait import vectorised
+from robot.gait.targets import NO_TRIM, BodyTrim, body_targets
+from robot.gait.tick import TickKernel
+from robot.gait.vectorised import solve
 from robot.gait.xmath import Num
 
 log = logging.getLogger(__name__)
@@ -57,22 +59,12 @@ def within_steering_budget(p: GaitParams) -> GaitParams:
     return dataclasses.replace(p, speed=p.speed * k, turn=p.turn * k, side_step=p.side_step * k)
 
 
-def solve(t: BodyTargets, robot: RobotConfig) -> tuple[list[Num], Num]:
-    """IK for every joint of ``robot`` (its joint order) and a reachable flag."""
-    g = robot.geometry
-    r = leg_ik(g, "r", t.r_sole, t.r_foot)
-    lft = leg_ik(g, "l", t.l_sole, t.l_foot)
-    q: list[Num] = [*r.q, *lft.q]
-    ok = r.reachable & lft.reachable
-    if robot.has_arms:
-        ra = arm_ik(g, t.r_hand)
-        la = arm_ik(g, t.l_hand)
-        q += [*ra.q, *la.q]
-        ok = ok & ra.reachable & la.reachable
-    layout = robot.layout
-    if layout is not None:   # 5-DoF legs, extra joints held at fixed angles
-        q = [q[i] if i >= 0 else fixed for i, fixed in layout]
-    return q, ok
+def _plain(values: tuple[Num, ...]) -> bool:
+    """Every value a Python float or int (not a numpy scalar or array)."""
+    for v in values:
+        if type(v) is not float and type(v) is not int:
+            return False
+    return True
 
 
 def _smoothstep(x: float) -> float:
@@ -112,6 +104,12 @@ class GaitEngine:
         self.lift = (0.0, 0.0)
         self._lo = [j.min_rad for j in robot.joints]
         self._hi = [j.max_rad for j in robot.joints]
+        self._limits = list(zip(self._lo, self._hi, strict=True))
+        self._kernel = TickKernel(robot)
+        self._plain_p: GaitParams | None = None   # the last parameters found _plain
+        self._plain_trim: BodyTrim | None = None  # the last trim found _plain
+        self._ramp_p: GaitParams | None = None    # the parameters _ramp_s is for
+        self._ramp_s = 0.0
 
     # -- parameters -------------------------------------------------------------------
     @property
@@ -199,21 +197,37 @@ class GaitEngine:
     def pose(self, *, amplitude: float | None = None) -> list[float]:
         """Joint angles [rad] at the current phase (default: the current envelope)."""
         a = self.amplitude if amplitude is None else amplitude
-        p = self._live
-        ch = gait.channels(self.phase, p, amplitude=a)
-        targets = body_targets(ch, p, self.robot.geometry, amplitude=a,
-                               leg_yaw=self._leg_yaw, trim=self.trim)
-        self.lift = (float(targets.lift_r), float(targets.lift_l))
-        q, ok = solve(targets, self.robot)
+        p, ph, trim = self._live, self.phase, self.trim
+        q: list[Num]
+        if self._plain_inputs(p, ph, a, trim):
+            # Python numbers throughout: the fused kernel, the same bits (robot.gait.tick).
+            q, lift_r, lift_l, ok = self._kernel.pose(ph, p, a, trim)
+        else:  # numpy scalars somewhere: the general functions, evaluated as they do
+            ch = gait.channels(ph, p, amplitude=a)
+            targets = body_targets(ch, p, self.robot.geometry, amplitude=a,
+                                   leg_yaw=self._leg_yaw, trim=trim)
+            lift_r, lift_l = float(targets.lift_r), float(targets.lift_l)
+            q, ok = solve(targets, self.robot)
+            q = [float(v) for v in q]
+        self.lift = (lift_r, lift_l)
         if not ok:
             self.unreachable_ticks += 1
             if self.unreachable_ticks in (1, 10, 100) or self.unreachable_ticks % 1000 == 0:
                 log.warning("gait target out of reach (%d ticks so far): clamped to the "
                             "nearest reachable pose; reduce stride, foot height or crouch",
                             self.unreachable_ticks)
-        lo, hi = self._lo, self._hi
-        return [lo[i] if v < lo[i] else hi[i] if v > hi[i] else float(v)
-                for i, v in enumerate(q)]
+        return [lo if v < lo else hi if v > hi else v
+                for v, (lo, hi) in zip(q, self._limits, strict=True)]
+
+    def _plain_inputs(self, p: GaitParams, ph: gait.Phase, a: float, trim: BodyTrim) -> bool:
+        """Every input a Python float or int, so the kernel's arithmetic is exactly the
+        general functions' (checked once per parameter set and per trim)."""
+        if p is not self._plain_p:
+            self._plain_p = p if _plain(tuple(vars(p).values())) else None
+        if trim is not self._plain_trim:
+            self._plain_trim = trim if _plain(trim) else None
+        return (p is self._plain_p and trim is self._plain_trim and _plain(ph)
+                and (type(a) is float or type(a) is int))
 
     def start_pose(self) -> list[float]:
         """The pose at phase 0 with the envelope at 0 (where a walk starts and ends)."""
@@ -229,7 +243,9 @@ class GaitEngine:
         angles [rad]."""
         self._follow(dt)
         p = self._live
-        ramp_s = p.ramp_cycles * p.cycle_s
+        if p is not self._ramp_p:
+            self._ramp_p, self._ramp_s = p, p.ramp_cycles * p.cycle_s
+        ramp_s = self._ramp_s
         step = 1.0 if not math.isfinite(ramp_s) or ramp_s <= 0 else dt / ramp_s
         if self._running:
             self._ramp = min(1.0, self._ramp + step)
@@ -248,21 +264,7 @@ class GaitEngine:
                with_channels: bool = True
                ) -> tuple[dict[str, npt.NDArray[np.float64]], npt.NDArray[np.float64]]:
         """Channels and joint angles (n_joints, n) over ``times`` [s] at full amplitude and
-        constant parameters (vectorised, in cache-sized chunks). ``with_channels=False``
-        returns an empty channel dict and only the joint angles."""
-        times = np.asarray(times, dtype=float)
-        n = times.shape[0]
-        names = gait.CHANNELS if with_channels else ()
-        out_ch = {name: np.empty(n) for name in names}
-        out_q = np.empty((len(self.robot.joints), n))
-        for i in range(0, n, chunk):
-            sl = slice(i, min(i + chunk, n))
-            ch = gait.curves(times[sl], self._target)
-            q, _ = solve(body_targets(ch, self._target, self.robot.geometry,
-                                      leg_yaw=self._leg_yaw), self.robot)
-            for name in names:
-                out_ch[name][sl] = ch[name]
-            for j, v in enumerate(q):
-                out_q[j, sl] = v
-        np.clip(out_q, np.array(self._lo)[:, None], np.array(self._hi)[:, None], out=out_q)
-        return out_ch, out_q
+        constant parameters (robot.gait.vectorised: in cache-sized chunks, over threads).
+        ``with_channels=False`` returns an empty channel dict and only the joint angles."""
+        return vectorised.curves(self.robot, self._target, times, chunk=chunk,
+                                 with_channels=with_channels)

@@ -11,6 +11,7 @@ serves one control tick on Python floats and a curve of a million frames on nump
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -52,10 +53,19 @@ class Phase(NamedTuple):
 
 
 def phase_at(t: Num, p: GaitParams) -> Phase:
-    """Phases at time(s) ``t`` [s] for constant parameters, grouped as printed."""
+    """Phases at time(s) ``t`` [s] for constant parameters, grouped as printed. A phase
+    equal to another by its parameters (k = 1, Abnc_L = Abnc_R) is that same object, so
+    ``channels`` takes its sine once (x * 1.0 is x, bit for bit)."""
     T = t * p.fps
     theta = T * p.vM
-    return Phase(theta, theta * p.phi, theta * p.k, t * 2 * p.Abnc_R, t * 2 * p.Abnc_L)
+    arm_R = t * 2 * p.Abnc_R
+    return Phase(theta, theta * p.phi, theta if p.k == 1.0 else theta * p.k, arm_R,
+                 arm_R if _same(p.Abnc_L, p.Abnc_R) else t * 2 * p.Abnc_L)
+
+
+def _same(a: float, b: float) -> bool:
+    """Equal, and zeros of the same sign."""
+    return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
 
 
 def advance(ph: Phase, p: GaitParams, dt: float) -> Phase:
@@ -75,10 +85,10 @@ def channels(ph: Phase, p: GaitParams, *, amplitude: float = 1.0) -> dict[str, N
     s_theta = xm.sin(ph.theta)
     c_theta = xm.cos(ph.theta)
     s_pel = xm.sin(ph.pelvis)
-    s_spi = xm.sin(ph.spine)
+    s_spi = s_theta if ph.spine is ph.theta else xm.sin(ph.spine)
     s_ftau = xm.sin(ph.theta - FTAU_ALPHA)
     s_ar = xm.sin(ph.arm_R)
-    s_al = xm.sin(ph.arm_L)
+    s_al = s_ar if ph.arm_L is ph.arm_R else xm.sin(ph.arm_L)
     delta_f = p.delta_f
     if a != 1.0:
         s_theta, c_theta, s_pel, s_spi = a * s_theta, a * c_theta, a * s_pel, a * s_spi

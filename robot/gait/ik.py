@@ -118,12 +118,18 @@ def leg_ik(g: Geometry, side: str, sole: Vec, foot_rot: Rot = xm.IDENTITY) -> Le
     ankle_roll = xm.atan2(ry * sz_, rz * sz_)  # in (-pi/2, pi/2]
     ankle_pitch = -xm.atan2(rx, sz_ * xm.sqrt(ry * ry + rz * rz)) - ankle_a
     ankle_pitch = xm.atan2(xm.sin(ankle_pitch), xm.cos(ankle_pitch))  # into (-pi, pi]
-    # Hip: R = foot_rot @ Rx(-roll) @ Ry(-(pitch + knee)) = Rz(yaw) Rx(roll) Ry(pitch).
-    r = xm.post_ry(xm.post_rx(foot_rot, -ankle_roll), -(ankle_pitch + knee))
-    hip_yaw = xm.atan2(-r[1], r[4])
+    # Hip: R = foot_rot @ Rx(-roll) @ Ry(-(pitch + knee)) = Rz(yaw) Rx(roll) Ry(pitch); of
+    # R only the entries 1, 4, 6, 7 and 8 are needed (those of xmath.post_rx / post_ry).
+    c, s = xm.cos(-ankle_roll), xm.sin(-ankle_roll)
+    f = foot_rot
+    r1, r4, r7, rx8 = c * f[1] + s * f[2], c * f[4] + s * f[5], c * f[7] + s * f[8], \
+        c * f[8] - s * f[7]
+    c, s = xm.cos(-(ankle_pitch + knee)), xm.sin(-(ankle_pitch + knee))
+    r6, r8 = c * f[6] - s * rx8, s * f[6] + c * rx8
+    hip_yaw = xm.atan2(-r1, r4)
     cz, sz = xm.cos(hip_yaw), xm.sin(hip_yaw)
-    hip_roll = xm.atan2(r[7], -r[1] * sz + r[4] * cz)
-    hip_pitch = xm.atan2(-r[6], r[8])
+    hip_roll = xm.atan2(r7, -r1 * sz + r4 * cz)
+    hip_pitch = xm.atan2(-r6, r8)
     return LegIK((hip_yaw, hip_roll, hip_pitch, knee, ankle_pitch, ankle_roll), reachable)
 
 

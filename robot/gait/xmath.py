@@ -125,7 +125,15 @@ def post_ry(r: Rot, a: Num) -> Rot:
             c * r[6] - s * r[8], r[7], s * r[6] + c * r[8])
 
 
+def cos_sin(a: Num) -> tuple[Num, Num]:
+    """(cos a, sin a). An array of zeros (a yaw or pitch that a parameter turns off) is
+    not evaluated: cos(+-0) = 1 and sin(+-0) = +-0 exactly."""
+    if type(a) is not float and isinstance(a, np.ndarray) and not a.any():
+        return np.ones_like(a), a
+    return cos(a), sin(a)
+
+
 def rz_ry(yaw: Num, pitch: Num) -> Rot:
     """rot_z(yaw) @ rot_y(pitch)."""
-    cz, sz, cy, sy = cos(yaw), sin(yaw), cos(pitch), sin(pitch)
+    (cz, sz), (cy, sy) = cos_sin(yaw), cos_sin(pitch)
     return (cz * cy, -sz, cz * sy, sz * cy, cz, sz * sy, -sy, 0.0, cy)

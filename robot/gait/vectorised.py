@@ -8,15 +8,14 @@ the same bits whatever the chunk size or the number of threads.
 
 A chunk's temporaries (some 10 MB) are freed at its end, and glibc then hands the heap's
 free top back to the OS (past 128 kB): the next chunk page-faults all of it in again,
-about 200 000 faults per million frames, half the time of the evaluation. ``curves``
-therefore asks glibc to keep ``HEAP_TOP_PAD`` bytes at the heap top (``mallopt``
-M_TOP_PAD; a process-wide allocator setting, which only keeps freed memory for reuse;
-nothing on other C libraries).
+about 200 000 faults per million frames, half the time of the evaluation. A library
+function does not change the process's allocator behind its caller's back, so this is
+left to the user: glibc's own tunable ``MALLOC_TOP_PAD_=33554432`` (32 MB kept at the heap
+top) in the environment of a long batch evaluation removes those faults.
 """
 
 from __future__ import annotations
 
-import ctypes
 import os
 from concurrent.futures import ThreadPoolExecutor
 
@@ -32,21 +31,6 @@ from robot.gait.xmath import Num
 
 #: Frames per chunk: a chunk's temporaries stay in the CPU's caches.
 CHUNK = 16384
-#: Free memory [bytes] glibc keeps at the top of the heap while ``curves`` runs.
-HEAP_TOP_PAD = 32 << 20
-_M_TOP_PAD = -2  # glibc malloc.h
-
-
-def keep_heap_top(pad: int = HEAP_TOP_PAD) -> None:
-    """Ask glibc's malloc to keep ``pad`` bytes of freed memory at the heap top instead of
-    returning it to the OS (see the module docstring); nothing where there is no glibc."""
-    try:
-        mallopt = ctypes.CDLL(None).mallopt
-    except (AttributeError, OSError):
-        return
-    mallopt(_M_TOP_PAD, pad)
-
-
 def solve(t: BodyTargets, robot: RobotConfig) -> tuple[list[Num], Num]:
     """IK for every joint of ``robot`` (its joint order) and a reachable flag."""
     g = robot.geometry
@@ -79,7 +63,6 @@ def curves(robot: RobotConfig, p: GaitParams, times: npt.NDArray[np.float64], *,
     """Channels and joint angles [rad] (n_joints, n), clamped to the joint limits, over
     ``times`` [s] at full amplitude and constant parameters ``p``. ``with_channels=False``
     returns an empty channel dict; ``workers``: threads (default: one per CPU)."""
-    keep_heap_top()
     times = np.asarray(times, dtype=float)
     n = times.shape[0]
     names = gait.CHANNELS if with_channels else ()

@@ -14,6 +14,7 @@ import pytest
 from robot.imu import ImuConfig, ImuError, open_imu
 from robot.imu.frames import quat_from_rpy
 from sim.emulator.bno055 import P0, FakeBno055
+from waiting import wait_for
 
 GYRO_LSB = math.radians(1 / 16)   # 16 LSB per dps (datasheet Table 3-22)
 ACCEL_LSB = 1 / 100               # 100 LSB per m/s^2 (Table 3-17)
@@ -105,6 +106,7 @@ def test_faults_after_open_fail_the_read_not_hang(dev: FakeBno055) -> None:
         with pytest.raises(ImuError, match="reading: no reply within 0.3 s"):
             imu.read()
         assert time.monotonic() - t0 < 1.0
+        assert wait_for(dev.drained)   # the unanswered requests were taken while silent
         dev.silent = False
         assert imu.read().accel[2] == pytest.approx(9.81, abs=ACCEL_LSB)  # recovers
 

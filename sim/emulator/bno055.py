@@ -84,6 +84,7 @@ class FakeBno055:
     def __init__(self, *, chip_id: int = 0xA0) -> None:
         self.chip_id = chip_id
         self.silent = False
+        self._pending = bytearray()   # received, not yet a whole request
         self.read_status: int | None = None
         self.requests = 0
         self._lock = threading.Lock()
@@ -149,8 +150,15 @@ class FakeBno055:
         for addr, value in P1_RESET.items():
             self._page[1][addr] = value
 
+    def drained(self) -> bool:
+        """Whether every byte the host sent has been taken and answered (or dropped, while
+        ``silent``): a test that ends a fault waits for this, so a request sent during the
+        fault is not answered after it (a busy machine may run this thread late)."""
+        ready, _, _ = select.select([self._master], [], [], 0)
+        return not ready and not self._pending
+
     def _serve(self) -> None:
-        buf = bytearray()
+        buf = self._pending
         while not self._stop.is_set():
             ready, _, _ = select.select([self._master], [], [], 0.05)
             if not ready:

@@ -185,11 +185,11 @@ class EmulatedServo:
             return None
         return self.heard + steps * wd.unit_s
 
-    def update(self, now: float) -> None:
-        """Advance the position model (and the watchdog) to ``now`` [s, time.monotonic()]."""
+    def update(self, now: float, *, quiet_until: float = float("inf")) -> None:
+        """Advance motion to ``now`` and the watchdog to ``quiet_until`` (silence seen) [s]."""
         self._assert_faults()
         deadline = self._watchdog_deadline()
-        if self.watchdog is not None and deadline is not None and deadline < now:
+        if self.watchdog is not None and deadline is not None and deadline < min(now, quiet_until):
             self._advance(max(deadline, self._t))
             self.set("goal_position", round(self._pos))   # stop where it is
             self.set(self.watchdog.register, self.watchdog.tripped)

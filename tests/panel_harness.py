@@ -8,12 +8,12 @@ fixture) and import the helpers.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
+import waiting
 from playwright.sync_api import Browser, sync_playwright
 
 from robot.config.bundled import DEFAULT_ROBOT
@@ -30,12 +30,8 @@ ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-f
 
 
 def wait_for(pred: Callable[[], bool], timeout: float = 10.0) -> bool:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if pred():
-            return True
-        time.sleep(0.02)
-    return False
+    """``pred`` held within ``timeout`` [s] (polled; see waiting.wait_for)."""
+    return waiting.wait_for(pred, timeout_s=timeout)
 
 
 @contextmanager

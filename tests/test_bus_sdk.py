@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 
 import pytest
+from waiting import wait_for
 
 from robot.bus import health
 from robot.bus.sdk_bus import SdkBus
@@ -24,13 +24,8 @@ def sync_writes(emu: Emulator) -> list:
     return [p for p in emu.log() if p.instruction == "sync_write"]
 
 
-def wait_until(predicate, timeout_s: float = 3.0) -> bool:  # type: ignore[no-untyped-def]
-    end = time.monotonic() + timeout_s
-    while time.monotonic() < end:
-        if predicate():
-            return True
-        time.sleep(0.01)
-    return False
+def wait_until(predicate: Callable[[], bool]) -> bool:
+    return wait_for(predicate, every_s=0.01)
 
 
 def test_open_is_healthy_and_scan_lists_every_servo(bus: SdkBus, robot: RobotConfig) -> None:
@@ -87,7 +82,7 @@ def test_one_sync_write_packet_per_call(bus: SdkBus, emu: Emulator, robot: Robot
     for k in range(10):
         bus.write_goals({i: 2048 + (k if i == 1 else 0) for i in robot.ids})
     # A sync write has no reply: the emulator may still be reading the last packets.
-    wait_until(lambda: len(emu.log()) >= 10)
+    assert wait_until(lambda: len(emu.log()) >= 10)
     log = emu.log()
     assert [p.instruction for p in log] == ["sync_write"] * 10
     goal = TABLES[bus.family]["goal_position"].address
@@ -107,7 +102,7 @@ def test_refuses_goals_outside_the_limits(bus: SdkBus, emu: Emulator, robot: Rob
         bus.write_goals({1: 2048.5})  # type: ignore[dict-item]
     assert sync_writes(emu) == []
     bus.write_goals({4: int(sm.tick_min[knee])})
-    wait_until(lambda: len(sync_writes(emu)) >= 1)  # no reply to wait for: poll the log
+    assert wait_until(lambda: len(sync_writes(emu)) >= 1)  # no reply to wait for: poll the log
     assert len(sync_writes(emu)) == 1
 
 

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from waiting import sleep_until, wait_for
 
 import robot.cli as cli
 from robot.bus.servo_map import ServoMap
@@ -100,17 +101,24 @@ def test_pose_ctrl_c_stops_and_holds(emu: Emulator, robot: RobotConfig,
            "--speed", "1.0", "--rate", "50"]
     proc = subprocess.Popen(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env={**os.environ, "MUJOCO_GL": "egl"})
-    deadline = time.monotonic() + 15
-    while time.monotonic() < deadline and not any(
-            p.instruction == "sync_write" for p in emu.log()[-3:]):
-        time.sleep(0.05)
-    time.sleep(0.6)  # well into the 2 s ramp
-    proc.send_signal(signal.SIGINT)
-    out, err = proc.communicate(timeout=15)
+    def knee_goal() -> int:
+        writes = [p for p in emu.log() if p.instruction == "sync_write"]
+        return writes[-1].values[4] if writes else 2048
+
+    rest_knee = ServoMap(robot).goals(ServoMap(robot).vector(robot.rest).tolist())[4]
+    # Well into the 2 s ramp: the knee's goal a tenth of the way to rest.
+    try:
+        assert wait_for(lambda: knee_goal() > 2048 + (rest_knee - 2048) / 10, timeout_s=60,
+                        stop=lambda: proc.poll() is not None), "the ramp never started"
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
     assert proc.returncode == 130, err
     assert "holding" in out
     n = len([p for p in emu.log() if p.instruction == "sync_write"])
-    time.sleep(0.1)
+    sleep_until(time.monotonic() + 0.1)     # 0.1 s later: five ticks at 50 Hz, no write
     assert len([p for p in emu.log() if p.instruction == "sync_write"]) == n  # stopped
     assert {emu.registers(i)["torque_enable"] for i in robot.ids} == {1}
     knee = emu.registers(4)["goal_position"]

@@ -20,12 +20,14 @@ from pathlib import Path
 from typing import NamedTuple
 
 import pytest
+from waiting import sleep_until, wait_for
 
 from robot.bus.base import Bus
 from robot.bus.sdk_bus import SdkBus
 from robot.bus.tables import TABLES
 from robot.config.robot import RobotConfig
 from robot.errors import BusError, ConfigError
+from robot.loop.watchdog import FAILSAFE_MARGIN
 from sim.emulator.chain import Emulator, Packet
 
 pytest_plugins = ("bus_harness",)
@@ -63,7 +65,7 @@ def stream(bus: SdkBus, robot: RobotConfig, knee: int, seconds: float) -> None:
     start = time.monotonic()
     for k in range(round(seconds / TICK_S)):
         bus.write_goals(goals(robot, knee))
-        time.sleep(max(0.0, start + (k + 1) * TICK_S - time.monotonic()))
+        sleep_until(start + (k + 1) * TICK_S)
 
 
 def watchdog_writes(emu: Emulator) -> list[Packet]:
@@ -161,9 +163,10 @@ bus.set_torque(robot.ids, enabled=True)
 bus.arm_failsafe(robot.ids, timeout_s=float(timeout_s))
 goals = {i: (int(knee) if i == int(knee_id) else 2048) for i in robot.ids}
 print("streaming", flush=True)
-while True:
+start = time.monotonic()
+for k in range(1, 10**9):
     bus.write_goals(goals)
-    time.sleep(0.005)
+    time.sleep(max(0.0, start + k * 0.005 - time.monotonic()))
 """
 
     def __init__(self, emu: Emulator) -> None:
@@ -193,7 +196,8 @@ def vanish(request: pytest.FixtureRequest, bus: SdkBus, emu: Emulator,
         if how == "sigkill":
             bus.close(torque_off=False)       # the child owns the port from here
             child = Child(emu)
-            time.sleep(0.05)
+            assert wait_for(lambda: any(p.instruction == "sync_write" and p.values[KNEE] == FAR
+                                        for p in emu.log())), "the child never streamed"
             child.kill()
             return
         bus.set_torque(robot.ids, enabled=True)
@@ -212,9 +216,11 @@ def test_when_the_host_vanishes(vanish: Callable[[], None], bus_factory: Factory
     vanish()
     last = [p for p in emu.log() if p.instruction == "sync_write"][-1]
     assert last.values[KNEE] == FAR
-    time.sleep(0.8)                  # past the timeout and past the knee's travel time
+    # Stopped: tripped (Dynamixel X), or at the last goal (no watchdog); then still there.
+    assert wait_for(lambda: emu.registers(KNEE)["present_position"] == FAR if manual is None
+                    else emu.registers(KNEE)["bus_watchdog"] == manual.tripped)
     before = emu.registers(KNEE)
-    time.sleep(0.2)
+    sleep_until(time.monotonic() + 0.2)   # 0.2 s of servo time: ~750 ticks if it moved
     after = emu.registers(KNEE)
     assert after["present_position"] == before["present_position"]   # no longer moving
     assert after["torque_enable"] == 1                                # torque as it was
@@ -241,8 +247,7 @@ def test_when_the_host_vanishes(vanish: Callable[[], None], bus_factory: Factory
         again.disarm_failsafe(robot.ids)
         assert {emu.registers(i)["bus_watchdog"] for i in robot.ids} == {0}
         again.write_goals(goals(robot, FAR))
-        time.sleep(0.6)
-        assert emu.registers(KNEE)["present_position"] == FAR
+        assert wait_for(lambda: emu.registers(KNEE)["present_position"] == FAR)
     finally:
         again.close()
 
@@ -251,7 +256,9 @@ def test_when_the_host_vanishes(vanish: Callable[[], None], bus_factory: Factory
 def test_a_steady_200_hz_stream_never_trips_it(bus: SdkBus, emu: Emulator,
                                                robot: RobotConfig) -> None:
     bus.set_torque(robot.ids, enabled=True)
-    armed = bus.arm_failsafe(robot.ids, timeout_s=TIMEOUT_S)
+    # Armed as the streamer arms it: a read-back retried to its end never trips it.
+    armed = bus.arm_failsafe(robot.ids,
+                             timeout_s=FAILSAFE_MARGIN * bus.retry_span_s + 2 * TICK_S)
     assert armed is not None
     emu.log(clear=True)
     start = time.monotonic()
@@ -259,7 +266,7 @@ def test_a_steady_200_hz_stream_never_trips_it(bus: SdkBus, emu: Emulator,
         bus.write_goals(goals(robot, 2048 + (k % 100)))
         if k % 10 == 9:
             bus.read_state(robot.ids)
-        time.sleep(max(0.0, start + (k + 1) * TICK_S - time.monotonic()))
+        sleep_until(start + (k + 1) * TICK_S)
     gap = max_gap(emu.log())
     regs = [emu.registers(i) for i in robot.ids]
     assert gap < armed, f"the host itself stalled {gap * 1e3:.0f} ms (machine overloaded?)"
@@ -270,11 +277,10 @@ def test_a_steady_200_hz_stream_never_trips_it(bus: SdkBus, emu: Emulator,
 @pytest.mark.parametrize("protocol", ["dynamixel"])
 def test_no_trip_while_torque_is_off(bus: SdkBus, emu: Emulator, robot: RobotConfig) -> None:
     bus.arm_failsafe([KNEE], timeout_s=0.02)
-    time.sleep(0.1)
+    sleep_until(emu.log()[-1].t + 0.1)        # five timeouts of silence, torque off
     assert emu.registers(KNEE)["bus_watchdog"] == 1
     bus.set_torque([KNEE], enabled=True)      # a packet: the watchdog starts counting now
-    time.sleep(0.1)
-    assert emu.registers(KNEE)["bus_watchdog"] == DXL.tripped
+    assert wait_for(lambda: emu.registers(KNEE)["bus_watchdog"] == DXL.tripped)
     assert emu.registers(KNEE)["torque_enable"] == 1
     assert bus.arm_failsafe([KNEE], timeout_s=TIMEOUT_S) == pytest.approx(TIMEOUT_S)
     assert emu.registers(KNEE)["bus_watchdog"] == 5   # re-arming clears the trip first
@@ -287,8 +293,7 @@ def test_register_range_and_reboot_as_the_manual_says(bus: SdkBus, emu: Emulator
         bus.write_register(KNEE, "bus_watchdog", DXL.max_steps + 1)
     bus.set_torque([KNEE], enabled=True)
     bus.arm_failsafe([KNEE], timeout_s=0.02)
-    time.sleep(0.1)
-    assert emu.registers(KNEE)["bus_watchdog"] == DXL.tripped
+    assert wait_for(lambda: emu.registers(KNEE)["bus_watchdog"] == DXL.tripped)
     bus.packet_handler.reboot(bus.port_handler, KNEE)   # RAM back to its initial value 0
     regs = emu.registers(KNEE)
     assert regs["bus_watchdog"] == 0 and regs["torque_enable"] == 0

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from waiting import sleep_until, wait_for
 
 import robot.cli as cli
 from robot.config.robot import RobotConfig
@@ -113,7 +114,7 @@ def inject_when_streaming(emu: Emulator, action: Callable[[], None] | None, *,
                 action()
                 info["at"] = time.monotonic()
                 return
-            time.sleep(0.01)
+            stop.wait(0.01)
 
     thread = threading.Thread(target=worker, daemon=True)
     if action is not None:
@@ -257,13 +258,14 @@ def test_port_closed_mid_walk(emu: Emulator, robot: RobotConfig, robot_toml: Pat
     goals = goal_writes(emu)
     assert_stream_safe(robot, goals)
     assert max(p.t for p in goals) <= info["at"] + 0.05       # nothing heard after it
-    time.sleep(0.3)                                           # past the 0.1 s failsafe
+    if emu.protocol == "dynamixel":                            # its failsafe trips
+        assert wait_for(lambda: {emu.registers(i)["bus_watchdog"] for i in robot.ids} == {-1})
     regs = [emu.registers(i) for i in robot.ids]
     assert {r["torque_enable"] for r in regs} == {1}          # unreachable: still torqued
     if emu.protocol == "dynamixel":
         assert {r["bus_watchdog"] for r in regs} == {-1}      # tripped: stopped, holding
         assert all(r["goal_position"] == r["present_position"] for r in regs)
-        time.sleep(0.1)
+        sleep_until(time.monotonic() + 0.1)                   # 0.1 s of servo time: still
         assert [emu.registers(i)["present_position"] for i in robot.ids] == [
             r["present_position"] for r in regs]
 
@@ -286,15 +288,27 @@ def test_signals(emu: Emulator, robot: RobotConfig, robot_toml: Path, case: str,
            *walk_args(emu, robot_toml, hold=hold, seconds=60)]
     proc = subprocess.Popen(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env={**os.environ, "MUJOCO_GL": "egl"})
+    assert proc.stderr is not None and proc.stdout is not None
+    err_lines: list[str] = []
+
+    def read_stderr() -> None:
+        for line in proc.stderr:     # line by line while the walk runs
+            err_lines.append(line)
+
+    reader = threading.Thread(target=read_stderr, daemon=True)
+    reader.start()
     try:
-        deadline = time.monotonic() + 20
-        while time.monotonic() < deadline and emu.counters().get("sync_write", 0) < 250:
-            time.sleep(0.02)
+        assert wait_for(lambda: emu.counters().get("sync_write", 0) >= 250, timeout_s=60,
+                        stop=lambda: proc.poll() is not None), "the walk never streamed"
         for k, sig in enumerate(sent):
-            if k:
-                time.sleep(0.15)                              # inside the ramp-out
+            if k:   # the first was handled (the walk says so): the second is its own signal
+                assert wait_for(lambda: any("stopping" in line for line in err_lines),
+                                stop=lambda: proc.poll() is not None), "".join(err_lines)
             proc.send_signal(sig)
-        out, err = proc.communicate(timeout=20)
+        proc.wait(timeout=30)
+        out = proc.stdout.read()
+        reader.join(10)
+        err = "".join(err_lines)
     finally:
         if proc.poll() is None:
             proc.kill()

@@ -10,11 +10,11 @@ import time
 from collections.abc import Iterator
 
 import pytest
+from waiting import wait_for
 
 from robot.imu import ImuConfig, ImuError, open_imu
 from robot.imu.frames import quat_from_rpy
 from sim.emulator.bno055 import P0, FakeBno055
-from waiting import wait_for
 
 GYRO_LSB = math.radians(1 / 16)   # 16 LSB per dps (datasheet Table 3-22)
 ACCEL_LSB = 1 / 100               # 100 LSB per m/s^2 (Table 3-17)

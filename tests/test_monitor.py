@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from waiting import wait_for
 
 import robot.cli as cli
 from robot.commands.monitor import next_deadline
@@ -190,9 +191,8 @@ def test_live_table_refreshes_in_place_on_a_terminal(emu: Emulator, robot: Robot
                             cwd=REPO, stdout=slave, stderr=subprocess.PIPE,
                             env={**os.environ, "MUJOCO_GL": "egl"})
     try:
-        end = time.monotonic() + 10
-        while time.monotonic() < end and b"".join(chunks).count(b"\x1b[J") < 3:
-            time.sleep(0.05)
+        assert wait_for(lambda: b"".join(chunks).count(b"\x1b[J") >= 3, timeout_s=60,
+                        stop=lambda: proc.poll() is not None), b"".join(chunks)
         proc.send_signal(signal.SIGINT)
         assert proc.wait(10) == 130
     finally:

@@ -25,14 +25,15 @@ from sim.mujoco.bus import MujocoBus
 pytest_plugins = ("panel_harness",)  # the browser fixture
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def running() -> Iterator[tuple[PanelController, str]]:
+    """A walking panel of its own for each test (no test sees a run another one ended)."""
     with served_panel() as (controller, base):
         controller.start()
         yield controller, base
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def page(running: tuple[PanelController, str], browser: Browser) -> Iterator[Page]:
     pg = browser.new_page(viewport={"width": 1400, "height": 950})
     errors: list[str] = []
@@ -109,8 +110,6 @@ def test_number_box_refuses_out_of_range(running: tuple[PanelController, str],
 
 def test_stop_start_estop_buttons(running: tuple[PanelController, str], page: Page) -> None:
     controller, _ = running
-    if not controller.running:  # the module's run ended under an earlier test: a new one
-        controller.start()
     assert wait_for(lambda: controller.state()["state"] == "walking")
     seen: set[str] = set()
     page.click("#stop")

@@ -35,9 +35,10 @@ navigator.getGamepads = () => window.__pads;
 pytest_plugins = ("panel_harness",)  # the browser fixture
 
 
-@pytest.fixture(scope="module")
-def panel(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[PanelController, str]]:
-    with served_panel(studio_dir=tmp_path_factory.mktemp("studio")) as served:
+@pytest.fixture
+def panel(tmp_path: Path) -> Iterator[tuple[PanelController, str]]:
+    """A panel of its own for each test (a walk one test stops is no other test's state)."""
+    with served_panel(studio_dir=tmp_path / "studio") as served:
         yield served
 
 
@@ -77,7 +78,8 @@ def assert_run_controls_on_screen(page: Page, viewport: dict[str, int]) -> None:
     assert total > viewport["height"] * 1.5  # there is something to scroll past
     for y in (total, total // 2):
         page.evaluate(f"window.scrollTo(0, {y})")
-        page.wait_for_timeout(100)
+        # laid out and painted after the scroll: two animation frames
+        page.evaluate("new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
         for sel in ("#estop", "#stop"):
             r = page.eval_on_selector(sel, "e => e.getBoundingClientRect().toJSON()")
             assert r["height"] >= MIN_TOUCH_PX, (sel, r)
@@ -210,7 +212,9 @@ def test_keyboard_steers_stops_and_estops(panel: tuple[PanelController, str],
         controller.set_params({"speed": 0.5, "turn": 0.0})
         controller.start()
         assert wait_for(lambda: controller.state()["state"] == "walking")
-        page.wait_for_timeout(300)  # the pushed state carries the new parameters
+        # the page steps from the values the loop pushed: wait until it shows them
+        expect(page.locator("#num-speed")).to_have_value("0.5")
+        expect(page.locator("#num-turn")).to_have_value("0")
         page.locator("h1").click()
         page.keyboard.press("ArrowUp")
         assert wait_for(lambda: abs(controller.params.speed - 0.6) < 1e-9, 3.0), \

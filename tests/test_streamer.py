@@ -8,10 +8,12 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
 from bus_harness import open_bus
+from waiting import wait_for
 
 from robot.bus.servo_map import ServoMap
 from robot.bus.tables import TABLES
@@ -133,20 +135,23 @@ def test_watchdog_stops_safely_on_injected_faults(emu: Emulator, robot: RobotCon
         assert all(emu.registers(i)["torque_enable"] == 0 for i in reachable)
 
 
-def test_sigint_ramps_out_and_leaves_torque_off(emu: Emulator, robot: RobotConfig) -> None:
+def test_sigint_ramps_out_and_leaves_torque_off(emu: Emulator, robot: RobotConfig,
+                                               robot_toml: Path) -> None:
+    # robot_toml: the reply timeout a loaded machine needs (with the bundled 20 ms, late
+    # replies under load tripped the servos' own 0.1 s bus watchdog mid-walk: "stopped
+    # following", exit 1).
     env = {**os.environ, "MUJOCO_GL": "egl"}
     cmd = [sys.executable, "-m", "robot.cli", "walk", "--bus", robot.bus.kind,
-           "--robot", robot.source, "--port", emu.port, "--seconds", "60", "--json"]
+           "--robot", str(robot_toml), "--port", emu.port, "--seconds", "60", "--json"]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env=env)
     try:
-        deadline = time.monotonic() + 15
-        while time.monotonic() < deadline:     # wait until the gait streams
-            if len(_goal_writes(emu.log(), robot)) > 100:
-                break
-            time.sleep(0.1)
+        # The gait streams (its handlers are installed) once 100 goals reached the servos.
+        assert wait_for(lambda: len(_goal_writes(emu.log(), robot)) > 100, timeout_s=60,
+                        every_s=0.1, stop=lambda: proc.poll() is not None), \
+            "the walk never streamed"
         proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=20)
+        out, err = proc.communicate(timeout=30)
     finally:
         if proc.poll() is None:
             proc.kill()

@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import json
 import threading
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from waiting import wait_for
 
 import robot.cli as cli
 from robot.config.bundled import DEFAULT_ROBOT
@@ -65,14 +65,18 @@ def test_panel_take_with_live_changes_replays_exactly(tmp_path: Path) -> None:
     name = studio.record("live")
     done = threading.Event()
 
+    def ticks() -> int:
+        return int(controller.state()["tick"])
+
     def puppeteer() -> None:
         for changes in ({"speed": 0.7}, {"turn": 0.1}, {"Slgt_R": 0.6, "Slgt_L": 0.6},
                         {"turn": -0.05}, {"speed": 0.9}):
-            time.sleep(0.15)
+            at = ticks()
+            wait_for(lambda at=at: ticks() >= at + 30)   # each some ticks after the last
             controller.set_params(changes)
         done.set()
     threading.Thread(target=puppeteer).start()
-    assert done.wait(10)
+    assert done.wait(60)
     assert controller.running, controller.state()  # walking still, no fault
     controller.stop()
     assert controller.wait(30) and studio.recording is None

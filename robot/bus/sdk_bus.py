@@ -149,10 +149,14 @@ class SdkBus(SdkRegisters, Bus):
         return n
 
     def scan(self, ids: Iterable[int]) -> list[ServoInfo]:
+        """The servos among ``ids`` that answer a ping; a silent id gets a second ping after
+        the others (one late reply must not read as a missing servo, as in health.check)."""
         found: list[ServoInfo] = []
         unit_us = RETURN_DELAY_UNIT_S[self.family] * 1e6
-        for sid in sorted(set(ids)):
-            model = self.ping(sid)
+        wanted = sorted(set(ids))
+        models = {sid: self.ping(sid) for sid in wanted}
+        models.update({sid: self.ping(sid) for sid in wanted if models[sid] is None})
+        for sid, model in models.items():
             if model is None:
                 continue
             found.append(ServoInfo(

@@ -6,6 +6,7 @@ config error, 128 + signal number when a signal stopped the run (130 SIGINT, 143
 
 from __future__ import annotations
 
+import logging
 import signal
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -14,6 +15,8 @@ from typing import Any, Protocol
 from robot.loop.telemetry import LoopStats
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+log = logging.getLogger(__name__)
 
 
 class Stoppable(Protocol):
@@ -34,6 +37,9 @@ class SignalLatch:
         self.count += 1
         if self.first is None:
             self.first = signum
+            # Said once handled: a second signal sent before this line is one the kernel
+            # may merge with the first (same number), so senders wait for it.
+            log.warning("signal %s: stopping (a second signal stops at once)", name)
             target.request_stop(f"signal {name}")
         else:
             target.emergency_stop(f"emergency stop (second signal, {name})")

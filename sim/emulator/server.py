@@ -27,6 +27,7 @@ from sim.emulator import dxl1_protocol, dxl_protocol, sts_protocol
 from sim.emulator.servo import EmulatedServo, ServoSpec
 
 LOG_MAX = 200_000            # packets kept in the child
+QUIET_POLL_S = 0.005         # idle wake-up [s]: how fresh ``quiet_at`` stays (see serve)
 TCGETS2 = 0x802C542A         # Linux ioctl: struct termios2 (44 bytes), c_ospeed at word 10
 TERMIOS2_WORDS = 11
 TERMIOS2_OSPEED = 10
@@ -90,6 +91,7 @@ class _ChainServer:
         self.drop_rate = self.corrupt_rate = 0.0
         self.missing: set[int] = set()
         self.vanish: dict[int, float] = {}
+        self.quiet_at = now      # the last time the line was seen empty [s]
         master, slave = os.openpty()
         tty.setraw(slave)
         os.set_blocking(master, False)
@@ -134,7 +136,7 @@ class _ChainServer:
                 self.counters["baud_mismatch"] += 1
                 continue
             for s in listening:
-                s.update(now)
+                s.update(now, quiet_until=self.quiet_at)
             # Servos sharing an id all execute the packet and all answer (on a real bus
             # their replies collide); each layer holds at most one servo per id.
             layers: list[dict[int, EmulatedServo]] = []
@@ -204,21 +206,20 @@ class _ChainServer:
         if cmd == "counters":
             return dict(self.counters)
         if cmd == "registers":
-            s = self.by_id(args[0])
-            s.update(time.monotonic())
-            return s.snapshot()
+            return self.advance(self.by_id(args[0])).snapshot()
         if cmd == "plug":
             return self.plug(args[0])
         if cmd == "registers_of":
-            s = self.servos[args[0]]
-            s.update(time.monotonic())
-            return s.snapshot()
+            return self.advance(self.servos[args[0]]).snapshot()
         if cmd == "set_register":
-            s = self.by_id(args[0])
-            s.update(time.monotonic())
-            s.set(args[1], args[2])
-            return None
+            return self.advance(self.by_id(args[0])).set(args[1], args[2])
         raise EmulatorError(f"unknown emulator request {cmd!r}")
+
+    def advance(self, s: EmulatedServo) -> EmulatedServo:
+        """``s`` updated to now. Its watchdog counts only the silence this process saw: a
+        stall of the emulator itself (a loaded machine) is not a silent host."""
+        s.update(time.monotonic(), quiet_until=self.quiet_at)
+        return s
 
     def plug(self, indices: list[int] | None) -> None:
         """Connect exactly ``indices`` (None: every servo); a newly connected servo powers on."""
@@ -239,14 +240,12 @@ class _ChainServer:
             self.missing = set(f["missing_ids"])
         self.vanish.update(f.get("vanish_at") or {})
         if f.get("stuck_ids") is not None:
-            now = time.monotonic()
             for s in self.servos:
-                s.update(now)
-                s.stuck = s.servo_id in f["stuck_ids"]
+                self.advance(s).stuck = s.servo_id in f["stuck_ids"]
         for sid, kind in (f.get("hw_error") or {}).items():
             s = self.by_id(sid)
             s.conditions = {kind} if kind else set()
-            s.update(time.monotonic())
+            self.advance(s)
         if f.get("close_port"):
             self.close_port()
 
@@ -254,7 +253,9 @@ class _ChainServer:
         self.conn.send(("ready", self.path))
         while True:
             fds: list[Any] = [self.conn] + ([self.master] if self.master is not None else [])
-            readable, _, _ = select.select(fds, [], [])
+            readable, _, _ = select.select(fds, [], [], QUIET_POLL_S)
+            if self.master not in readable:
+                self.quiet_at = time.monotonic()
             if self.master is not None and self.master in readable:
                 try:
                     data = os.read(self.master, 4096)

@@ -147,13 +147,14 @@ class EmulatedServo:
         wd = self.watchdog
         return wd is not None and self.get(wd.register) == wd.tripped
 
-    def update(self, now: float) -> None:
-        """Advance the position model (and the watchdog) to ``now`` [s, time.monotonic()]."""
+    def update(self, now: float, *, quiet_until: float = float("inf")) -> None:
+        """Advance motion to ``now`` and the watchdog to ``quiet_until`` (silence seen) [s,
+        time.monotonic()]."""
         self._assert_faults()
         wd = self.watchdog
         deadline = None if wd is None else wd.deadline(
             self.get(wd.register), torque_on=bool(self.get("torque_enable")), heard=self.heard)
-        if wd is not None and deadline is not None and deadline < now:
+        if wd is not None and deadline is not None and deadline < min(now, quiet_until):
             self._advance(max(deadline, self._t))
             self.set("goal_position", round(self._pos))   # stop where it is
             self.set(wd.register, wd.tripped)

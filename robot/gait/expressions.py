@@ -145,14 +145,3 @@ def curves(times: npt.NDArray[np.float64], p: GaitParams) -> dict[str, npt.NDArr
     out = channels(phase_at(np.asarray(times, dtype=float), p), p)
     n = len(times)
     return {k: np.broadcast_to(np.asarray(v, dtype=float), (n,)) for k, v in out.items()}
-
-
-class PhaseIntegrator:
-    """Live phase state: ``step(params, dt)`` integrates, so parameter changes never jump."""
-
-    def __init__(self, start: Phase | None = None) -> None:
-        self.phase = start if start is not None else Phase(0.0, 0.0, 0.0, 0.0, 0.0)
-
-    def step(self, p: GaitParams, dt: float) -> Phase:
-        self.phase = advance(self.phase, p, dt)
-        return self.phase

@@ -16,6 +16,7 @@ import robot.cli as cli
 from robot.bus.servo_map import ServoMap
 from robot.config.gait_file import load_gait
 from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from robot.gait.engine import GaitEngine
 from robot.loop.latency import SampleStats
 from robot.loop.streamer import Streamer
@@ -123,14 +124,15 @@ def test_sample_stats_exact_while_small_bounded_when_large() -> None:
 def test_bus_watchdog_armed_past_the_longest_retried_transaction(
         emu: Emulator, robot: RobotConfig, robot_toml: Path) -> None:
     """Bus Watchdog (X-series address 98, 20 ms units) is armed while streaming, for longer
-    than a transaction retried to its end (50 ms x 3 attempts here), and disarmed after."""
+    than a transaction retried to its end (the harness file's reply timeout x 3 attempts),
+    and disarmed after."""
     emu.log(clear=True)
     assert cli.main(["walk", "--bus", "dynamixel", "--port", emu.port, "--robot",
                      str(robot_toml), "--seconds", "0.3", "--set", "ramp_cycles=0.5"]) == 0
     writes = [p for p in emu.log() if p.instruction == "write" and p.address == 98]
     values = {i: [p.values[i] for p in writes if i in p.values] for i in robot.ids}
-    span = 0.050 * 3
-    steps = math.ceil((1.5 * span + 2 / 200.0) / 0.020 - 1e-9)   # 12: 0.24 s
-    assert steps == 12
+    bus = load_robot(robot_toml).bus                             # the file the walk ran
+    span = bus.timeout_ms * 1e-3 * (bus.retries + 1)             # every attempt times out
+    steps = math.ceil((1.5 * span + 2 / 200.0) / 0.020 - 1e-9)   # 1.5 x span + 2 ticks
     assert all(v == [0, steps, 0] for v in values.values()), values   # clear, arm, disarm
     assert {emu.registers(i)["bus_watchdog"] for i in robot.ids} == {0}

@@ -299,7 +299,8 @@ def test_signals(emu: Emulator, robot: RobotConfig, robot_toml: Path, case: str,
     reader.start()
     try:
         assert wait_for(lambda: emu.counters().get("sync_write", 0) >= 250, timeout_s=60,
-                        stop=lambda: proc.poll() is not None), "the walk never streamed"
+                        stop=lambda: proc.poll() is not None), \
+            f"the walk never streamed: {''.join(err_lines)}"
         for k, sig in enumerate(sent):
             if k:   # the first was handled (the walk says so): the second is its own signal
                 assert wait_for(lambda: any("stopping" in line for line in err_lines),

@@ -149,7 +149,7 @@ def test_sigint_ramps_out_and_leaves_torque_off(emu: Emulator, robot: RobotConfi
         # The gait streams (its handlers are installed) once 100 goals reached the servos.
         assert wait_for(lambda: len(_goal_writes(emu.log(), robot)) > 100, timeout_s=60,
                         every_s=0.1, stop=lambda: proc.poll() is not None), \
-            "the walk never streamed"
+            f"the walk never streamed: {proc.poll() is not None and proc.communicate()[1]}"
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=30)
     finally:

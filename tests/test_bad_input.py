@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from bus_harness import TEST_TIMEOUT_MS
 
 import robot.cli as cli
 from robot.config.bundled import ROBOTS_DIR
@@ -44,9 +45,9 @@ JOINT_RANGES = {"servo_id": "[0, 252]", "zero_ticks": "[0, 4095]", "min_rad": "[
 
 
 def base_robot(protocol: str = "dynamixel") -> str:
-    # A reply timeout that tolerates a busy test machine (as in test_cli_bus).
+    # A reply timeout that tolerates a busy test machine (the harness's, tests/bus_harness.py).
     text = (ROBOTS_DIR / f"biped18-{protocol}.toml").read_text()
-    return text.replace("timeout_ms = 20.0", "timeout_ms = 50.0")
+    return text.replace("timeout_ms = 20.0", f"timeout_ms = {TEST_TIMEOUT_MS}")
 
 
 def set_field(text: str, table: str, key: str, value: str) -> str:

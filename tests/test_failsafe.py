@@ -151,10 +151,11 @@ class Child:
     """A driver in its own process: opens the bus, torque on, arms, streams until killed."""
 
     SCRIPT = """
-import sys, time
+import sys
 from robot.bus.factory import make_bus
 from robot.config.bundled import ROBOTS_DIR
 from robot.config.robot_file import load_robot
+from robot.loop.clock import MonotonicClock
 protocol, port, timeout_s, knee_id, knee = sys.argv[1:6]
 robot = load_robot(ROBOTS_DIR / f"biped18-{protocol}.toml")
 bus = make_bus(protocol, robot=robot, port=port, timeout_ms=50.0)
@@ -163,10 +164,11 @@ bus.set_torque(robot.ids, enabled=True)
 bus.arm_failsafe(robot.ids, timeout_s=float(timeout_s))
 goals = {i: (int(knee) if i == int(knee_id) else 2048) for i in robot.ids}
 print("streaming", flush=True)
-start = time.monotonic()
+clock = MonotonicClock()
+start = clock.now()
 for k in range(1, 10**9):
     bus.write_goals(goals)
-    time.sleep(max(0.0, start + k * 0.005 - time.monotonic()))
+    clock.sleep_until(start + k * 0.005)   # absolute deadlines, as the streamer keeps them
 """
 
     def __init__(self, emu: Emulator) -> None:

@@ -10,6 +10,8 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
+from robot.loop.clock import MonotonicClock
+
 #: Deadline for a condition that takes well under a second on an idle machine [s]:
 #: generous, because a loaded 2-core machine stalls processes for seconds.
 PATIENCE_S = 20.0
@@ -29,6 +31,5 @@ def wait_for(pred: Callable[[], bool], *, timeout_s: float = PATIENCE_S, every_s
 
 
 def sleep_until(t: float) -> None:
-    """Return once the monotonic clock reads at least ``t`` [s]."""
-    while (left := t - time.monotonic()) > 0:
-        time.sleep(left)
+    """Return once the monotonic clock reads at least ``t`` [s] (the loop's own clock)."""
+    MonotonicClock().sleep_until(t)

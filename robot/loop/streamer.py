@@ -81,8 +81,7 @@ class Streamer(Generic[SourceT]):
         self._bus_dead = False
         self._q_last: JointVector = np.zeros(len(robot_map.ids))
         self._lateness = SampleStats()
-        self._overruns = 0
-        self._bus_errors = 0
+        self._overruns = self._bus_errors = 0
         self._next = 0.0
         self._ticks = 0
 
@@ -116,6 +115,10 @@ class Streamer(Generic[SourceT]):
         self.telemetry.stop_reason = reason
         self._estop.set()
         self._stop.set()
+
+    def fault(self, reason: str) -> None:
+        """End the run as a fault (an observer's verdict): ramp out, rest, torque off."""
+        self._set_fault(reason)
 
     # -- runs ----------------------------------------------------------------------------
     def run(self, *, seconds: float | None = None) -> LoopStats:

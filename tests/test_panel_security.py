@@ -288,3 +288,27 @@ def test_token_panel_answers_to_its_lan_url(token_panel: tuple[PanelController, 
     hostname = socket.gethostname()
     assert get(port, "/api/state", host=f"{hostname}:{port}", extra=auth).status == 200
     assert get(port, "/api/state", host=f"evil.example:{port}", extra=auth).status == 421
+
+
+def test_bearer_scheme_is_case_insensitive(token_panel: tuple[PanelController, int]) -> None:
+    """RFC 7235: the auth scheme is case-insensitive; the token itself is not."""
+    _, port = token_panel
+    for scheme in ("bearer", "BEARER", "BeArEr"):
+        assert get(port, "/api/state", extra=f"Authorization: {scheme} s3cret-tok\n"
+                   ).status == 200, scheme
+    assert get(port, "/api/state", extra="Authorization: bearer S3CRET-TOK\n").status == 401
+    assert get(port, "/api/state", extra="Authorization: Basic s3cret-tok\n").status == 401
+
+
+def test_number_with_thousands_of_digits_is_one_line_400(served: tuple[PanelController, int],
+                                                          capfd: pytest.CaptureFixture[str]
+                                                          ) -> None:
+    controller, port = served
+    before = controller.params
+    for body in (b'{"vM": ' + b"9" * 5000 + b"}", b'{"vM": ' + b"9" * 1000 + b"}",
+                 b'{"vM": 1e999}', b'{"vM": NaN}', b"[" * 60000):
+        r = post(port, "/api/params", body)
+        assert r.status == 400 and "\n" not in r.body["error"], (r.status, r.body)
+        assert "sys." not in r.body["error"]
+    assert controller.params == before
+    assert "Traceback" not in capfd.readouterr().err

@@ -75,10 +75,10 @@ class Flood:
 
     OPENERS = 16
 
-    def __init__(self, port: int, n: int, *, with_token: bool) -> None:
+    def __init__(self, port: int, n: int, *, token: str | None) -> None:
         head = f"GET /api/state HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n"
-        if with_token:
-            head += f"Authorization: Bearer {TOKEN}\r\n"
+        if token:
+            head += f"Authorization: Bearer {token}\r\n"
         self.head = (head + "X-Slow: ").encode()
         self.port = port
         self.socks: list[socket.socket] = []
@@ -172,7 +172,7 @@ def measure_flood(*, connections: int = 800, hold_s: float = 20.0, drip_s: float
             time.sleep(settle_s)
             before = _state(base)
             t_flood = time.monotonic()
-            flood = Flood(port, connections, with_token=with_token)
+            flood = Flood(port, connections, token=TOKEN if with_token else None)
             stop = threading.Event()
 
             def watch() -> None:

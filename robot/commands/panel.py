@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import secrets
 import signal
 import time
@@ -88,6 +89,19 @@ def _route_signals(target: _Deferred, latch: SignalLatch) -> None:
         signal.signal(s, handler)
 
 
+#: How much lower this process's CPU priority is than the loop process's (nice units).
+WEB_NICE = 5
+
+
+def _give_way() -> None:
+    """Lower this process's CPU priority below the loop process's (started already, it
+    keeps its own): on a busy machine the scheduler prefers the loop to the web side."""
+    try:
+        os.nice(WEB_NICE)
+    except OSError as e:
+        log.debug("could not lower the web side's priority: %s", e)
+
+
 def _farewell(report: dict[str, Any], *, aborted: bool) -> tuple[str, bool]:
     """The last line, from what the loop told the wire; and whether torque is safe."""
     failed = list(report.get("failed", []))
@@ -131,6 +145,7 @@ def run(args: argparse.Namespace) -> int:
     report: dict[str, Any] = {}
     try:
         controller.open()                 # the loop process, the bus open: or one line
+        _give_way()
         try:
             server = build_server(controller, host=args.host, port=args.http_port,
                                   token=token, studio=studio)

@@ -29,6 +29,7 @@ import sys
 import tempfile
 import threading
 import time
+import urllib.error
 import urllib.request
 from pathlib import Path
 from typing import Any
@@ -51,14 +52,26 @@ def _robot_file(tmp: Path) -> Path:
     return path
 
 
-def _state(base: str) -> dict[str, Any]:
+def panel_state(base: str) -> dict[str, Any]:
     req = urllib.request.Request(base + "api/state",
                                  headers={"Authorization": f"Bearer {TOKEN}"})
     with urllib.request.urlopen(req, timeout=10) as r:
         return dict(json.load(r))
 
 
-def _threads(pid: int) -> int:
+def panel_post(base: str, path: str) -> int:
+    """POST ``path`` (an empty JSON body) with the token; the status."""
+    req = urllib.request.Request(base + path.lstrip("/"), data=b"{}", method="POST",
+                                 headers={"Authorization": f"Bearer {TOKEN}",
+                                          "Content-Type": "application/json"})
+    try:
+        with urllib.request.urlopen(req, timeout=30) as r:
+            return int(r.status)
+    except urllib.error.HTTPError as e:
+        return int(e.code)
+
+
+def thread_count(pid: int) -> int:
     try:
         for line in Path(f"/proc/{pid}/status").read_text().splitlines():
             if line.startswith("Threads:"):
@@ -137,7 +150,9 @@ def _gaps_ms(times: np.ndarray, lo: float, hi: float) -> dict[str, float]:
             "gaps_over_2_periods": int((gaps > 2 * period).sum())}
 
 
-def _launch(python: str, emu_port: str, tmp: Path) -> tuple[subprocess.Popen[str], str]:
+def launch_panel(python: str, emu_port: str, tmp: Path) -> tuple[subprocess.Popen[str], str]:
+    """`biped panel` (run by ``python``) on every address with ``TOKEN``, walking the
+    emulated chain on ``emu_port``; the process and its loopback base URL."""
     cmd = [python, "-m", "robot.cli", "panel", "--bus", "dynamixel", "--port", emu_port,
            "--robot", str(_robot_file(tmp)), "--host", "0.0.0.0", "--token", TOKEN,
            "--http-port", "0", "--rate", f"{RATE_HZ:g}", "--presets-dir", str(tmp / "p"),
@@ -160,26 +175,26 @@ def measure_flood(*, connections: int = 800, hold_s: float = 20.0, drip_s: float
     robot = load_robot(ROBOTS_DIR / "biped18-dynamixel.toml")
     seen: dict[str, Any] = {"states": set(), "threads_max": 0, "reported_hz_min": None}
     with Emulator("dynamixel", robot) as emu, tempfile.TemporaryDirectory() as d:
-        proc, base = _launch(python, emu.port, Path(d))
+        proc, base = launch_panel(python, emu.port, Path(d))
         port = int(base.rsplit(":", 1)[1].strip("/"))
         try:
             end = time.monotonic() + 30
-            while _state(base)["state"] != "walking":
+            while panel_state(base)["state"] != "walking":
                 if time.monotonic() > end:
                     raise RuntimeError("the panel never reached walking")
                 time.sleep(0.1)
             t_base = time.monotonic()
             time.sleep(settle_s)
-            before = _state(base)
+            before = panel_state(base)
             t_flood = time.monotonic()
             flood = Flood(port, connections, token=TOKEN if with_token else None)
             stop = threading.Event()
 
             def watch() -> None:
                 while not stop.wait(0.25):
-                    seen["threads_max"] = max(seen["threads_max"], _threads(proc.pid))
+                    seen["threads_max"] = max(seen["threads_max"], thread_count(proc.pid))
                     try:
-                        s = _state(base)
+                        s = panel_state(base)
                     except OSError:
                         continue
                     seen["states"].add(s["state"])
@@ -197,13 +212,13 @@ def measure_flood(*, connections: int = 800, hold_s: float = 20.0, drip_s: float
                 time.sleep(0.05)
             opened_s = time.monotonic() - t_flood
             alive = flood.drip()
-            held = _state(base)
+            held = panel_state(base)
             t_close = time.monotonic()
             flood.close()
             time.sleep(settle_s)
             stop.set()
             watcher.join(5)
-            after = _state(base)
+            after = panel_state(base)
             tripped = [i for i in robot.ids if emu.registers(i)["bus_watchdog"] == -1]
             goals = np.array([p.t for p in emu.log() if p.instruction == "sync_write"
                               and p.address == GOAL_ADDRESS])

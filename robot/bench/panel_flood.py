@@ -71,6 +71,16 @@ def panel_post(base: str, path: str) -> int:
         return int(e.code)
 
 
+def stop_panel(proc: subprocess.Popen[str], timeout: float = 60.0) -> None:
+    """SIGTERM (a safe stop) and wait; killed if it has not ended after ``timeout`` [s]."""
+    proc.send_signal(signal.SIGTERM)
+    try:
+        proc.wait(timeout)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+
+
 def thread_count(pid: int) -> int:
     try:
         for line in Path(f"/proc/{pid}/status").read_text().splitlines():
@@ -223,12 +233,7 @@ def measure_flood(*, connections: int = 800, hold_s: float = 20.0, drip_s: float
             goals = np.array([p.t for p in emu.log() if p.instruction == "sync_write"
                               and p.address == GOAL_ADDRESS])
         finally:
-            proc.send_signal(signal.SIGTERM)
-            try:
-                proc.wait(30)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+            stop_panel(proc)
     return {
         "connections": connections, "with_token": with_token, "hold_s": hold_s,
         "refused_at_connect": flood.refused, "still_open_at_close": alive,

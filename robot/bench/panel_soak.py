@@ -19,8 +19,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import signal
-import subprocess
 import sys
 import tempfile
 import threading
@@ -36,6 +34,7 @@ from robot.bench.panel_flood import (
     launch_panel,
     panel_post,
     panel_state,
+    stop_panel,
     thread_count,
 )
 from robot.config.bundled import ROBOTS_DIR
@@ -155,12 +154,7 @@ def soak(*, minutes: float = 60.0, flood_every: float = 10.0, hold_s: float = 20
             watchers.close()
             tripped = [i for i in robot.ids if emu.registers(i)["bus_watchdog"] == -1]
         finally:
-            proc.send_signal(signal.SIGTERM)
-            try:
-                proc.wait(60)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+            stop_panel(proc)
     figures = {who: {k: _trend(samples, k, who) for k in ("rss_mib", "threads", "fds")}
                for who in ("web", "loop")}
     return {"minutes": minutes, "clients": CLIENTS, "floods": floods, "restarts": restarts,

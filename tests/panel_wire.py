@@ -209,3 +209,24 @@ def assert_estop_held(robot: RobotConfig, log: list[Packet], protocol: str,
 
 def torque_now(emu: Emulator, robot: RobotConfig) -> dict[int, int]:
     return {i: emu.registers(i)["torque_enable"] for i in robot.ids}
+
+
+def children(pid: int) -> list[int]:
+    """The processes whose parent is ``pid`` (from /proc)."""
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            out.append(int(stat.parent.name))
+    return out
+
+
+def gone(pid: int) -> bool:
+    """``pid`` has exited (or is a zombie waiting for its parent)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "Z"
+    except OSError:
+        return True

@@ -7,13 +7,14 @@ Watchdog) and the last line, which must say what the wire was told."""
 
 from __future__ import annotations
 
+import math
 import os
 import signal
 import time
 from pathlib import Path
 
 import pytest
-from panel_wire import Panel, launched, torque_now
+from panel_wire import Panel, children, gone, launched, torque_now
 from waiting import sleep_until, wait_for
 
 from robot.config.robot import RobotConfig
@@ -22,12 +23,22 @@ from sim.emulator.chain import Emulator
 pytest_plugins = ("bus_harness",)
 
 INT, TERM = signal.SIGINT, signal.SIGTERM
+RESOLUTION = 4096  # ticks per turn (XL430)
 RATE = 100.0  # [Hz]: what matters here is how it ends, not how fast it runs
 
 
 @pytest.fixture
 def protocol() -> str:
     return "dynamixel"  # the Bus Watchdog shows a stalled or unreachable loop
+
+
+def rest_goals(robot: RobotConfig) -> list[int]:
+    """The rest pose in ticks, by the manual's formula (ticks = zero + sign q 4096/2pi)."""
+    out = []
+    for j in robot.joints:
+        q = min(max(robot.rest.get(j.name, 0.0), j.min_rad), j.max_rad)
+        out.append(round(j.zero_ticks + j.sign * q * RESOLUTION / (2 * math.pi)))
+    return out
 
 
 def walking(panel: Panel) -> None:
@@ -151,3 +162,44 @@ def test_full_disk_under_record_and_save(emu: Emulator, robot: RobotConfig, robo
     assert code == 130 and out.splitlines()[-1].endswith("torque off"), out
     assert set(torque_now(emu, robot).values()) == {0}
     assert os.path.islink(takes / "full.take.jsonl")
+
+
+def test_web_side_killed_the_loop_stops_the_robot(emu: Emulator, robot: RobotConfig,
+                                                  robot_toml: Path, tmp_path: Path) -> None:
+    """SIGKILL on `biped panel` (nothing of it runs any more): its loop process sees the
+    pipe end, ramps out, rests, turns torque off and exits."""
+    with launched(emu, robot_toml, tmp_path, start=True, rate=RATE) as panel:
+        walking(panel)
+        (loop,) = children(panel.proc.pid)
+        panel.proc.kill()
+        panel.proc.wait(10)
+        assert wait_for(lambda: gone(loop), timeout_s=40), "the loop process did not end"
+    assert set(torque_now(emu, robot).values()) == {0}
+    goals = [p for p in emu.log() if p.instruction == "sync_write" and p.address == 116]
+    assert goals and goals[-1].values == {j.servo_id: t for j, t in zip(
+        robot.joints, rest_goals(robot), strict=True)}            # it rested first
+
+
+def test_loop_frozen_then_back_is_shown_then_stopped(emu: Emulator, robot: RobotConfig,
+                                                     robot_toml: Path, tmp_path: Path) -> None:
+    """The loop process frozen (SIGSTOP) for longer than the servos' Bus Watchdog: the
+    panel says the loop is not answering; when it runs again it finds the gap and stops
+    at once (torque off), never a silent "walking"."""
+    with launched(emu, robot_toml, tmp_path, start=True, rate=RATE) as panel:
+        walking(panel)
+        (loop,) = children(panel.proc.pid)
+        os.kill(loop, signal.SIGSTOP)
+        try:
+            assert wait_for(lambda: panel.state()["state"] == "fault", timeout_s=10)
+            assert "did not answer" in panel.state()["fault"]
+            assert wait_for(lambda: {emu.registers(i)["bus_watchdog"] for i in robot.ids}
+                            == {-1})                            # the servos stopped
+        finally:
+            os.kill(loop, signal.SIGCONT)
+        assert wait_for(lambda: not panel.state()["running"]), panel.state()
+        s = panel.state()
+        assert "stalled" in (s["fault"] or ""), s
+        assert set(torque_now(emu, robot).values()) == {0}
+        panel.proc.send_signal(INT)
+        code, out = end(panel)
+    assert code == 130 and out.splitlines()[-1].endswith("torque off"), out

@@ -165,7 +165,14 @@ class LoopProcess:
         return slot
 
     def call(self, op: str, *, timeout: float = 10.0, **args: Any) -> Any:
-        return self.send(op, **args).wait(timeout)
+        """Send ``op`` and wait for its answer (LoopUnavailable after ``timeout`` [s]; a
+        late answer is then dropped)."""
+        slot = self.send(op, **args)
+        try:
+            return slot.wait(timeout)
+        except LoopUnavailable:
+            self._pending = {k: v for k, v in self._pending.items() if v is not slot}
+            raise
 
     def close(self, timeout: float = 5.0) -> int | None:
         """End the pipe (the loop process ends as after ``shutdown``) and reap it. Shut

@@ -65,8 +65,9 @@ def _decode(kind: str, payload: Any) -> Any:
 class Pending:
     """An answer on its way (``wait``)."""
 
-    def __init__(self, op: str) -> None:
+    def __init__(self, op: str, rid: int = 0) -> None:
         self.op = op
+        self.rid = rid
         self._event = threading.Event()
         self._answer: tuple[str, Any] = ("internal", "no answer")
 
@@ -150,11 +151,11 @@ class LoopProcess:
 
     def send(self, op: str, **args: Any) -> Pending:
         """Send ``op`` now (in the caller's order); its answer comes to the Pending."""
-        slot = Pending(op)
+        rid = next(self._ids)
+        slot = Pending(op, rid)
         if self.gone is not None or self._conn is None:
             slot.set(("biped", self.gone or "the control loop is not running"))
             return slot
-        rid = next(self._ids)
         self._pending[rid] = slot
         try:
             with self._send_lock:
@@ -171,7 +172,7 @@ class LoopProcess:
         try:
             return slot.wait(timeout)
         except LoopUnavailable:
-            self._pending = {k: v for k, v in self._pending.items() if v is not slot}
+            self._pending.pop(slot.rid, None)
             raise
 
     def close(self, timeout: float = 5.0) -> int | None:

@@ -203,3 +203,37 @@ def test_loop_frozen_then_back_is_shown_then_stopped(emu: Emulator, robot: Robot
         panel.proc.send_signal(INT)
         code, out = end(panel)
     assert code == 130 and out.splitlines()[-1].endswith("torque off"), out
+
+
+def test_a_starved_loop_is_shown_late_then_stopped(emu: Emulator, robot: RobotConfig,
+                                                   robot_toml: Path, tmp_path: Path) -> None:
+    """The loop process gets 30 ms of every 100 (frozen the rest, never long enough to
+    trip the servos' Bus Watchdog): the panel shows it late while it walks, then the run
+    ends as a fault (ramped out to rest, torque off), never a silent "walking"."""
+    with launched(emu, robot_toml, tmp_path, "--set", "ramp_cycles=0.3", start=True,
+                  rate=RATE) as panel:
+        walking(panel)
+        (loop,) = children(panel.proc.pid)
+        seen: set[str] = set()
+        t, end_at, k = time.monotonic(), time.monotonic() + 20.0, 0
+        try:
+            while time.monotonic() < end_at:
+                os.kill(loop, signal.SIGSTOP)
+                sleep_until(t + 0.07)
+                os.kill(loop, signal.SIGCONT)
+                sleep_until(t + 0.1)
+                t, k = t + 0.1, k + 1
+                if k % 5 == 0:
+                    s = panel.state()
+                    seen.add(s["state"])
+                    if not s["running"]:
+                        break
+        finally:
+            os.kill(loop, signal.SIGCONT)
+        assert wait_for(lambda: not panel.state()["running"]), panel.state()
+        s = panel.state()
+        assert "late" in seen, seen
+        assert "late" in (s["fault"] or "") and "safe stop" in s["fault"], s
+        assert set(torque_now(emu, robot).values()) == {0}
+        assert [emu.registers(j.servo_id)["goal_position"] for j in robot.joints] == \
+            rest_goals(robot)                                   # ramped out to rest

@@ -22,17 +22,17 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 from robot.balance.stage import Balance, attitude_reader
-from robot.bus.base import Bus
 from robot.bus.lease import BusLease, Session
 from robot.bus.servo_map import ServoMap
 from robot.config.params import GaitParams
 from robot.errors import BipedError
 from robot.imu import Imu
-from robot.loop.watchdog import FAILSAFE_MARGIN, WatchdogConfig
+from robot.loop.take_writer import TakeWriter
 from robot.motion.posing import Capture, limb_joints, limbs
 from robot.panel.idle_pose import IdlePose
 from robot.panel.loop_watch import LoopWatch
 from robot.panel.options import HostSpec, PanelStateError
+from robot.panel.rate_guard import stall_limit_s
 from robot.panel.runs import RunKind, build
 from robot.panel.sim_monitor import sim_monitor_factory
 from robot.panel.sim_reset import reset_to_home
@@ -45,13 +45,6 @@ log = logging.getLogger(__name__)
 
 #: ``done(outcome)``: answer a command later; the outcome is a payload or an exception.
 Done = Callable[[object], None]
-
-
-def stall_limit_s(bus: Bus, rate_hz: float) -> float:
-    """The longest gap between ticks the servos' own bus watchdog survives [s]: what the
-    streamer arms it with (robot.loop.ending.arm_failsafe)."""
-    failsafe = WatchdogConfig().failsafe_s or 0.0
-    return max(failsafe, FAILSAFE_MARGIN * bus.retry_span_s + 2.0 / rate_hz)
 
 
 class LoopHost:
@@ -74,7 +67,6 @@ class LoopHost:
         self._capture: Capture | None = None
         self._polling = False
         self.closing = False
-        self.closed = threading.Event()
 
     def open(self) -> None:
         """Open the bus (a wrong port fails here, before anything is served) and the
@@ -177,6 +169,17 @@ class LoopHost:
             self._run, self._capture = run, None
         self.watch.begin(kind, built.driver)
         done({"state": "starting"})
+        try:
+            self._stream(kind, run, built.recorder, session)
+        finally:
+            session.end()              # free before "not running": a start may follow
+            with self._lock:
+                self._run = None
+        return None
+
+    def _stream(self, kind: RunKind, run: Run[Any], recorder: TakeWriter | None,
+                session: Session) -> None:
+        """Stream the run, close it, and report how it ended."""
         stats = None
         try:
             stats = run.stream()
@@ -185,9 +188,7 @@ class LoopHost:
             self.watch.failed(f"{type(e).__name__}: {e}")
         finally:
             run.close()
-            with self._lock:
-                self._run = None
-        error = built.recorder.close_quietly() if built.recorder is not None else None
+        error = recorder.close_quietly() if recorder is not None else None
         if error:
             log.error("panel: %s: %s", kind.owner, error)
         holding = stats is not None and stats.holding and session.live
@@ -195,7 +196,6 @@ class LoopHost:
             self.lease.torque_off(self.robot.ids)     # an e-stop as the run ended holding
         self.watch.end(stats, holding=holding, record_error=error,
                        telemetry=run.streamer.telemetry)
-        return None
 
     def _verdict(self, stop: str, at_once: bool) -> None:
         run = self._run
@@ -210,7 +210,7 @@ class LoopHost:
         run = self._run
         if run is not None:
             run.request_stop("panel stop")
-        return {"state": self.watch.state_name(running=run is not None)}
+        return {"state": self.watch.state_name()}
 
     def emergency_stop(self) -> dict[str, Any]:
         """Latch at the bus edge and torque off now; the run (if any) ends within a tick."""

@@ -110,9 +110,9 @@ class LoopWatch:
             self.holding, self._sim, self.fault = False, {}, None
             self._tel = {"state": "idle", "stop_reason": "simulation reset"}
 
-    def state_name(self, *, running: bool) -> str:
+    def state_name(self) -> str:
         with self._lock:
-            return str(self._tel.get("state", "idle")) if running or self._tel else "idle"
+            return str(self._tel.get("state", "idle"))
 
     def snapshot(self, *, running: bool) -> dict[str, Any]:
         with self._lock:

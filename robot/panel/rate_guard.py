@@ -18,6 +18,9 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass
 
+from robot.bus.base import Bus
+from robot.loop.watchdog import FAILSAFE_MARGIN, WatchdogConfig
+
 
 @dataclass(frozen=True)
 class Verdict:
@@ -97,3 +100,10 @@ class RateGuard:
         if late_for >= self.late_stop_s or slow_for >= self.stop_after_s:
             return Verdict(f"{alarm}, for {late_for:.1f} s: safe stop", stop=True)
         return Verdict(alarm)
+
+
+def stall_limit_s(bus: Bus, rate_hz: float) -> float:
+    """The longest gap between ticks the servos' own bus watchdog survives [s]: what the
+    streamer arms it with (robot.loop.ending.arm_failsafe)."""
+    failsafe = WatchdogConfig().failsafe_s or 0.0
+    return max(failsafe, FAILSAFE_MARGIN * bus.retry_span_s + 2.0 / rate_hz)

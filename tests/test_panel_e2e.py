@@ -6,7 +6,9 @@ Waits use Playwright's ``expect`` (no string evaluation: the page's CSP forbids 
 
 from __future__ import annotations
 
+import os
 import re
+import signal
 import time
 from collections.abc import Iterator
 
@@ -160,3 +162,20 @@ def test_token_mode_from_a_phone(browser: Browser) -> None:
         server.shutdown()
         server.server_close()
         controller.shutdown(timeout=2.0)
+
+
+def test_a_loop_that_does_not_answer_is_shown(running: tuple[PanelController, str],
+                                              page: Page) -> None:
+    """The loop process frozen: the page says so (state and the fault row), never a
+    stale "walking"; when it runs again the page follows it."""
+    controller, _ = running
+    expect(page.locator("#state")).to_have_text("walking")
+    loop = controller.pid
+    assert loop is not None
+    os.kill(loop, signal.SIGSTOP)
+    try:
+        expect(page.locator("#state")).to_have_text(re.compile("^fault"), timeout=15000)
+        expect(page.locator("#loop")).to_contain_text("did not answer")
+    finally:
+        os.kill(loop, signal.SIGCONT)
+    expect(page.locator("#state")).to_have_text("walking", timeout=15000)

@@ -160,6 +160,13 @@ def _gaps_ms(times: np.ndarray, lo: float, hi: float) -> dict[str, float]:
             "gaps_over_2_periods": int((gaps > 2 * period).sum())}
 
 
+def _rates(states: list[dict[str, Any]], times: list[float]) -> dict[str, float]:
+    """Overruns per second in the windows before the flood, while it held, after it."""
+    n = [int(s.get("overruns", 0)) for s in states]
+    return {w: round((n[k + 1] - n[k]) / max(times[k + 1] - times[k], 1e-9), 1)
+            for k, w in enumerate(("quiet", "holding", "after_close"))}
+
+
 def launch_panel(python: str, emu_port: str, tmp: Path) -> tuple[subprocess.Popen[str], str]:
     """`biped panel` (run by ``python``) on every address with ``TOKEN``, walking the
     emulated chain on ``emu_port``; the process and its loopback base URL."""
@@ -193,7 +200,7 @@ def measure_flood(*, connections: int = 800, hold_s: float = 20.0, drip_s: float
                 if time.monotonic() > end:
                     raise RuntimeError("the panel never reached walking")
                 time.sleep(0.1)
-            t_base = time.monotonic()
+            t_base, start = time.monotonic(), panel_state(base)
             time.sleep(settle_s)
             before = panel_state(base)
             t_flood = time.monotonic()
@@ -242,8 +249,10 @@ def measure_flood(*, connections: int = 800, hold_s: float = 20.0, drip_s: float
         "wire_before": _gaps_ms(goals, t_base, t_flood),
         "wire_holding": _gaps_ms(goals, t_flood, t_close),
         "wire_after_close": _gaps_ms(goals, t_close, t_close + settle_s),
-        "overruns": {"before": before.get("overruns"), "holding": held.get("overruns"),
-                     "after": after.get("overruns")},
+        "overruns": {"start": start.get("overruns"), "before": before.get("overruns"),
+                     "holding": held.get("overruns"), "after": after.get("overruns")},
+        "overruns_per_s": _rates([start, before, held, after],
+                                 [t_base, t_flood, t_close, t_close + settle_s]),
         "loop_hz_reported_min": seen["reported_hz_min"],
         "states_seen": sorted(seen["states"]), "state_after": after.get("state"),
         "fault_after": after.get("fault"),

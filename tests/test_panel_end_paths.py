@@ -237,3 +237,32 @@ def test_a_starved_loop_is_shown_late_then_stopped(emu: Emulator, robot: RobotCo
         assert set(torque_now(emu, robot).values()) == {0}
         assert [emu.registers(j.servo_id)["goal_position"] for j in robot.joints] == \
             rest_goals(robot)                                   # ramped out to rest
+
+
+@pytest.mark.parametrize("fault", ["overheating", "drop100"])
+def test_a_bus_fault_mid_walk_is_shown_and_torque_goes_off(
+        emu: Emulator, robot: RobotConfig, robot_toml: Path, tmp_path: Path,
+        fault: str) -> None:
+    """A servo's hardware error flag, or a bus that stops answering: the run stops at
+    once on the watchdog, torque off at the wire, the panel shows why and serves on;
+    a new start works once the bus is well again."""
+    knee = robot.joint("l_knee").servo_id
+    with launched(emu, robot_toml, tmp_path, start=True, rate=RATE) as panel:
+        walking(panel)
+        if fault == "drop100":
+            emu.set_faults(drop_rate=1.0)
+        else:
+            emu.set_faults(hw_error={knee: fault})
+        assert wait_for(lambda: not panel.state()["running"]), panel.state()
+        s = panel.state()
+        assert s["fault"] and s["fault"].startswith("watchdog"), s
+        assert ("bus errors" if fault == "drop100" else f"reports {fault}") in s["fault"]
+        assert set(torque_now(emu, robot).values()) == {0}
+        emu.clear_faults()
+        if fault == "drop100":
+            assert panel.request("POST", "/api/start")[0] == 200
+            walking(panel)
+        panel.proc.send_signal(INT)
+        code, out = end(panel)
+    assert code == 130 and out.splitlines()[-1].endswith("torque off"), out
+    assert set(torque_now(emu, robot).values()) == {0}

@@ -87,8 +87,8 @@ class LoopWatch:
             self.last_stats, self.holding = stats, holding
             self.kind = self.driver = None
             self.record_error = record_error
-            if stats is not None and stats.fault and self.fault is None:
-                self.fault = stats.stop_reason
+            if stats is not None:      # how it ended, not a late alarm from before
+                self.fault = stats.stop_reason if stats.fault else None
 
     def failed(self, reason: str) -> None:
         with self._lock:

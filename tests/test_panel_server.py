@@ -318,3 +318,17 @@ def test_idle_figure_shows_the_read_back_pose_without_writing(protocol: str,
             server.shutdown()
             server.server_close()
             controller.shutdown()
+
+
+def test_a_start_may_be_the_first_thing_asked() -> None:
+    """No I/O in the constructor: the first request (here a start) starts the loop
+    process and the bus."""
+    robot = load_robot(DEFAULT_ROBOT)
+    controller = PanelController(robot, BusSpec("sim"), load_gait("walk").params)
+    assert controller.pid is None
+    try:
+        controller.start()
+        assert controller.pid is not None and controller.running
+    finally:
+        controller.emergency_stop()
+        assert controller.shutdown(timeout=5)["holding"] is False

@@ -116,13 +116,14 @@ class PanelController:
     def _move(self, op: str, received: float | None, **args: Any) -> Any:
         """Send a mover in arrival order (refused if an e-stop arrived after it) and wait
         for its answer."""
+        loop = self.loop                       # opened outside the lock (it takes it)
         with self._lock:
             if received is not None and received <= self._estop_at:
                 raise PanelStateError("an emergency stop came after this request was sent: "
                                       "nothing moved; send it again")
             if self._closing:
                 raise PanelStateError("the panel is shutting down")
-            pending = self.loop.send(op, **args)
+            pending = loop.send(op, **args)
         try:
             return pending.wait(MOVE_TIMEOUT_S)
         finally:
@@ -160,10 +161,11 @@ class PanelController:
     def emergency_stop(self, *, received: float | None = None) -> list[str]:
         """Latch at the bus edge and torque off at once (a run ends within one tick);
         answers once torque off has been sent: the failures, one line each."""
+        loop = self.loop
         with self._lock:
             self._estop_at = max(self._estop_at, time.monotonic() if received is None
                                  else received)
-            pending = self.loop.send("estop")
+            pending = loop.send("estop")
         try:
             return list(pending.wait(ESTOP_TIMEOUT_S)["failed"])
         finally:

@@ -22,6 +22,7 @@ COMMANDS: tuple[str, ...] = (
     "play",
     "capture",
     "export",
+    "import_",
     "curves",
     "scan",
     "torque",

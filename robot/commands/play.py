@@ -36,6 +36,7 @@ from robot.loop.take_writer import TakeWriter
 from robot.motion.keyframes import SUFFIXES, load_sequence, parse_sequence
 from robot.motion.layered import LayeredEngine
 from robot.motion.scripted import PlaybackEngine
+from robot.motion.show import show_of, stream_sequence
 from robot.motion.takes import SUFFIX, Take, TakeHeader, is_take, read_take
 from robot.run.run import Run
 from robot.run.spec import RunOptions, RunSpec
@@ -62,6 +63,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                    help=f"record the replay (.csv, .jsonl or NAME{SUFFIX})")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     add_balance_args(p)
+    p.add_argument("--balance", action="store_true", help="an imported take (biped import): "
+                   "the balance stage corrects the legs while the arms and head perform as "
+                   "authored (needs the robot's [imu])")
     p.set_defaults(set=[])
     return p
 
@@ -95,9 +99,15 @@ def run(args: argparse.Namespace) -> int:
         layer = (parse_sequence(h.keyframes, robot, source=f"{take.source}: keyframes")
                  if h.keyframes else None)
         stop = take.stop_tick if take.stop_tick is not None else len(take.t)
-        args.no_balance = args.no_balance or not h.balance
-        engine = PlaybackEngine(robot, h.params, changes=take.changes, stop_tick=stop,
-                                keyframes=layer)
+        show = show_of(h.show, take.source)
+        if show.stream:   # an imported animation: its joints as they are (--balance: legs)
+            engine = LayeredEngine(robot, h.params, keyframes=stream_sequence(take),
+                                   walk=False)
+            args.no_balance = not args.balance
+        else:
+            args.no_balance = args.no_balance or not h.balance
+            engine = PlaybackEngine(robot, h.params, changes=take.changes, stop_tick=stop,
+                                    keyframes=layer)
         rate, read_every, limit = h.rate_hz, h.read_every, None
         header = h
     elif Path(args.file).suffix in SUFFIXES:

@@ -26,6 +26,7 @@ from robot.commands.common import (
     rate_hz,
     seconds,
 )
+from robot.commands.physics_check import physics_check, physics_watch
 from robot.config.bundled import DEFAULT_GAIT
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
@@ -38,6 +39,7 @@ from robot.motion.layered import LayeredEngine
 from robot.motion.scripted import PlaybackEngine
 from robot.motion.show import show_of, stream_sequence
 from robot.motion.takes import SUFFIX, Take, TakeHeader, is_take, read_take
+from robot.previs.show_check import plot_check
 from robot.run.run import Run
 from robot.run.spec import RunOptions, RunSpec
 
@@ -62,6 +64,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--record", default=None, metavar="PATH",
                    help=f"record the replay (.csv, .jsonl or NAME{SUFFIX})")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.add_argument("--check-plot", default=None, type=output_file, metavar="FILE.png",
+                   help="sim bus: plot the physics check (support margin, torque by limb, "
+                        "headroom per joint)")
     add_balance_args(p)
     p.add_argument("--balance", action="store_true", help="an imported take (biped import): "
                    "the balance stage corrects the legs while the arms and head perform as "
@@ -135,9 +140,12 @@ def run(args: argparse.Namespace) -> int:
     if args.record:
         writer = (TakeWriter(args.record, header) if is_take(args.record)
                   else Recorder(args.record, robot.joint_names, robot.ids))
+    watch = physics_watch(bus)
     spec = RunSpec(robot=robot, source=engine, bus=bus, imu=imu, recorder=writer,
+                   observer=watch,
                    options=RunOptions(rate_hz=rate, read_every=read_every, hold=args.hold,
-                                      seconds=limit, signals=True, watch=False))
+                                      seconds=limit, signals=True, watch=watch is not None,
+                                      stop_on_fall=watch is not None))
     playing = Run(spec)
     with playing:
         if isinstance(writer, TakeWriter) and isinstance(engine, PlaybackEngine):
@@ -152,6 +160,13 @@ def run(args: argparse.Namespace) -> int:
               "stop_reason": stats.stop_reason, "fault": stats.fault,
               "holding": stats.holding, "balance": imu is not None,
               "record_error": record_error, "exit_code": code}
+    check = physics_check(watch, robot, done.metrics)
+    if check is not None and check.fell_at is not None:
+        code = result["exit_code"] = max(code, 1)   # the show did not hold up: incomplete
+    if check is not None:
+        result["physics"] = check.as_dict()
+        if args.check_plot:
+            plot_check(check, args.check_plot, title=f"physics check: {args.file}")
     if args.json:
         print(json.dumps(result))
     else:
@@ -161,4 +176,8 @@ def run(args: argparse.Namespace) -> int:
               f"{'holding the rest pose, torque ON' if stats.holding else 'torque off'}")
         if record_error:
             print(f"record FAILED: {record_error}")
+        if check is not None:
+            print(check.table())
+            if args.check_plot:
+                print(f"wrote {args.check_plot}")
     return code

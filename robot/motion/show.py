@@ -22,13 +22,14 @@ timeline.
 
 from __future__ import annotations
 
+import json
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from robot.config.toml_io import JsonValue, TomlValue, number, show
+from robot.config.toml_io import JsonValue, TomlValue, number, read_toml, show
 from robot.errors import ConfigError
 from robot.motion.keyframes import Sequence
 from robot.motion.takes import Take
@@ -130,3 +131,22 @@ def stream_sequence(take: Take) -> Sequence:
     times = np.arange(len(take.t)) / take.header.rate_hz
     return Sequence(name=Path(take.source).name, joints=take.header.joints, times=times,
                     poses=take.q, interpolation="smooth", source=take.source)
+
+
+def show_of_sequence(path: str | Path) -> Show:
+    """The ``[show]`` table of a keyframe file (robot/motion/keyframes.py), or no show."""
+    p = Path(path)
+    data: Mapping[str, TomlValue] | Mapping[str, JsonValue]
+    if p.suffix == ".toml":
+        data = read_toml(p)
+    else:
+        try:
+            data = json.loads(p.read_text())
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+            raise ConfigError(f"{p}: not a valid JSON keyframe file: {e}") from None
+    raw = data.get("show") if isinstance(data, dict) else None
+    if raw is None:
+        return Show(base=str(p.parent))
+    if not isinstance(raw, dict):
+        raise ConfigError(f"{p}: show: expected a table (audio, audio_offset_s, cue)")
+    return parse_show(raw, where=f"{p}: show", base=p.parent)

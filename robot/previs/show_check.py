@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from robot.config.joint_names import ARM_NAMES, LEG_NAMES
+from robot.config.joint_names import limb_groups
 from robot.config.robot import RobotConfig
 from robot.loop.watchdog import WatchdogConfig
 from robot.previs.curves import outside_legend, palette
@@ -132,10 +132,7 @@ def plot_check(check: ShowCheck, out: str | Path, *, title: str) -> None:
     import matplotlib.pyplot as plt
 
     names = [j.joint for j in check.joints]
-    groups = [(label, [n for n in names if test(n)]) for label, test in (
-        ("legs", lambda n: n in LEG_NAMES), ("arms", lambda n: n in ARM_NAMES),
-        ("extra joints", lambda n: n not in LEG_NAMES and n not in ARM_NAMES))]
-    groups = [(label, g) for label, g in groups if g]
+    groups = limb_groups(names)
     fig, axes = plt.subplots(2 + len(groups), 1, figsize=(13, 2.8 * (2 + len(groups))),
                              layout="constrained")
     ax = axes[0]

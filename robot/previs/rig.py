@@ -6,9 +6,10 @@ world at rest (``pose``): what a BVH channel set means directly; a glTF node wit
 rotation is brought to the same form by ``Rig.from_local``. The robot frame (REP-103: x
 forward, y left, z up) is found from the rest pose (``orient``): up is the skeleton's
 longest extent, pointing away from the end with the feet (the end where more chain ends
-lie); left is the side of the bones named left (``l_``, ``.L``, ``Left``...) or, with no
-such name, +X (Blender, glTF and our own export all put the character's left on +X);
-forward completes a right-handed frame.
+lie; with none to tell, from the root toward the rest of the skeleton); left is the side
+of the bones named left (``l_``, ``.L``, ``Left``...) or, with no such name, +X (Blender,
+glTF and our own export all put the character's left on +X); forward completes a
+right-handed frame.
 """
 
 from __future__ import annotations
@@ -106,12 +107,17 @@ class Rig:
         band = END_BAND * extent[k]
         low = int(np.sum(tips <= h.min() + band))
         high = int(np.sum(tips >= h.max() - band))
-        if low == high:
+        out = np.zeros(3)
+        if low != high:
+            out[k] = 1.0 if low > high else -1.0
+            return out
+        # No feet to tell (an upper body alone): up is from the root toward the rest.
+        lean = float(np.mean(h) - pos[0, k])
+        if abs(lean) < 1e-9 * max(extent[k], 1e-12):
             raise ConfigError(f"{self.source}: cannot tell up from down in the rest pose "
                               f"({low} chain ends at each end of axis {'XYZ'[k]}); give "
                               "--up (+x, -x, +y, -y, +z or -z)")
-        out = np.zeros(3)
-        out[k] = 1.0 if low > high else -1.0
+        out[k] = 1.0 if lean > 0 else -1.0
         return out
 
     def orient(self, up: str | None = None) -> Array:

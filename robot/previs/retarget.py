@@ -3,7 +3,9 @@ bone map (robot/previs/bone_map.py).
 
 Each mapped bone's rotation from rest, turned into robot axes (R = C D C^T with C from
 ``Rig.orient``), is decomposed onto the joint axes in the map's order (robot/previs/
-rotations.py); joint = sign x angle + offset. Joints the map leaves out hold ``hold``
+rotations.py; of its two solutions the one that leaves the axes the bone does not use at 0,
+so a shoulder raised past 90 degrees stays one pitch, not a flip); joint = sign x angle +
+offset. Joints the map leaves out hold ``hold``
 (the gait's standing pose). The root's travel is scaled to the robot by the ratio of the
 two legs' lengths (the rig's: the root's height above its lowest chain end at rest).
 """
@@ -18,7 +20,7 @@ from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.previs.bone_map import BoneMap
 from robot.previs.rig import Array, Rig
-from robot.previs.rotations import decompose
+from robot.previs.rotations import decompose, other_solution
 
 
 @dataclass(frozen=True)
@@ -53,6 +55,11 @@ def retarget(rig: Rig, robot: RobotConfig, bone_map: BoneMap, hold: Array, *,
             continue
         r = c @ rig.pose[:, b] @ c.T
         angles = decompose(order, r)
+        free = [col for col, m in enumerate(maps) if m is None]
+        if free:   # a bone turned past 90 deg: the solution that leaves unused axes at 0
+            alt = other_solution(angles)
+            use = np.abs(alt[:, free]).sum(axis=1) < np.abs(angles[:, free]).sum(axis=1)
+            angles[use] = alt[use]
         for col, m in enumerate(maps):
             if m is not None:
                 q[:, names.index(m.joint)] = m.sign * angles[:, col] + m.offset

@@ -51,6 +51,14 @@ def decompose(order: str, r: Array) -> Array:
     return np.column_stack([alpha, beta, gamma])
 
 
+def other_solution(angles: Array) -> Array:
+    """The second Tait-Bryan solution of the same rotations: (a + pi, pi - b, c + pi),
+    each wrapped to (-pi, pi] (the middle angle beyond +-pi/2)."""
+    alt = angles + np.array([np.pi, 0.0, np.pi])
+    alt[:, 1] = np.pi - angles[:, 1]
+    return (alt + np.pi) % (2 * np.pi) - np.pi
+
+
 def quat_matrix(q: npt.ArrayLike) -> Array:
     """Unit quaternions (n, 4) as glTF stores them, (x, y, z, w), → rotations (n, 3, 3)."""
     x, y, z, w = (np.asarray(q, dtype=float) / np.linalg.norm(q, axis=-1, keepdims=True)).T

@@ -180,3 +180,23 @@ def test_an_imported_take_plays_its_stream_on_the_sim(tmp_path: Path) -> None:
     cmd = np.column_stack([show[f"cmd_{n}"] for n in take.header.joints])
     assert 10 < len(cmd) <= len(take.q) - 1      # tick 0 is where the ramp in ends
     assert np.abs(cmd - take.q[1:len(cmd) + 1]).max() < 1e-6
+
+
+def test_a_shoulder_raised_past_90_degrees_stays_one_pitch(tmp_path: Path) -> None:
+    """Of the two Euler solutions, the one with the bone's unused axis at 0: an arm raised
+    to -2.2 rad of pitch (126 deg, overhead) is that pitch, not -0.94 with roll flipped."""
+    pitch = np.linspace(0.0, -2.2, 31)
+    lines = ["HIERARCHY", "ROOT pelvis", "{", "OFFSET 0 0 0",
+             "CHANNELS 6 Xposition Yposition Zposition Yrotation Zrotation Xrotation",
+             "JOINT chest", "{", "OFFSET 0 30 0", "CHANNELS 3 Zrotation Xrotation Yrotation",
+             "JOINT r_shoulder", "{", "OFFSET -10 0 0",
+             "CHANNELS 3 Zrotation Xrotation Yrotation", "End Site", "{", "OFFSET 0 -20 0",
+             "}", "}", "}", "}", "MOTION", f"Frames: {len(pitch)}", "Frame Time: 0.033333"]
+    lines += [f"0 45 0 0 0 0 0 0 0 0 {np.degrees(p):.6f} 0" for p in pitch]
+    src, out = tmp_path / "raise.bvh", tmp_path / "raise.take.jsonl"
+    src.write_text("\n".join(lines) + "\n")
+    assert cli.main(["import", str(src), "--out", str(out), "--strict"]) == 0
+    take = read_take(out)
+    names = take.header.joints
+    assert np.abs(take.q[::7, names.index("r_shoulder_pitch")] - pitch).max() < 1e-5
+    assert np.abs(take.q[:, names.index("r_shoulder_roll")]).max() < 1e-5

@@ -48,7 +48,7 @@ class ServoState:
 class Bus(ABC):
     """A chain of servos. Use as a context manager; ``close()`` turns torque off."""
 
-    #: "dynamixel" | "feetech" | "sim"
+    #: "dynamixel" | "dynamixel1" | "feetech" | "lx" | "sim"
     kind: str = "abstract"
 
     @abstractmethod
@@ -102,6 +102,11 @@ class Bus(ABC):
     def disarm_failsafe(self, ids: Iterable[int]) -> None:
         """Disarm it (and clear a tripped watchdog) so the servos accept goals again; no-op
         when there is none. This default is for buses without one: it does nothing."""
+        return None
+
+    def check_rate(self, rate_hz: float, *, read_every: int) -> None:
+        """ConfigError when the wire cannot carry goals at ``rate_hz`` [Hz] with a read-back
+        every ``read_every`` ticks (the LX bus: one packet per servo). Default: any rate."""
         return None
 
     def release(self, ids: Iterable[int]) -> None:

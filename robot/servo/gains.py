@@ -117,6 +117,9 @@ GAIN_SETS: dict[str, GainSet] = {
         Gain("i_coefficient", 0, 254, "eeprom", "position loop integral coefficient",
              f"{_STS}; I coefficient(23)"),
     ),
+    # HiWonder/LewanSoul LX: the Bus Servo Communication Protocol has no gain command (a
+    # position, a move time, limits, offset, load/unload, LED): nothing to set.
+    "lx": _set("lx", "lx"),
 }
 
 

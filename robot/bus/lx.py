@@ -34,7 +34,7 @@ from robot.bus.limits import TickLimits
 from robot.bus.lx_packet import encode, value, word
 from robot.bus.lx_port import LX_VALUES, LxPort
 from robot.bus.lx_status import LxStatus
-from robot.bus.lx_wire import check_rate
+from robot.bus.lx_wire import check_rate, max_rate_hz
 from robot.bus.sdk_port import PORT_ERRORS, READ_BLOCK_S
 from robot.bus.tables import LX_BAUD, LX_BROADCAST_ID
 from robot.config.robot import RobotConfig
@@ -238,7 +238,9 @@ class LxBus(LxPort, Bus):
             out[sid] = self.status.state(sid, pos)
         return out
 
+    def max_rate_hz(self, *, read_every: int) -> float | None:
+        return max_rate_hz(len(self.robot.ids) if self.robot else 1, read_every=read_every)
+
     def check_rate(self, rate_hz: float, *, read_every: int) -> None:
         """ConfigError when the wire cannot carry ``rate_hz`` for this robot's servos."""
-        n = len(self.robot.ids) if self.robot else 1
-        check_rate(rate_hz, n, read_every=read_every)
+        check_rate(rate_hz, len(self.robot.ids) if self.robot else 1, read_every=read_every)

@@ -5,10 +5,14 @@ against the driver's table (robot/bus/tables.py), the emulator's own transcripti
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from robot.bus import lx_packet, lx_wire
 from robot.bus.tables import ERROR_BITS, LX_ALARM_BITS, LX_BROADCAST_ID, LX_COMMANDS
+from robot.config.bundled import ROBOTS_DIR
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.servo.models import MODELS
 from sim.emulator import lx_commands as emulator
@@ -102,3 +106,12 @@ def test_wire_budget_by_hand() -> None:
     with pytest.raises(ConfigError, match=r"--rate 200: 18 LX servos .* use --rate 52"):
         lx_wire.check_rate(200.0, 18, read_every=10)
     assert lx_wire.max_rate_hz(12, read_every=10) > 75
+
+
+def test_an_lx_robot_file_with_gains_is_refused_in_one_line(tmp_path: Path) -> None:
+    text = (ROBOTS_DIR / "biped18-lx.toml").read_text()
+    path = tmp_path / "lx-gains.toml"
+    path.write_text(text.replace("[bus]\n", "[bus.gains]\np_gain = 3\n\n[bus]\n", 1))
+    with pytest.raises(ConfigError, match=r"bus.gains.p_gain: not a gain of LX-16A .*valid: "
+                                          r"none \(its firmware takes no gains"):
+        load_robot(path)

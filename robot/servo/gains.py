@@ -125,4 +125,5 @@ GAIN_SETS: dict[str, GainSet] = {
 
 def describe(gain_set: str) -> str:
     """``name [lo..hi]`` for every gain of ``gain_set``, for messages."""
-    return ", ".join(f"{g.name} [{g.lo}..{g.hi}]" for g in GAIN_SETS[gain_set].gains.values())
+    return (", ".join(f"{g.name} [{g.lo}..{g.hi}]" for g in GAIN_SETS[gain_set].gains.values())
+            or "none (its firmware takes no gains: remove the table)")

@@ -202,6 +202,12 @@ class Session(Bus):
     def retry_span_s(self) -> float:
         return self.lease.bus.retry_span_s
 
+    def max_rate_hz(self, *, read_every: int) -> float | None:
+        return self.lease.bus.max_rate_hz(read_every=read_every)
+
+    def check_rate(self, rate_hz: float, *, read_every: int) -> None:
+        self.lease.bus.check_rate(rate_hz, read_every=read_every)
+
     def ping(self, servo_id: int) -> int | None:
         with self.lease.io:
             return self.lease.bus.ping(servo_id)

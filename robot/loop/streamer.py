@@ -65,6 +65,7 @@ class Streamer(Generic[SourceT]):
         self.dt = 1.0 / rate_hz
         self._step = robot_map.max_speed * self.dt  # slew limit per tick [rad]
         self.read_every = max(1, read_every)
+        bus.check_rate(rate_hz, read_every=self.read_every)   # before anything moves
         self.clock: Clock = clock or getattr(bus, "clock", None) or MonotonicClock()
         self.hold_at_end = hold_at_end
         self.watchdog_config = watchdog or WatchdogConfig()
@@ -81,7 +82,8 @@ class Streamer(Generic[SourceT]):
         self._bus_dead = False
         self._q_last: JointVector = np.zeros(len(robot_map.ids))
         self._lateness = SampleStats()
-        self._overruns = self._bus_errors = 0
+        self._overruns = 0
+        self._bus_errors = 0
         self._next = 0.0
         self._ticks = 0
 
@@ -115,10 +117,6 @@ class Streamer(Generic[SourceT]):
         self.telemetry.stop_reason = reason
         self._estop.set()
         self._stop.set()
-
-    def fault(self, reason: str) -> None:
-        """End the run as a fault (an observer's verdict): ramp out, rest, torque off."""
-        self._set_fault(reason)
 
     # -- runs ----------------------------------------------------------------------------
     def run(self, *, seconds: float | None = None) -> LoopStats:

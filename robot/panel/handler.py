@@ -142,7 +142,7 @@ class Handler(BaseHTTPRequestHandler):
         self.send_response(response.status)
         self.send_header("Content-Type", response.content_type)
         self.send_header("Content-Length", str(len(response.body)))
-        for k, v in HEADERS.items():
+        for k, v in {**HEADERS, **response.headers}.items():
             self.send_header(k, v)
         if self.close_connection:
             self.send_header("Connection", "close")

@@ -25,18 +25,17 @@ from robot.balance.stage import Balance, attitude_reader
 from robot.bus.lease import BusLease, Session
 from robot.bus.servo_map import ServoMap
 from robot.config.params import GaitParams
-from robot.errors import BipedError
 from robot.imu import Imu
 from robot.loop.take_writer import TakeWriter
-from robot.motion.posing import Capture, limb_joints, limbs
+from robot.motion.posing import limb_joints
 from robot.panel.idle_pose import IdlePose
+from robot.panel.loop_posing import Posing
 from robot.panel.loop_watch import LoopWatch
 from robot.panel.options import HostSpec, PanelStateError
 from robot.panel.rate_guard import stall_limit_s
 from robot.panel.runs import RunKind, build
 from robot.panel.sim_monitor import sim_monitor_factory
 from robot.panel.sim_reset import reset_to_home
-from robot.run.release import release
 from robot.run.run import Run
 from robot.run.spec import RunOptions, RunSpec
 from robot.run.walk import walk_imu
@@ -64,8 +63,9 @@ class LoopHost:
         self._thread = threading.Thread(target=self._work, name="panel-loop")
         self._lock = threading.Lock()
         self._run: Run[Any] | None = None
-        self._capture: Capture | None = None
+        self.posing = Posing(self.robot)
         self._polling = False
+        self._guard_stop: str | None = None   # why the rate guard stopped the run
         self.closing = False
 
     def open(self) -> None:
@@ -114,12 +114,11 @@ class LoopHost:
         if not running and not self.closing and self.raw.is_open and not self._polling:
             self._polling = True
             self._ops.put(self._poll)
-        cap = self._capture
-        return {**self.watch.snapshot(running=running), "params": self._params(),
-                "owner": self.lease.owner, "torque": dict(self.lease.torque),
-                "keyframes": len(cap.times) if cap else 0,
-                "capture_joints": list(cap.joints) if cap else [],
-                "limbs": list(limbs(self.robot))}
+        run = self._run
+        return {**self.watch.snapshot(running=running), **self.posing.summary(),
+                "params": self._params(), "owner": self.lease.owner,
+                "engine_t": getattr(run.streamer.engine, "time", None) if run else None,
+                "torque": dict(self.lease.torque)}
 
     def _params(self) -> GaitParams:
         run = self._run
@@ -166,7 +165,8 @@ class LoopHost:
                                close_bus=False, watch=False)))
         run.open()                     # the take file first: unwritable, nothing moves
         with self._lock:
-            self._run, self._capture = run, None
+            self._run = run
+        self.posing.clear()
         self.watch.begin(kind, built.driver)
         done({"state": "starting"})
         try:
@@ -191,18 +191,23 @@ class LoopHost:
         error = recorder.close_quietly() if recorder is not None else None
         if error:
             log.error("panel: %s: %s", kind.owner, error)
-        holding = stats is not None and stats.holding and session.live
+        guard, self._guard_stop = self._guard_stop, None
+        holding = stats is not None and stats.holding and session.live and guard is None
         if stats is not None and stats.holding and not holding:
-            self.lease.torque_off(self.robot.ids)     # an e-stop as the run ended holding
-        self.watch.end(stats, holding=holding, record_error=error,
+            self.lease.torque_off(self.robot.ids)     # an e-stop or a late loop: never hold
+        self.watch.end(stats, holding=holding, record_error=error, fault=guard,
                        telemetry=run.streamer.telemetry)
 
     def _verdict(self, stop: str, at_once: bool) -> None:
+        """The rate guard's stop: at once (the servos no longer listen) or a ramp out to
+        rest; either way a fault, so the run never ends holding (``_stream``)."""
+        self._guard_stop = stop
         run = self._run
         if run is not None:
-            run.streamer.fault(stop)
             if at_once:
                 run.streamer.emergency_stop(stop)
+            else:
+                run.streamer.request_stop(stop)
 
     def stop(self) -> dict[str, Any]:
         """Safe stop of the run (ramp out, rest, torque off or hold); without one, the
@@ -222,46 +227,19 @@ class LoopHost:
         return {"state": "estop", "failed": failed}
 
     def release(self, limb: object, done: Done) -> None:
-        joints = limb_joints(self.robot, limb)
+        limb_joints(self.robot, limb)                # an unknown limb: refused now
         session = self._acquire(f"the release of {limb}")
 
-        def op() -> dict[str, Any]:
-            try:
-                release(self.robot, session, str(limb))
-            except BipedError:
-                if not session.live:
-                    raise PanelStateError(f"an emergency stop came first: {limb} not "
-                                          "released; torque is off") from None
-                raise
-            with self._lock:
-                if self._capture is None or self._capture.joints != joints:
-                    self._capture = Capture(self.robot, joints)
+        def op() -> object:
+            result = self.posing.release(session, limb)
             self.watch.released = str(limb)
-            return {"released": str(limb)}
+            return result
         self._later(session, done, op)
 
     def capture(self, t: float | None, done: Done) -> None:
-        cap = self._capture
-        if cap is None:
-            raise PanelStateError("release a limb first (torque off), then move it by hand "
-                                  "and capture")
+        cap = self.posing.captured()
         session = self._acquire("a keyframe capture")
-
-        def op() -> dict[str, Any]:
-            pose = cap.add(session, t=t)
-            return {"t": cap.times[-1], "pose": dict(zip(cap.joints, pose, strict=True))}
-        self._later(session, done, op)
-
-    def clear(self) -> dict[str, Any]:
-        with self._lock:
-            self._capture = None
-        return {}
-
-    def keyframes(self, name: str) -> object:
-        cap = self._capture
-        if cap is None or not cap.times:
-            raise PanelStateError("no keyframes captured yet")
-        return cap.sequence(name)
+        self._later(session, done, lambda: self.posing.capture(session, cap, t))
 
     def reset(self, done: Done) -> None:
         if self.raw.kind != "sim":

@@ -28,8 +28,8 @@ def _commands(host: LoopHost) -> tuple[dict[str, Callable[[Args], object]],
         "params": lambda a: host.set_params(a["changes"]),
         "stop": lambda a: host.stop(),
         "estop": lambda a: host.emergency_stop(),
-        "clear": lambda a: host.clear(),
-        "keyframes": lambda a: host.keyframes(a["name"]),
+        "clear": lambda a: host.posing.clear(),
+        "keyframes": lambda a: host.posing.keyframes(a["name"]),
     }
     later: dict[str, Callable[[Args, Done], None]] = {
         "start": lambda a, done: host.start(a["kind"], done),

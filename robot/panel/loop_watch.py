@@ -15,7 +15,7 @@ from robot.bus.base import ServoState
 from robot.config.robot import RobotConfig
 from robot.loop.telemetry import LoopStats, Telemetry, TickObserver
 from robot.panel.rate_guard import RateGuard
-from robot.panel.runs import Play, Record, RunKind
+from robot.panel.runs import Play, Record, RunKind, ShowTake
 from robot.panel.snapshot import TickRate, telemetry_snapshot
 
 RATE_WINDOW = 50  # ticks over which the loop rate is measured
@@ -80,14 +80,22 @@ class LoopWatch:
             self.fault, self.record_error, self.holding = None, None, False
 
     def end(self, stats: LoopStats | None, *, holding: bool, record_error: str | None,
-            telemetry: Telemetry | None = None) -> None:
+            fault: str | None = None, telemetry: Telemetry | None = None) -> None:
+        """The run has ended: ``fault`` the rate guard's stop, if it stopped it."""
         with self._lock:
             if telemetry is not None:
                 self._tel = telemetry_snapshot(telemetry)
             self.last_stats, self.holding = stats, holding
             self.kind = self.driver = None
             self.record_error = record_error
-            if stats is not None:      # how it ended, not a late alarm from before
+            if stats is None:
+                return
+            if fault:                  # the rate guard stopped it
+                self.fault = fault
+            elif stats.estop:          # the operator's: not a fault, even if a write
+                self.fault = None      # was refused at the latch on its way out
+                self._tel["stop_reason"] = "emergency stop"
+            else:                      # how it ended, not a late alarm from before
                 self.fault = stats.stop_reason if stats.fault else None
 
     def failed(self, reason: str) -> None:
@@ -123,7 +131,8 @@ class LoopWatch:
             return {"running": running, "tel": tel, "sim": dict(self._sim),
                     "loop_hz": self._rate.hz(), "runs": self.runs, "driver": self.driver,
                     "recording": kind.take if isinstance(kind, Record) else None,
-                    "playing": kind.take if isinstance(kind, Play) else None,
+                    "playing": kind.take if isinstance(kind, (Play, ShowTake)) else None,
+                    "show": isinstance(kind, ShowTake),
                     "released": self.released, "holding": self.holding,
                     "fault": self.fault, "record_error": self.record_error,
                     "last_stats": stats.as_dict() if stats is not None else None}

@@ -68,7 +68,20 @@ class Keyframes:
         return f"sequence {self.sequence.name}"
 
 
-RunKind = Walk | Record | Play | Keyframes
+@dataclass(frozen=True)
+class ShowTake:
+    """A show take (an imported animation, robot.motion.show) streamed as recorded: its
+    joint stream as a keyframe sequence, at any rate; the panel plays its audio."""
+
+    take: str
+    sequence: Sequence
+
+    @property
+    def owner(self) -> str:
+        return f"take {self.take}"
+
+
+RunKind = Walk | Record | Play | Keyframes | ShowTake
 
 
 @dataclass
@@ -99,5 +112,8 @@ def build(kind: RunKind, robot: RobotConfig, params: GaitParams) -> Built:
         stop = take.stop_tick if take.stop_tick is not None else len(take.t)
         return Built(PlaybackEngine(robot, h.params, changes=take.changes, stop_tick=stop,
                                     keyframes=layer), driver=kind.owner)
+    if isinstance(kind, ShowTake):
+        return Built(LayeredEngine(robot, params, keyframes=kind.sequence, walk=False),
+                     driver=kind.owner)
     engine = LayeredEngine(robot, params, keyframes=kind.sequence, walk=kind.walk)
     return Built(engine, driver=None if kind.walk else kind.owner)

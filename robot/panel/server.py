@@ -13,6 +13,7 @@ Endpoints (JSON in and out; errors are ``{"error": "..."}``, never an empty repl
   GET  /api/live     WebSocket (robot.panel.live): the state, parameters and studio status
                      pushed 20 times a second; the page uses it instead of polling
   GET  /api/takes | /api/sequences        recorded takes, saved keyframe sequences
+  GET  /api/show/audio?take=NAME          a show take's soundtrack (byte ranges: the page seeks)
   POST /api/record {"name"?} | /api/play {"name"}   record a take (ends with stop), replay
   POST /api/pose/release {"limb"} | /api/pose/capture | /api/pose/clear | /api/pose/save
        {"name"} | /api/sequence/play {"name", "layer": bool}: posing by hand (panel.studio)

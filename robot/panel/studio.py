@@ -25,9 +25,10 @@ from robot.errors import ConfigError
 from robot.motion.keyframes import Sequence, load_sequence, parse_sequence, sequence_to_toml
 from robot.motion.layered import LayeredEngine
 from robot.motion.posing import limb_joints, limbs
+from robot.motion.show import Show, show_of, stream_sequence
 from robot.motion.takes import SUFFIX, TakeHeader, read_take
 from robot.panel.controller import PanelController
-from robot.panel.runs import Keyframes, Play, Record
+from robot.panel.runs import Keyframes, Play, Record, ShowTake
 
 log = logging.getLogger(__name__)
 
@@ -54,6 +55,7 @@ class Studio:
         self.robot: RobotConfig = controller.robot
         self.takes_dir = takes_dir or user_data_dir() / "takes"
         self.keys_dir = keys_dir or user_data_dir() / "keyframes"
+        self.show: Show | None = None  # the show take last played (its audio, cues)
 
     @property
     def recording(self) -> str | None:
@@ -96,11 +98,41 @@ class Studio:
         if h.joints != self.robot.joint_names:
             raise ConfigError(f"take {take_name!r} was recorded on {h.robot}, not "
                               f"{self.robot.name}")
+        show = show_of(h.show, str(path))
+        if show.stream:   # an imported show: its joints as they are, at any rate
+            seq = stream_sequence(take)
+            self.c.start(run=ShowTake(take_name, seq), received=received)
+            self.show = show
+            return {"take": take_name, "seconds": seq.duration}
         if h.rate_hz != self.c.options.rate_hz:
             raise ConfigError(f"take {take_name!r} was recorded at {h.rate_hz:g} Hz; the "
                               f"panel runs at {self.c.options.rate_hz:g} Hz (use biped play)")
         self.c.start(run=Play(take_name, str(path)), received=received)
         return {"take": take_name, "seconds": take.gait_seconds}
+
+    def show_status(self) -> dict[str, Any] | None:
+        """The playing show's audio fields and its time [s] (the engine's: 0 at the first
+        tick after the ramp in, as the loop last reported it), for the page that plays the
+        audio; None: no show playing."""
+        show, s = self.show, self.c.loop_state()
+        playing = s.get("playing")
+        if show is None or playing is None or not s.get("show"):
+            return None
+        return {"take": playing, "t": float(s.get("engine_t") or 0.0),
+                "audio": f"/api/show/audio?take={playing}" if show.audio else None,
+                "audio_offset_s": show.audio_offset_s,
+                "cues": [{"t": c.t, "name": c.name} for c in show.cues]}
+
+    def audio_file(self, name: object) -> Path:
+        """The sound file a take's show names (ConfigError if it has none)."""
+        take_name = _name(name, "take")
+        path = self.takes_dir / f"{take_name}{SUFFIX}"
+        if not path.is_file():
+            raise ConfigError(f"take {take_name!r}: not found")
+        audio = show_of(read_take(path).header.show, str(path)).audio_path()
+        if audio is None or not audio.is_file():
+            raise ConfigError(f"take {take_name!r}: no audio file")
+        return audio
 
     # -- posing by hand and keyframes -------------------------------------------------
     def release(self, limb: object, *, received: float | None = None) -> dict[str, Any]:
@@ -159,7 +191,7 @@ class Studio:
         s = self.c.loop_state()
         return {"recording": s.get("recording"), "playing": s.get("playing"),
                 "released": s.get("released"), "limbs": list(limbs(self.robot)),
-                "keyframes": s.get("keyframes", 0),
+                "keyframes": s.get("keyframes", 0), "show": self.show_status(),
                 "capture_joints": list(s.get("capture_joints", []))}
 
 

@@ -277,7 +277,7 @@ class Emulator:
 
     def set_register(self, servo_id: int, name: str, value: int) -> None:
         """Store a register without the checks a host write gets (e.g. return_delay_time)."""
-        if name not in TABLES[self.family]:
+        if self.family in TABLES and name not in TABLES[self.family]:   # LX: checked there
             raise EmulatorError(f"register {name!r} is not in the {self.family} table; "
                                 f"valid: {', '.join(TABLES[self.family])}")
         self._call("set_register", servo_id, name, int(value))

@@ -23,7 +23,7 @@ from types import ModuleType
 from typing import Any
 
 from robot.errors import BipedError
-from sim.emulator import dxl1_protocol, dxl_protocol, sts_protocol
+from sim.emulator import dxl1_protocol, dxl_protocol, lx_protocol, sts_protocol
 from sim.emulator.servo import EmulatedServo, ServoSpec
 
 LOG_MAX = 200_000            # packets kept in the child
@@ -60,7 +60,7 @@ class Packet:
 
 #: Wire protocol codec per bus kind.
 CODECS: dict[str, ModuleType] = {"dynamixel": dxl_protocol, "dynamixel1": dxl1_protocol,
-                                 "feetech": sts_protocol}
+                                 "feetech": sts_protocol, "lx": lx_protocol}
 
 
 @dataclass(frozen=True)
@@ -81,7 +81,8 @@ class _ChainServer:
         self.codec: ModuleType = CODECS[spec.protocol]
         self.parser = self.codec.Parser()
         now = time.monotonic()
-        self.servos = [EmulatedServo(s, now) for s in spec.servos]
+        servo_class = getattr(self.codec, "SERVO", EmulatedServo)  # LX: no control table
+        self.servos = [servo_class(s, now) for s in spec.servos]
         self.plugged: set[int] = set(range(len(self.servos)) if spec.plugged is None
                                      else spec.plugged)
         self.rng = random.Random(spec.seed)

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from types import TracebackType
 from typing import Any
@@ -91,25 +91,29 @@ class BusLease:
         with self.io:
             return self.bus.read_state(ids)
 
-    def emergency_stop(self, reason: str = "emergency stop") -> list[str]:
+    def emergency_stop(self, reason: str = "emergency stop", *,
+                       confirm: bool = True) -> list[str]:
         """Latch (every earlier session's goals and torque-on are refused from now on),
-        then torque off on every servo: one packet, then confirmed servo by servo. Returns
-        the failures (one line each; empty when the bus took both)."""
+        then torque off on every servo: one packet, then (``confirm``) confirmed servo by
+        servo; a run that is ending confirms it itself. Returns the failures (one line
+        each; empty when the bus took them)."""
         with self.io:
             self._generation += 1
             self.estop_reason = reason
             if not self.bus.is_open:
                 return []
-            return self.torque_off(self.ids)
+            return self.torque_off(self.ids, confirm=confirm)
 
-    def torque_off(self, ids: Sequence[int]) -> list[str]:
+    def torque_off(self, ids: Sequence[int], *, confirm: bool = True) -> list[str]:
         """Torque off on ``ids`` (one packet, then confirmed), whoever holds the bus; the
         failures as lines."""
         failed = []
+        steps: list[tuple[str, Callable[[list[int]], None]]] = [
+            ("disable torque", self.bus.release)]
+        if confirm:
+            steps.append(("confirm torque off", lambda i: self.bus.set_torque(i, enabled=False)))
         with self.io:
-            for what, step in (("disable torque", self.bus.release),
-                               ("confirm torque off",
-                                lambda i: self.bus.set_torque(i, enabled=False))):
+            for what, step in steps:
                 try:
                     step(list(ids))
                     self.torque.update(dict.fromkeys(ids, False))
@@ -120,10 +124,15 @@ class BusLease:
         return failed
 
     def close(self, *, torque_off: bool) -> list[str]:
-        """Close the bus (torque off first unless holding is wanted); the failures."""
-        failed = self.torque_off(self.ids) if torque_off and self.bus.is_open else []
+        """Close the bus, torque off first unless holding is wanted (servo by servo unless
+        every one has already confirmed it; the bus's own close sends one more packet);
+        the failures."""
+        failed = []
+        if torque_off and self.bus.is_open and \
+                not all(self.torque.get(i) is False for i in self.ids):
+            failed = self.torque_off(self.ids)
         with self.io:
-            self.bus.close(torque_off=False)
+            self.bus.close(torque_off=torque_off)
         return failed
 
 

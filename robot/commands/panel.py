@@ -170,10 +170,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"biped panel: stopping (ramp out, rest, {end}; again: torque off now)",
               flush=True)
     finally:
-        if server is not None:
-            server.shutdown()             # no new request while the loop closes
-        report = controller.shutdown(abort=lambda: signals.abort)
-        if server is not None:
+        report = controller.shutdown(abort=lambda: signals.abort)  # first: a second
+        if server is not None:                                    # signal acts at once
+            server.shutdown()
             server.server_close()
     line, safe = _farewell(report, aborted=signals.abort)
     print(f"biped panel: stopped; {line}", flush=True)

@@ -269,7 +269,7 @@ class PanelController:
         result: dict[str, Any] = {}
         while True:
             try:
-                result = dict(pending.wait(0.05))
+                result = dict(pending.wait(0.02))
                 break
             except LoopUnavailable:
                 pass

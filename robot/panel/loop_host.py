@@ -222,7 +222,7 @@ class LoopHost:
         run = self._run
         if run is not None:
             run.emergency_stop("emergency stop")
-        failed = self.lease.emergency_stop("emergency stop")
+        failed = self.lease.emergency_stop("emergency stop", confirm=run is None)
         self.watch.estop(running=run is not None)
         return {"state": "estop", "failed": failed}
 

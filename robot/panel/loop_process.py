@@ -223,3 +223,5 @@ def child_main(fd: int) -> None:
         raise SystemExit(2) from None
     conn.send(("ok", None))
     serve(conn, host, _encode)
+    logging.shutdown()
+    os._exit(0)       # the bus is closed, the loop thread joined: no teardown to wait for

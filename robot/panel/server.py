@@ -143,7 +143,8 @@ def serve_in_thread(server: ThreadingHTTPServer) -> tuple[threading.Thread, str]
     host, port = str(server.server_address[0]), int(server.server_address[1])
     if host in WILDCARD:
         host = "127.0.0.1" if host == "0.0.0.0" else "::1"
-    thread = threading.Thread(target=server.serve_forever, name="panel-http", daemon=True)
+    thread = threading.Thread(target=server.serve_forever, kwargs={"poll_interval": 0.1},
+                              name="panel-http", daemon=True)
     thread.start()
     return thread, base_url(host, port)
 

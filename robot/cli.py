@@ -10,11 +10,13 @@ import argparse
 import importlib
 import logging
 import os
+import signal
 import sys
 from importlib.metadata import PackageNotFoundError, version
 
 from robot.commands.common import one_line_errors
 from robot.errors import BipedError, SafetyStop
+from robot.run.signals import Interrupted, SignalLatch
 
 # Order is the order of `biped --help`.
 COMMANDS: tuple[str, ...] = (
@@ -64,12 +66,32 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    os.environ.setdefault("MUJOCO_GL", "egl")
-    parser = build_parser()
+    """Run one ``biped`` command; its exit code. SIGINT/SIGTERM are handled from here on
+    (robot.run.signals): no command is killed by them. ``argv`` None: this process is the
+    command (the console script, ``python -m robot.cli``): it exits here with the code,
+    the handlers in place to the end; otherwise (in-process callers) the old handlers
+    come back and the code is returned."""
+    latch = SignalLatch()
+    restore = latch.install()
     try:
+        code = _main(argv)
+    finally:
+        if argv is not None:
+            restore()
+    if argv is None:
+        latch.end(code)
+    return code
+
+
+def _main(argv: list[str] | None) -> int:
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    try:
+        parser = build_parser()
         args = parser.parse_args(argv)
     except SystemExit as e:   # --help (0) or a refused option (2, one line on stderr)
         return e.code if isinstance(e.code, int) else 2
+    except KeyboardInterrupt as e:
+        return interrupted("", e)
     logging.basicConfig(level=getattr(logging, args.log_level), stream=sys.stderr,
                         format="%(levelname)s %(name)s: %(message)s")
     try:
@@ -82,9 +104,15 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except BrokenPipeError:
         return 0  # stdout closed early (e.g. piped into `head`)
-    except KeyboardInterrupt:
-        print(f"biped {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as e:
+        return interrupted(f" {args.command}", e)
+
+
+def interrupted(command: str, e: KeyboardInterrupt) -> int:
+    """Say so; 128 + the signal's number (130 for SIGINT, 143 for SIGTERM)."""
+    signum = e.signum if isinstance(e, Interrupted) else signal.SIGINT
+    print(f"biped{command}: interrupted ({signal.Signals(signum).name})", file=sys.stderr)
+    return 128 + signum
 
 
 if __name__ == "__main__":

@@ -25,6 +25,7 @@ from robot.commands.common import (
 from robot.commands.world_args import add_world_args, describe_world, world_from
 from robot.errors import ConfigError
 from robot.motion.keyframes import load_sequence
+from robot.run.result import TORQUE_WORDS
 from robot.run.run import execute
 from robot.run.spec import RunOptions
 from robot.run.walk import walk_spec, walk_summary
@@ -114,10 +115,13 @@ def format_summary(r: dict[str, Any]) -> str:
         f" {r['overruns']} overruns, {r['bus_errors']} bus errors",
         f"  realtime      x{r['realtime_factor']:.1f}",
         f"  stopped       {r['stop_reason']}",
-        f"  servos        {'holding the rest pose, torque ON' if r['holding'] else 'torque off'}",
+        f"  servos        {servo_words(r['torque'])}",
     ]
     if r.get("record_error"):
         lines.append(f"  record        FAILED: {r['record_error']}")
     return "\n".join(lines)
 
 
+def servo_words(torque: str) -> str:
+    """What the servos were left doing (LoopStats.torque), in the summary's words."""
+    return "holding the rest pose, torque ON" if torque == "on" else TORQUE_WORDS[torque]

@@ -79,6 +79,11 @@ class Watchdog:
 
     def check(self, states: Mapping[int, ServoState], q_cmd: npt.NDArray[np.float64]) -> None:
         """Raise SafetyStop on a hardware fault, overheating, or a servo not following."""
+        self.faults(states)
+        self._following(states, q_cmd)
+
+    def faults(self, states: Mapping[int, ServoState]) -> None:
+        """Raise SafetyStop on a hardware fault or overheating."""
         for sid, s in states.items():
             bad = sorted(s.errors & FAULTS)
             if bad:
@@ -86,6 +91,9 @@ class Watchdog:
             if s.temperature is not None and s.temperature > self.cfg.max_temperature_c:
                 raise SafetyStop(f"{self._joint(sid)} at {s.temperature:.0f} °C "
                                  f"(limit {self.cfg.max_temperature_c:.0f} °C)")
+
+    def _following(self, states: Mapping[int, ServoState],
+                   q_cmd: npt.NDArray[np.float64]) -> None:
         present = self.map.from_positions({i: s.position for i, s in states.items()})
         err = np.abs(present - q_cmd)
         lagging = err > self.cfg.follow_error_rad

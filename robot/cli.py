@@ -1,7 +1,8 @@
 """`biped` command line: a thin dispatcher over ``robot.commands.<name>`` modules.
 
 Each command module has ``add_parser(subparsers)`` and ``run(args) -> int``. Bad input gives
-one clear line on stderr and exit code 2; nothing reaches the robot.
+one clear line on stderr and exit code 2; nothing reaches the robot. A bus error (a servo
+missing or silent, the port failing) or a safety stop is one line and exit code 1.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import sys
 from importlib.metadata import PackageNotFoundError, version
 
 from robot.commands.common import one_line_errors
-from robot.errors import BipedError, SafetyStop
+from robot.errors import BipedError, BusError, SafetyStop
 from robot.run.signals import Interrupted, SignalLatch
 
 # Order is the order of `biped --help`.
@@ -98,6 +99,9 @@ def _main(argv: list[str] | None) -> int:
         return int(args._run(args) or 0)
     except SafetyStop as e:   # e.g. a run refused to start: a safety stop, exit 1
         print(f"biped {args.command}: safety stop: {e}", file=sys.stderr)
+        return 1
+    except BusError as e:     # a servo missing or silent, the port failed: hardware, exit 1
+        print(f"biped {args.command}: bus error: {e}", file=sys.stderr)
         return 1
     except BipedError as e:
         print(f"biped {args.command}: error: {e}", file=sys.stderr)

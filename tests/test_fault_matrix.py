@@ -263,6 +263,7 @@ def test_port_closed_mid_walk(emu: Emulator, robot: RobotConfig, robot_toml: Pat
     reason = result["stop_reason"]
     assert reason.startswith("watchdog: 5 bus errors in a row") and "port error" in reason
     assert "\n" not in reason and not result["holding"]
+    assert result["torque"] == "unknown"                      # not "off": nothing was sent
     goals = goal_writes(emu)
     assert_stream_safe(robot, goals)
     assert max(p.t for p in goals) <= info["at"] + 0.05       # nothing heard after it
@@ -276,6 +277,24 @@ def test_port_closed_mid_walk(emu: Emulator, robot: RobotConfig, robot_toml: Pat
         sleep_until(time.monotonic() + 0.1)                   # 0.1 s of servo time: still
         assert [emu.registers(i)["present_position"] for i in robot.ids] == [
             r["present_position"] for r in regs]
+
+
+@pytest.mark.parametrize("protocol", ["dynamixel"])
+def test_port_closed_summary_says_what_is_known(emu: Emulator, robot: RobotConfig,
+                                                robot_toml: Path,
+                                                capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 19 item 8: after the port closed, the summary said "servos torque off" while
+    all 18 held torque. It may only say what the bus confirmed."""
+    args = [a for a in walk_args(emu, robot_toml, hold=False) if a != "--json"]
+    with inject_when_streaming(emu, lambda: emu.set_faults(close_port=True)):
+        out = io.StringIO()
+        with redirect_stdout(out):
+            code = cli.main(args)
+    assert code == 1, capsys.readouterr().err
+    servos = next(line for line in out.getvalue().splitlines()
+                  if line.strip().startswith("servos"))
+    assert "torque off" not in servos and "UNKNOWN" in servos, servos
+    assert torque(emu, robot.ids) == {1}                       # what the wire shows
 
 
 # ------------------------------------------------------------------------------ signals

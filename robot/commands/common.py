@@ -149,6 +149,12 @@ def _writable_dir(d: Path) -> str | None:
         return f"{d} is not a directory"
     if not os.access(d, os.W_OK | os.X_OK):
         return f"directory {d} is not writable"
+    try:
+        full = os.statvfs(d).f_bavail == 0
+    except OSError:
+        full = False                      # no statvfs there: the write will tell
+    if full:
+        return f"no space left on the device of directory {d}"
     return None
 
 

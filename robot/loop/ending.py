@@ -85,8 +85,9 @@ def end(bus: Bus, ids: Sequence[int], *, hold: bool, confirm: Callable[[], None]
             confirm()
         except SafetyStop as e:
             fault = f"watchdog: {e}"
-        except BusError as e:
+        except BusError as e:              # silent: only the one packet, no more timeouts
             fault = f"watchdog: not holding torque on servos that do not answer: {e}"
+            bus_dead = True
         else:
             torque = finish(bus, ids, torque_off=False, bus_dead=bus_dead, failsafe=failsafe)
             if torque == "on" and not estop():

@@ -24,9 +24,9 @@ import time
 from pathlib import Path
 
 import pytest
+from test_keyframes import WAVE
 from waiting import sleep_until, wait_for
 
-from robot.config.bundled import ROBOTS_DIR
 from robot.config.robot import RobotConfig
 from sim.emulator.chain import Emulator
 
@@ -35,21 +35,6 @@ pytest_plugins = ("bus_harness", "full_disk")
 REPO = Path(__file__).resolve().parent.parent
 GAPS_MS = (5, 50, 150, 300)
 TWICE = {"sigint": (signal.SIGINT, signal.SIGINT), "sigterm": (signal.SIGTERM, signal.SIGTERM)}
-WAVE = """name = "wave"
-loop = true
-[[keyframe]]
-t = 0.0
-r_shoulder_pitch = 0.0
-r_elbow = -0.2
-[[keyframe]]
-t = 1.5
-r_shoulder_pitch = -1.0
-r_elbow = -0.9
-[[keyframe]]
-t = 3.0
-r_shoulder_pitch = 0.0
-r_elbow = -0.2
-"""
 
 
 class Biped:
@@ -124,19 +109,11 @@ class Biped:
         return "".join(self.out) + "".join(self.err)
 
 
-#: Reply timeout of these tests' robot file [ms]: each test runs a whole `biped` process
-#: beside its emulator, and at a load average of 10 on 2 cores the harness's 100 ms was
-#: seen missed three times in a row (a failed arm of the Bus Watchdog, exit 1).
-PATIENT_TIMEOUT_MS = 250.0
-
-
-@pytest.fixture
-def robot_toml(tmp_path: Path, protocol: str) -> Path:
-    """The bundled robot with ``PATIENT_TIMEOUT_MS`` (overrides bus_harness's)."""
-    text = (ROBOTS_DIR / f"biped18-{protocol}.toml").read_text()
-    path = tmp_path / f"robot-{protocol}.toml"
-    path.write_text(text.replace("timeout_ms = 20.0", f"timeout_ms = {PATIENT_TIMEOUT_MS}"))
-    return path
+#: Reply timeout of these tests' robot file [ms] (bus_harness's robot_toml): each test runs
+#: a whole `biped` process beside its emulator, and at a load average of 10 on 2 cores the
+#: harness's 100 ms was seen missed three times in a row (a failed arm of the Bus
+#: Watchdog, exit 1).
+REPLY_TIMEOUT_MS = 250.0
 
 
 def bus_args(emu: Emulator, robot_toml: Path) -> list[str]:

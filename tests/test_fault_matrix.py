@@ -175,6 +175,32 @@ FAULTS = [
 ]
 
 
+#: Issue 19 item 6: a knee that jammed 5 s into `walk --seconds 20` got 3739 more goals and
+#: the walk ended "completed" (goal - present peaked at 0.36 rad, under the fixed 0.6 rad).
+JAM_AFTER_GOALS = 600                                  # 3 s of walking at 200 Hz
+#: The jam check judges 1 s of read-backs (robot.loop.following); the knee's goal must then
+#: sweep its threshold (0.25 rad) once more: a stride. Well under the 18.7 s it took.
+JAM_STOPS_WITHIN_S = 3.0
+
+
+@pytest.mark.parametrize("joint", ["l_knee", "r_hip_pitch"])
+def test_jam_mid_walk_is_a_safety_stop(emu: Emulator, robot: RobotConfig, robot_toml: Path,
+                                       joint: str, capsys: pytest.CaptureFixture[str]) -> None:
+    victim = robot.joint(joint).servo_id
+    jam = lambda: emu.set_faults(stuck_ids=[victim])   # noqa: E731
+    with inject_when_streaming(emu, jam, after=JAM_AFTER_GOALS) as info:
+        code, result, err = run_walk(walk_args(emu, robot_toml, hold=False, seconds=20), capsys)
+    emu.clear_faults()
+    assert code == 1, err
+    reason = result["stop_reason"]
+    assert reason.startswith(f"watchdog: servo {victim} ({joint}) stopped following"), reason
+    goals = goal_writes(emu)
+    assert_stream_safe(robot, goals)
+    assert info["at"] is not None
+    assert max(p.t for p in goals) - info["at"] < JAM_STOPS_WITHIN_S    # not driven on
+    assert torque(emu, robot.ids) == {0}
+
+
 def _hw_cases() -> list[tuple[str, str]]:
     return [(p, f) for p, flags in HW_FLAGS.items() for f in flags]
 

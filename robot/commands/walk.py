@@ -13,16 +13,17 @@ from robot.commands.common import (
     add_bus_args,
     add_robot_args,
     add_set_arg,
+    bounded_int,
     bus_from,
     input_file,
     output_file,
     params_from,
-    positive_int,
     rate_hz,
     robot_from,
     seconds,
 )
 from robot.commands.world_args import add_world_args, describe_world, world_from
+from robot.config.read_back import MAX_READ_PERIOD_S, check_read_every, max_read_every
 from robot.errors import ConfigError
 from robot.motion.keyframes import load_sequence
 from robot.run.result import TORQUE_WORDS
@@ -32,14 +33,21 @@ from robot.run.walk import walk_spec, walk_summary
 
 log = logging.getLogger(__name__)
 
+#: --read-every: an integer in [1, the most any --rate allows] at parse time; the bound
+#: at the run's rate is checked once the rate is known (robot.loop.watchdog).
+read_every = bounded_int(1, max_read_every(2000.0), what="a read-back interval [ticks]")
+
 
 def add_walk_args(p: argparse.ArgumentParser) -> None:
     """Options shared by `walk` and `panel`."""
     add_robot_args(p)
     add_bus_args(p, default="sim")
     p.add_argument("--rate", type=rate_hz, default=200.0, help="control rate [Hz]")
-    p.add_argument("--read-every", type=positive_int, default=10, metavar="N",
-                   help="read servos back every N ticks (default: %(default)s)")
+    p.add_argument("--read-every", type=read_every, default=10, metavar="N",
+                   help="read servos back every N ticks (default: %(default)s, or as often as "
+                        f"needed); at most {MAX_READ_PERIOD_S:g} s apart (N <= "
+                        f"{MAX_READ_PERIOD_S:g} x --rate): the watchdog must see heat, "
+                        "hardware errors and a jammed servo within about a second")
     p.add_argument("--hold", action="store_true",
                    help="hold the rest pose with torque on at the end (default: torque off)")
     p.add_argument("--realtime", action="store_true", help="pace the simulation to the wall clock")
@@ -78,6 +86,7 @@ def run(args: argparse.Namespace) -> int:
         {"realtime": args.realtime, "view": args.view} if kind == "sim" else {})
     if world is not None:
         options["world"] = world
+    check_read_every(args.read_every, args.rate, where="--read-every")
     bus = bus_from(args, robot, kind=kind, **options)
     imu = imu_for(args, robot, bus)
     layer = load_sequence(args.keyframes, robot) if args.keyframes else None

@@ -37,6 +37,7 @@ import numpy as np
 from robot.bus.base import Bus
 from robot.bus.servo_map import ServoMap
 from robot.config.params import GaitParams
+from robot.config.read_back import max_read_every
 from robot.errors import BusDead, BusError, ConfigError, SafetyStop
 from robot.loop.clock import Clock, MonotonicClock, Pacer
 from robot.loop.ending import arm_failsafe, end
@@ -65,13 +66,13 @@ class Streamer(Generic[SourceT]):
         self.rate_hz = rate_hz
         self.dt = 1.0 / rate_hz
         self._step = robot_map.max_speed * self.dt  # slew limit per tick [rad]
-        self.read_every = max(1, read_every)
+        self.read_every = min(max(1, read_every), max_read_every(rate_hz))  # inputs refuse more
         self.clock: Clock = clock or getattr(bus, "clock", None) or MonotonicClock()
         self.hold_at_end = hold_at_end
         self.watchdog_config = watchdog or WatchdogConfig()
-        self.watchdog = Watchdog(self.watchdog_config, robot_map, robot=source.robot)
-        self.observer = observer
-        self.feedback = feedback
+        self.watchdog = Watchdog(self.watchdog_config, robot_map, robot=source.robot,
+                                 read_period_s=self.read_every * self.dt)
+        self.observer, self.feedback = observer, feedback
         self._feedback_on = False
         self.telemetry = Telemetry()
         self._lock = threading.Lock()
@@ -203,8 +204,7 @@ class Streamer(Generic[SourceT]):
         """Hold or torque off (robot.loop.ending.end); what is known of the torque."""
         torque, fault = end(self.bus, self.map.ids, hold=hold, estop=self._estop.is_set,
                             confirm=lambda: self.watchdog.faults(self.bus.read_state(self.map.ids)),
-                            bus_dead=self._bus_dead,
-                            failsafe=bool(self.watchdog_config.failsafe_s))
+                            bus_dead=self._bus_dead, failsafe=bool(self.watchdog_config.failsafe_s))
         if fault is not None:
             self._set_fault(fault)
         self.telemetry.state = "estop" if self._estop.is_set() else "stopped"

@@ -108,6 +108,10 @@ def _main(argv: list[str] | None) -> int:
         return 2
     except BrokenPipeError:
         return 0  # stdout closed early (e.g. piped into `head`)
+    except OSError as e:      # a file no command check caught (a full disk, ...): one line
+        where = f"{e.filename}: " if e.filename else ""
+        print(f"biped {args.command}: error: {where}{e.strerror or e}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt as e:
         return interrupted(f" {args.command}", e)
 

@@ -23,6 +23,7 @@ from robot.commands.common import (
     one_line_errors,
     output_file,
     robot_from,
+    writing,
 )
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
@@ -64,7 +65,8 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
     if not capture.times:
         raise ConfigError("no keyframe captured; nothing was written")
     seq = capture.sequence(args.name or out.stem)
-    out.write_text(sequence_to_toml(seq))
+    with writing("--out", out):
+        out.write_text(sequence_to_toml(seq))
     try:
         load_sequence(out, robot)  # as `biped play` and `walk --keyframes` will read it
     except ConfigError as e:

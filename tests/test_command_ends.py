@@ -27,7 +27,9 @@ import pytest
 from test_keyframes import WAVE
 from waiting import sleep_until, wait_for
 
+from robot.config.bundled import ROBOTS_DIR
 from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness", "full_disk")
@@ -356,3 +358,27 @@ def test_output_on_a_full_disk_is_refused_before_the_port(emu: Emulator, robot_t
     assert code == 2, out + err
     assert len(err.strip().splitlines()) == 1 and "--out" in err and "space" in err, err
     assert emu.log() == []                                  # the port was not used
+
+
+# ------------------------------------------------------------------------------ scan
+AX_LOCK, AX_RETURN_DELAY = 47, 5            # AX-12A control table (ROBOTIS e-Manual)
+
+
+def test_fix_return_delay_never_locks_an_ax12_eeprom() -> None:
+    """Item 9: on AX-12As `scan --fix-return-delay` wrote Lock (47) = 1, which locks their
+    EEPROM until power-off (the Feetech unlock/relock dance applied to the wrong family).
+    Only Return Delay Time (5) may be written, and only where it is not 0 already."""
+    import robot.cli as cli
+
+    with Emulator("dynamixel1", load_robot(ROBOTS_DIR / "biped18-ax12.toml")) as emu:
+        for sid in (3, 7):
+            emu.set_register(sid, "return_delay_time", 250)
+        emu.log(clear=True)
+        assert cli.main(["scan", "--bus", "dynamixel1", "--port", emu.port, "--robot",
+                         "biped18-ax12", "--ids", "1-18", "--fix-return-delay", "--json"]) == 0
+        writes = [p for p in emu.log() if p.instruction in ("write", "sync_write", "reg_write")]
+        assert AX_LOCK not in {p.address for p in writes}
+        assert sorted((p.address, sid) for p in writes if p.address == AX_RETURN_DELAY
+                      for sid in p.values) == [(AX_RETURN_DELAY, 3), (AX_RETURN_DELAY, 7)]
+        assert {emu.registers(i)["lock"] for i in range(1, 19)} == {0}
+        assert {emu.registers(i)["return_delay_time"] for i in range(1, 19)} == {0}

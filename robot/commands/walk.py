@@ -36,6 +36,8 @@ log = logging.getLogger(__name__)
 #: --read-every: an integer in [1, the most any --rate allows] at parse time; the bound
 #: at the run's rate is checked once the rate is known (robot.loop.watchdog).
 read_every = bounded_int(1, max_read_every(2000.0), what="a read-back interval [ticks]")
+#: Read back every 10th tick: 50 ms at the default 200 Hz.
+READ_EVERY = 10
 
 
 def add_walk_args(p: argparse.ArgumentParser) -> None:
@@ -43,9 +45,9 @@ def add_walk_args(p: argparse.ArgumentParser) -> None:
     add_robot_args(p)
     add_bus_args(p, default="sim")
     p.add_argument("--rate", type=rate_hz, default=200.0, help="control rate [Hz]")
-    p.add_argument("--read-every", type=read_every, default=10, metavar="N",
-                   help="read servos back every N ticks (default: %(default)s, or as often as "
-                        f"needed); at most {MAX_READ_PERIOD_S:g} s apart (N <= "
+    p.add_argument("--read-every", type=read_every, default=READ_EVERY, metavar="N",
+                   help=f"read servos back every N ticks (default: {READ_EVERY}, fewer at "
+                        f"a low --rate); at most {MAX_READ_PERIOD_S:g} s apart (N <= "
                         f"{MAX_READ_PERIOD_S:g} x --rate): the watchdog must see heat, "
                         "hardware errors and a jammed servo within about a second")
     p.add_argument("--hold", action="store_true",
@@ -86,13 +88,14 @@ def run(args: argparse.Namespace) -> int:
         {"realtime": args.realtime, "view": args.view} if kind == "sim" else {})
     if world is not None:
         options["world"] = world
-    check_read_every(args.read_every, args.rate, where="--read-every")
+    every = (min(READ_EVERY, max_read_every(args.rate)) if args.read_every == READ_EVERY
+             else check_read_every(args.read_every, args.rate, where="--read-every"))
     bus = bus_from(args, robot, kind=kind, **options)
     imu = imu_for(args, robot, bus)
     layer = load_sequence(args.keyframes, robot) if args.keyframes else None
     spec = walk_spec(robot, params, bus, gait=gait.name, imu=imu, keyframes=layer,
                      record=args.record, options=RunOptions(
-                         rate_hz=args.rate, read_every=args.read_every, hold=args.hold,
+                         rate_hz=args.rate, read_every=every, hold=args.hold,
                          seconds=args.seconds, stop_on_fall=args.stop_on_fall, signals=True))
     result = walk_summary(spec, execute(spec), gait=gait.name)
     if args.json:

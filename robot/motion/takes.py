@@ -32,7 +32,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.config.params import GaitParams, canonical_name, check_value
-from robot.config.read_back import check_read_every
+from robot.config.read_back import check_read_every, max_read_every
 from robot.config.toml_io import JsonValue, number, parse_json
 from robot.errors import ConfigError
 
@@ -143,8 +143,9 @@ def _header(where: str, h: JsonValue) -> TakeHeader:
         raise _fail(where, "keyframes: expected a keyframe sequence object or null")
     return TakeHeader(robot=strings["robot"], robot_file=strings["robot_file"],
                       joints=names, rate_hz=float(rate),
-                      read_every=check_read_every(h.get("read_every", 10), float(rate),
-                                                  where=f"{where}: read_every"),
+                      read_every=check_read_every(
+                          h.get("read_every", min(10, max_read_every(rate))), float(rate),
+                          where=f"{where}: read_every"),
                       gait=strings["gait"] or "take",
                       params=GaitParams().replace(params, where=f"{where}: params"),
                       bus=strings["bus"] or "sim", balance=h.get("balance") is True,

@@ -204,6 +204,68 @@ def test_pose_with_every_reply_dropped_ends_torque_off(
     assert torque(emu, robot) == {0}                       # the torque-off packet needs no reply
 
 
+# ------------------------------------------------------------------------------ bus faults
+FAULTS = {  # name: what the emulator does to the right knee (or to every reply)
+    "every reply dropped": lambda emu, knee: emu.set_faults(drop_rate=1.0),
+    "a silent servo": lambda emu, knee: emu.set_faults(vanish={knee: 0.0}),
+    "overload flag": lambda emu, knee: emu.set_faults(hw_error={knee: "overload"}),
+}
+
+
+def run_with_fault(p: Biped, emu: Emulator, robot: RobotConfig, fault: str
+                   ) -> tuple[int, str, str, tuple[int, ...]]:
+    """Inject ``fault`` once goals flow; the exit, outputs and the servos that can still
+    hear a packet (a silent one cannot, by definition)."""
+    knee = robot.joint("r_knee").servo_id
+    p.when(lambda: goals_sent(emu) >= 20)
+    FAULTS[fault](emu, knee)
+    code, out, err = p.finish()
+    emu.clear_faults()
+    return code, out, err, tuple(i for i in robot.ids if fault != "a silent servo" or i != knee)
+
+
+@pytest.mark.parametrize("fault", sorted(FAULTS))
+def test_pose_bus_fault_mid_ramp(emu: Emulator, robot: RobotConfig, robot_toml: Path,
+                                 fault: str) -> None:
+    """A fault mid-ramp: a safety stop, exit 1, torque off on every servo that hears."""
+    p = Biped("pose", "rest", *bus_args(emu, robot_toml), "--rate", "50", "--speed", "0.2")
+    code, out, err, reachable = run_with_fault(p, emu, robot, fault)
+    assert code == 1, out + err
+    last = out.splitlines()[-1]
+    assert last.startswith("stopped: watchdog") and "torque ON" not in last, last
+    assert {emu.registers(i)["torque_enable"] for i in reachable} == {0}
+
+
+@pytest.mark.parametrize("fault", sorted(FAULTS))
+@pytest.mark.parametrize("protocol", ["dynamixel"])
+def test_play_bus_fault(emu: Emulator, robot: RobotConfig, robot_toml: Path, tmp_path: Path,
+                        fault: str) -> None:
+    seq = tmp_path / "wave.toml"
+    seq.write_text(WAVE)
+    p = Biped("play", str(seq), *bus_args(emu, robot_toml), "--seconds", "60", "--json")
+    code, out, err, reachable = run_with_fault(p, emu, robot, fault)
+    assert code == 1, out + err
+    result = json.loads(out)
+    assert result["fault"] and result["stop_reason"].startswith("watchdog")
+    assert result["torque"] in ("off", "sent") and not result["holding"]
+    assert {emu.registers(i)["torque_enable"] for i in reachable} == {0}
+
+
+@pytest.mark.parametrize("protocol", ["dynamixel"])
+def test_calibrate_servo_goes_silent_at_a_prompt(emu: Emulator, robot: RobotConfig,
+                                                 robot_toml: Path, tmp_path: Path) -> None:
+    out_file = tmp_path / "calibrated.toml"
+    p = Biped("calibrate", *bus_args(emu, robot_toml), "--out", str(out_file), stdin=True)
+    p.said("torque OFF on")
+    emu.set_faults(vanish={robot.joint("r_knee").servo_id: 0.0})
+    p.send("\n")                                          # step 1 reads every servo
+    code, out, err = p.finish()
+    emu.clear_faults()
+    assert code == 1, out + err
+    assert "bus error" in err and "(r_knee)" in err and not out_file.exists()
+    assert torque(emu, robot) == {0}
+
+
 # ------------------------------------------------------------------------------ capture
 @pytest.mark.parametrize("sent", [(signal.SIGTERM,), (signal.SIGINT,),
                                   (signal.SIGTERM, signal.SIGTERM),
@@ -349,14 +411,20 @@ def test_setup_motors_signal_at_the_prompt(robot_toml: Path, protocol: str,
 
 
 # ------------------------------------------------------------------------------ full disk
-@pytest.mark.parametrize("cmd", ["capture", "calibrate"])
+@pytest.mark.parametrize("cmd", ["capture --out", "calibrate --out", "play --record"])
 def test_output_on_a_full_disk_is_refused_before_the_port(emu: Emulator, robot_toml: Path,
-                                                          full_dir: Path, cmd: str) -> None:
+                                                          full_dir: Path, tmp_path: Path,
+                                                          cmd: str) -> None:
     emu.log(clear=True)
-    p = Biped(cmd, *bus_args(emu, robot_toml), "--out", str(full_dir / "x.toml"), stdin=True)
+    name, option = cmd.split()
+    seq = tmp_path / "wave.toml"
+    seq.write_text(WAVE)
+    argv = [name, *([str(seq)] if name == "play" else []), *bus_args(emu, robot_toml),
+            option, str(full_dir / ("x.csv" if name == "play" else "x.toml"))]
+    p = Biped(*argv, stdin=True)
     code, out, err = p.finish()
     assert code == 2, out + err
-    assert len(err.strip().splitlines()) == 1 and "--out" in err and "space" in err, err
+    assert len(err.strip().splitlines()) == 1 and option in err and "space" in err, err
     assert emu.log() == []                                  # the port was not used
 
 

@@ -10,6 +10,7 @@ import math
 import os
 import random
 import signal
+import threading
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
@@ -30,7 +31,7 @@ from robot.loop.streamer import Streamer
 from robot.loop.telemetry import Telemetry
 from robot.motion.posing import PoseMove
 from robot.run.run import Run
-from robot.run.signals import SignalLatch
+from robot.run.signals import Interrupted, SignalLatch
 from robot.run.spec import RunOptions, RunSpec
 from sim.emulator.chain import Emulator
 
@@ -231,3 +232,59 @@ def test_a_stop_before_the_stream_starts_writes_nothing(
     assert stats.torque == "untouched" and stats.ticks == 0
     assert [p for p in emu.log() if p.instruction in WRITES] == []
     assert run.result.exit_code == 143 and wire_torque(emu, robot) == {0}
+
+
+class Target:
+    def __init__(self) -> None:
+        self.calls: list[str] = []
+
+    def request_stop(self, reason: str = "") -> None:
+        self.calls.append(f"stop: {reason}")
+
+    def emergency_stop(self, reason: str = "") -> None:
+        self.calls.append(f"estop: {reason}")
+
+
+def test_latch_regions() -> None:
+    """The rules of robot.run.signals, by calling the handler as the interpreter would:
+    outside any region the first signal raises (once), a shielded region defers it to
+    its end, a routed one stops the target and never raises."""
+    latch = SignalLatch()
+    with pytest.raises(Interrupted) as first:
+        latch.handle(signal.SIGTERM)
+    assert first.value.signum == signal.SIGTERM
+    latch.handle(signal.SIGINT)                           # the cleanup is not interrupted
+    assert (latch.first, latch.count, latch.emergency) == (signal.SIGTERM, 2, True)
+    assert latch.exit_code(None) == 143
+
+    shielded = SignalLatch()
+    with pytest.raises(Interrupted):
+        with shielded.shielded():
+            shielded.handle(signal.SIGINT)                # only counted here
+            done = True
+    assert done
+
+    routed, target = SignalLatch(), Target()
+    with routed.routed(target):
+        routed.handle(signal.SIGINT)
+        with routed.shielded():                           # routing wins: the loop is told
+            routed.handle(signal.SIGTERM)
+    assert target.calls == ["stop: signal SIGINT",
+                            "estop: emergency stop (second signal, SIGTERM)"]
+    assert routed.exit_code(None) == 130
+
+
+def test_shield_in_another_thread_changes_nothing(command_latch: SignalLatch) -> None:
+    """A run closing in a panel thread must not defer (and later raise) the main thread's
+    signal there."""
+    from robot.run.signals import shield
+
+    def close() -> None:
+        with shield():
+            assert command_latch._shields == 0
+
+    worker = threading.Thread(target=close)
+    worker.start()
+    worker.join()
+    with shield():
+        assert command_latch._shields == 1

@@ -26,6 +26,7 @@ import logging
 import os
 import signal
 import sys
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from types import FrameType
@@ -198,9 +199,10 @@ def stop_on_signals(target: Stoppable, latch: SignalLatch | None = None
 
 @contextmanager
 def shield() -> Iterator[None]:
-    """The command's latch's ``shielded`` region (nothing when there is no command)."""
+    """The command's latch's ``shielded`` region (nothing when there is no command, or
+    in another thread: signals run in the main thread and never interrupt another)."""
     latch = installed()
-    if latch is None:
+    if latch is None or threading.current_thread() is not threading.main_thread():
         yield
         return
     with latch.shielded():

@@ -23,7 +23,9 @@ import threading
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
+from test_fault_matrix import goal_writes, rest_ticks, tick_window
 from test_keyframes import WAVE
 from waiting import sleep_until, wait_for
 
@@ -136,6 +138,19 @@ def goals_sent(emu: Emulator) -> int:
     return emu.counters().get("sync_write", 0)
 
 
+def assert_goals_safe(emu: Emulator, robot: RobotConfig, rate_hz: float) -> None:
+    """Every goal on the wire inside the joint limits, consecutive goals within the slew
+    limit at ``rate_hz`` (the manual's tick formula, tests/test_fault_matrix.py)."""
+    goals = goal_writes(emu)
+    assert goals, "no goal reached the servos"
+    ticks = np.array([[p.values[i] for i in robot.ids] for p in goals])
+    window = tick_window(robot)
+    assert all(window[i][0] <= t <= window[i][1] for row in ticks
+               for i, t in zip(robot.ids, row, strict=True)), "a goal left the joint limits"
+    step = np.array([j.max_speed_rad_s / rate_hz * 4096 / (2 * math.pi) for j in robot.joints])
+    assert (np.abs(np.diff(ticks, axis=0)) <= step + 1.0).all(), "a goal broke the slew limit"
+
+
 def assert_released(emu: Emulator, robot: RobotConfig) -> None:
     """Torque off on every servo and no Bus Watchdog left armed or tripped."""
     assert torque(emu, robot) == {0}
@@ -157,6 +172,7 @@ def test_pose_two_signals(emu: Emulator, robot: RobotConfig, robot_toml: Path, t
     p.signals(sent, gap_ms=gap_ms)
     code, out, err = p.finish()
     assert code == 128 + sent[0], err
+    assert_goals_safe(emu, robot, 50.0)
     last = out.splitlines()[-1]
     assert watchdog(emu, robot) == {0}                     # never left armed or tripped
     if "second signal" in last or " again: " in err:       # it heard the second: off
@@ -231,6 +247,7 @@ def test_pose_bus_fault_mid_ramp(emu: Emulator, robot: RobotConfig, robot_toml: 
     p = Biped("pose", "rest", *bus_args(emu, robot_toml), "--rate", "50", "--speed", "0.2")
     code, out, err, reachable = run_with_fault(p, emu, robot, fault)
     assert code == 1, out + err
+    assert_goals_safe(emu, robot, 50.0)
     last = out.splitlines()[-1]
     assert last.startswith("stopped: watchdog") and "torque ON" not in last, last
     assert {emu.registers(i)["torque_enable"] for i in reachable} == {0}
@@ -391,6 +408,9 @@ def test_play_signals(emu: Emulator, robot: RobotConfig, robot_toml: Path, tmp_p
     result = json.loads(out)
     assert result["torque"] == "off" and not result["holding"]
     assert_released(emu, robot)
+    assert_goals_safe(emu, robot, 200.0)
+    if len(sent) == 1:                                     # a stop, not an e-stop: at rest
+        assert {i: emu.registers(i)["goal_position"] for i in robot.ids} == rest_ticks(robot)
 
 
 # ------------------------------------------------------------------------------ setup-motors

@@ -178,9 +178,11 @@ FAULTS = [
 #: Issue 19 item 6: a knee that jammed 5 s into `walk --seconds 20` got 3739 more goals and
 #: the walk ended "completed" (goal - present peaked at 0.36 rad, under the fixed 0.6 rad).
 JAM_AFTER_GOALS = 600                                  # 3 s of walking at 200 Hz
-#: The jam check judges 1 s of read-backs (robot.loop.following); the knee's goal must then
-#: sweep its threshold (0.25 rad) once more: a stride. Well under the 18.7 s it took.
-JAM_STOPS_WITHIN_S = 3.0
+#: The jam check judges 1 s of read-backs (robot.loop.following); the joint's goal must then
+#: sweep its threshold (0.25 rad) once more: about a stride. Counted in goal packets (gait
+#: ticks), not wall seconds: a loaded machine slows the loop, not the gait per tick.
+#: 3 s of gait at 200 Hz; the measured figure was 190 (it was 3739).
+JAM_MOST_GOALS = 600
 
 
 @pytest.mark.parametrize("joint", ["l_knee", "r_hip_pitch"])
@@ -197,7 +199,7 @@ def test_jam_mid_walk_is_a_safety_stop(emu: Emulator, robot: RobotConfig, robot_
     goals = goal_writes(emu)
     assert_stream_safe(robot, goals)
     assert info["at"] is not None
-    assert max(p.t for p in goals) - info["at"] < JAM_STOPS_WITHIN_S    # not driven on
+    assert len([p for p in goals if p.t > info["at"]]) <= JAM_MOST_GOALS   # not driven on
     assert torque(emu, robot.ids) == {0}
 
 

@@ -110,6 +110,13 @@ class Bus(ABC):
         ``set_torque(ids, enabled=False)`` while the bus answers. Default: ``set_torque``."""
         self.set_torque(ids, enabled=False)
 
+    def read_gains(self, servo_id: int, *, model: int | None = None) -> dict[str, int] | None:
+        """The position-control gain registers of ``servo_id`` [register values, named as in
+        robot/servo/gains.py], by its joint's servo model (else by ``model``, its model
+        number); None when the model is unknown or the bus has no gain registers (this
+        default, for buses without them)."""
+        return None
+
     def read_positions(self, ids: Iterable[int]) -> dict[int, int]:
         """Present positions [ticks] of ``ids``."""
         return {i: s.position for i, s in self.read_state(ids).items()}

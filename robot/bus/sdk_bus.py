@@ -20,6 +20,7 @@ from robot.bus.sdk_port import PORT_ERRORS
 from robot.bus.sdk_registers import SdkRegisters
 from robot.bus.sync_read import BlockSyncRead, Reply
 from robot.bus.tables import COMM_WATCHDOG, RETURN_DELAY_UNIT_S
+from robot.bus.wire_time import TickWire, tick_wire
 from robot.config.robot import RobotConfig
 from robot.servo.models import MODELS_BY_NUMBER, model_name
 
@@ -67,6 +68,7 @@ class SdkBus(SdkRegisters, Bus):
         port = self.port_class(self.port_name)
         port.timeout_ms = self.timeout_ms
         self._gains_done.clear()
+        self.return_delay_s = 0.0       # measured again by the health check
         self._port = port
         self._ph = self._make_packet_handler()
         self.set_baud(self.baud)
@@ -192,6 +194,13 @@ class SdkBus(SdkRegisters, Bus):
             gain_writer.apply(self, pending)
             self._gains_done.update(pending)
         super().set_torque(ids, enabled=enabled)
+
+    def tick_wire(self, read_every: int) -> TickWire | None:
+        if self.robot is None:
+            return None
+        return tick_wire(self.family, servos=len(self.robot.ids), baud=self.baud,
+                         goal_size=self._goal_size, block_size=self._reader.length,
+                         read_every=read_every)
 
     def read_gains(self, servo_id: int, *, model: int | None = None) -> dict[str, int] | None:
         joint = self.robot.joint_by_id(servo_id) if self.robot else None

@@ -34,6 +34,8 @@ class SdkRegisters:
     kind: str
     family: ClassVar[str]
     sdk: ClassVar[ModuleType]
+    #: The servos' longest return delay, as the health check read it on open [s].
+    return_delay_s: float = 0.0
 
     def __init__(self, port: str, *, baud: int, robot: RobotConfig | None = None,
                  retries: int | None = None, timeout_ms: float | None = None) -> None:

@@ -22,6 +22,7 @@ from typing import Generic
 
 from robot.balance.stage import Balance, attitude_reader
 from robot.bus.servo_map import ServoMap
+from robot.bus.wire_time import check_rate
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.loop.source import Feedback, SourceT
@@ -82,6 +83,7 @@ class Run(Generic[SourceT]):
         spec, o = self.spec, self.spec.options
         if not spec.bus.is_open:
             spec.bus.open()
+        check_rate(spec.bus, o.rate_hz, o.read_every)   # before torque: nothing has moved
         if o.watch and isinstance(spec.bus, WatchedBus):
             self.watch = spec.bus.run_watch()
         if spec.imu is not None:

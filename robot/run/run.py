@@ -21,8 +21,8 @@ from types import TracebackType
 from typing import Generic
 
 from robot.balance.stage import Balance, attitude_reader
+from robot.bus.rate_check import check_rate
 from robot.bus.servo_map import ServoMap
-from robot.bus.wire_time import check_rate
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.loop.source import Feedback, SourceT

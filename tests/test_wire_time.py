@@ -16,6 +16,7 @@ import serial
 from waiting import sleep_until, wait_for
 
 import robot.cli as cli
+from robot.bus.dynamixel import DynamixelBus
 from robot.bus.factory import make_bus
 from robot.bus.servo_map import ServoMap
 from robot.config.bundled import ROBOTS_DIR
@@ -124,13 +125,20 @@ def test_an_accepted_rate_holds_on_the_emulator(tmp_path: Path,
         assert summary["overruns"] == 0, summary
 
 
+class UncheckedBus(DynamixelBus):
+    """The real Dynamixel bus without its rate check (to see what the wire does)."""
+
+    def check_rate(self, rate_hz: float, *, read_every: int) -> None:
+        return None
+
+
 def test_the_emulators_wire_makes_200_hz_at_57600_overrun(tmp_path: Path) -> None:
-    """Bypassing the check (a Streamer built by hand), the emulated wire itself cannot
-    carry 18 servos' write + read at 200 Hz: the loop counts overruns."""
+    """Bypassing the check, the emulated wire itself cannot carry 18 servos' write + read
+    at 200 Hz: the loop counts overruns."""
     path = robot_toml(tmp_path, 57600)
     robot = load_robot(path)
     with Emulator("dynamixel", robot, baud=57600) as emu:
-        bus = make_bus("dynamixel", robot=robot, port=emu.port, timeout_ms=500)
+        bus = UncheckedBus(emu.port, baud=57600, robot=robot, timeout_ms=500)
         bus.open()
         try:
             engine = GaitEngine(robot, load_gait("walk").params)
@@ -149,6 +157,10 @@ def test_check_rate_names_the_baud(tmp_path: Path) -> None:
     check_rate(bus, 16.0, 10)
     with pytest.raises(ConfigError, match="at 57600 baud carry at most 16 Hz"):
         check_rate(bus, 17.0, 10)
+    with pytest.raises(ConfigError, match="at 57600 baud carry at most 16 Hz"):
+        bus.check_rate(17.0, read_every=10)           # the Bus interface the Streamer calls
+    assert bus.max_rate_hz(read_every=10) == pytest.approx(
+        hand_max_rate(*HAND["dynamixel"], 57600, 10))
     check_rate(make_bus("sim", robot=robot), 1000.0, 10)
 
 

@@ -52,7 +52,7 @@ class ServoState:
 class Bus(ABC):
     """A chain of servos. Use as a context manager; ``close()`` turns torque off."""
 
-    #: "dynamixel" | "feetech" | "sim"
+    #: "dynamixel" | "dynamixel1" | "feetech" | "lx" | "sim"
     kind: str = "abstract"
 
     @abstractmethod
@@ -108,6 +108,16 @@ class Bus(ABC):
         when there is none. This default is for buses without one: it does nothing."""
         return None
 
+    def max_rate_hz(self, *, read_every: int) -> float | None:
+        """The fastest control rate the wire carries with a read-back every ``read_every``
+        ticks [Hz]; None when the wire sets no practical limit (the default)."""
+        return None
+
+    def check_rate(self, rate_hz: float, *, read_every: int) -> None:
+        """ConfigError when the wire cannot carry goals at ``rate_hz`` [Hz] with a read-back
+        every ``read_every`` ticks (the LX bus: one packet per servo). Default: any rate."""
+        return None
+
     def release(self, ids: Iterable[int]) -> None:
         """Torque off on ``ids`` at once, in one packet that needs no reply where the bus
         allows (an emergency, or a bus that stopped answering); confirm with
@@ -141,3 +151,10 @@ class Bus(ABC):
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
         self.close()
+
+
+def bus_rate(bus: Bus, rate_hz: float = 200.0, *, read_every: int = 10) -> float:
+    """``rate_hz`` [Hz], or the fastest the bus's wire carries if that is lower (an LX
+    chain: no sync write), for loops whose rate the user did not choose (holding a pose)."""
+    top = bus.max_rate_hz(read_every=read_every)
+    return rate_hz if top is None else min(rate_hz, float(int(top)))

@@ -1,5 +1,6 @@
-"""Before a run: can the bus's wire carry the loop's rate? (robot/bus/wire_time.py does
-the arithmetic.)"""
+"""Before a run: can a vendor bus's wire carry the loop's rate? (robot/bus/wire_time.py
+does the arithmetic; ``SdkBus.check_rate`` calls this, and the Streamer calls that before
+anything moves.)"""
 
 from __future__ import annotations
 

@@ -13,7 +13,7 @@ import time
 from collections.abc import Iterable, Mapping
 from typing import Any, ClassVar
 
-from robot.bus import failsafe, gain_writer, health
+from robot.bus import failsafe, gain_writer, health, rate_check
 from robot.bus.base import Bus, ServoInfo, ServoState
 from robot.bus.limits import TickLimits
 from robot.bus.sdk_port import PORT_ERRORS
@@ -194,6 +194,13 @@ class SdkBus(SdkRegisters, Bus):
             gain_writer.apply(self, pending)
             self._gains_done.update(pending)
         super().set_torque(ids, enabled=enabled)
+
+    def max_rate_hz(self, *, read_every: int) -> float | None:
+        wire = self.tick_wire(read_every)
+        return None if wire is None else wire.max_rate_hz
+
+    def check_rate(self, rate_hz: float, *, read_every: int) -> None:
+        rate_check.check_rate(self, rate_hz, read_every)
 
     def tick_wire(self, read_every: int) -> TickWire | None:
         if self.robot is None:

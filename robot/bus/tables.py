@@ -204,6 +204,7 @@ ERROR_BITS: dict[str, dict[int, str]] = {
     "dynamixel_x": DYNAMIXEL_X_ERROR_BITS,
     "dynamixel_p1": DYNAMIXEL_P1_ERROR_BITS,
     "feetech_sts": FEETECH_STS_ERROR_BITS,
+    "lx": {0: "overheating", 1: "voltage", 2: "overload"},   # lx_tables.LX_ALARM_BITS
 }
 
 # Unit of one "return delay" register step [s]: Dynamixel X 2 µs, Feetech STS 2 µs.

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 
+from robot.bus.base import bus_rate
 from robot.bus.servo_map import ServoMap
 from robot.commands.common import (
     add_bus_args,
@@ -40,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
             return 0
         sm = ServoMap(robot)
         here = PoseMove(robot, sm.from_positions(bus.read_positions(sm.ids)))
-        stats = Streamer(sm, bus, here, hold_at_end=True).run()
+        stats = Streamer(sm, bus, here, rate_hz=bus_rate(bus), hold_at_end=True).run()
         if stats.fault or not stats.holding:
             print(f"stopped: {stats.stop_reason}; torque OFF")
             return 1

@@ -65,6 +65,7 @@ class Streamer(Generic[SourceT]):
         self.dt = 1.0 / rate_hz
         self._step = robot_map.max_speed * self.dt  # slew limit per tick [rad]
         self.read_every = max(1, read_every)
+        bus.check_rate(rate_hz, read_every=self.read_every)   # before anything moves
         self.clock: Clock = clock or getattr(bus, "clock", None) or MonotonicClock()
         self.hold_at_end = hold_at_end
         self.watchdog_config = watchdog or WatchdogConfig()

@@ -21,7 +21,6 @@ from types import TracebackType
 from typing import Generic
 
 from robot.balance.stage import Balance, attitude_reader
-from robot.bus.rate_check import check_rate
 from robot.bus.servo_map import ServoMap
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
@@ -83,7 +82,6 @@ class Run(Generic[SourceT]):
         spec, o = self.spec, self.spec.options
         if not spec.bus.is_open:
             spec.bus.open()
-        check_rate(spec.bus, o.rate_hz, o.read_every)   # before torque: nothing has moved
         if o.watch and isinstance(spec.bus, WatchedBus):
             self.watch = spec.bus.run_watch()
         if spec.imu is not None:

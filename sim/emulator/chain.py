@@ -283,9 +283,9 @@ class Emulator:
         self._call("set_register", servo_id, name, int(value))
 
     def _check_names(self, names: Iterable[str]) -> list[str]:
-        """``names``, each in the control table of some servo of the chain."""
-        valid = {n for s in self.spec.servos for n in TABLES[MODELS[s.model].layout]}
-        if bad := [n for n in names if n not in valid]:
+        """``names``, each in some servo's control table (LX: none, its servo checks)."""
+        valid = {n for s in self.spec.servos for n in TABLES.get(MODELS[s.model].layout, ())}
+        if self.family in TABLES and (bad := [n for n in names if n not in valid]):
             raise EmulatorError(f"register {bad[0]!r} is not in the {self.family} tables; "
                                 f"valid: {', '.join(sorted(valid))}")
         return list(names)

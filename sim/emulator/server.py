@@ -20,7 +20,7 @@ from multiprocessing.connection import Connection
 from types import ModuleType
 from typing import Any
 
-from sim.emulator import dxl1_protocol, dxl_protocol, sts_protocol
+from sim.emulator import dxl1_protocol, dxl_protocol, lx_protocol, sts_protocol
 from sim.emulator.line import Line, Outbox, pty_speed
 from sim.emulator.records import ChainSpec, EmulatorError, Packet
 from sim.emulator.servo import EmulatedServo
@@ -40,7 +40,7 @@ COUNTER_KEYS = ("rx_bytes", "tx_bytes", "rx_packets", "tx_packets", "rx_bad_chec
 
 #: Wire protocol codec per bus kind.
 CODECS: dict[str, ModuleType] = {"dynamixel": dxl_protocol, "dynamixel1": dxl1_protocol,
-                                 "feetech": sts_protocol}
+                                 "feetech": sts_protocol, "lx": lx_protocol}
 
 
 class _ChainServer:
@@ -51,7 +51,8 @@ class _ChainServer:
         self.codec: ModuleType = CODECS[spec.protocol]
         self.parser = self.codec.Parser()
         now = time.monotonic()
-        self.servos = [EmulatedServo(s, now) for s in spec.servos]
+        servo_class = getattr(self.codec, "SERVO", EmulatedServo)  # LX: no control table
+        self.servos = [servo_class(s, now) for s in spec.servos]
         self.plugged: set[int] = set(range(len(self.servos)) if spec.plugged is None
                                      else spec.plugged)
         self.rng = random.Random(spec.seed)
@@ -181,7 +182,7 @@ class _ChainServer:
             for s in self.servos:
                 s.conditions.clear()
                 s.stuck = False
-                s.frozen.clear()
+                s.frozen = set()
             return None
         if cmd == "log":
             out = list(self.log)

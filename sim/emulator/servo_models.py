@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 #: ``Emulator(protocol)`` -> control-table family.
 PROTOCOL_FAMILY: dict[str, str] = {
     "dynamixel": "dynamixel_x", "dynamixel1": "dynamixel_p1", "feetech": "feetech_sts",
+    "lx": "lx",
 }
 
 
@@ -84,4 +85,12 @@ MODELS: dict[str, ServoModel] = {
     # Feetech STS3032 (6 V): 4096 steps/rev; no-load 0.1 s/60 deg. Model 1288 (= 5 * 256 +
     # 8) is the value the driver lists; no Feetech page here prints it.
     "STS3032": ServoModel("STS3032", 1288, "feetech_sts", 4096, _per_60deg(0.1)),
+    # HiWonder/LewanSoul LX (sim/emulator/lx_servo.py): positions 0..1000 over 0..240 deg,
+    # 0.24 deg each (1001 positions spanning 240.24 deg at that pitch); no model number on
+    # the wire (the number is the driver's label). No-load speed: LX-16A 0.16 s/60 deg at
+    # 7.4 V (LewanSoul spec); LX-224 0.20 s/60 deg at 7.4 V and LX-224HV 0.18 s/60 deg at
+    # 11.1 V (HiWonder listings).
+    "LX-16A": ServoModel("LX-16A", 16, "lx", 1001, _per_60deg(0.16), 240.24),
+    "LX-224": ServoModel("LX-224", 224, "lx", 1001, _per_60deg(0.20), 240.24),
+    "LX-224HV": ServoModel("LX-224HV", 2240, "lx", 1001, _per_60deg(0.18), 240.24),
 }

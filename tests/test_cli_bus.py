@@ -56,10 +56,11 @@ def test_scan_json_is_a_clean_list(emu: Emulator, robot: RobotConfig, robot_toml
 def test_scan_table_names_missing_joints(emu: Emulator, robot_toml: Path,
                                          capsys: pytest.CaptureFixture[str]) -> None:
     emu.set_faults(missing_ids=[7, 12])
-    assert cli.main(["scan", *bus_args(emu, robot_toml)]) == 0
+    assert cli.main(["scan", *bus_args(emu, robot_toml)]) == 1    # incomplete: exit 1
     out = capsys.readouterr().out
     assert "16 servo(s)" in out
-    assert "missing joints: l_hip_yaw (id 7), l_ankle_roll (id 12)" in out
+    assert "missing joints (2 of 18; exit status 1): l_hip_yaw (id 7), l_ankle_roll (id 12)" \
+        in out
 
 
 def test_scan_at_wrong_baud_names_the_rate(emu: Emulator, robot_toml: Path,

@@ -1,4 +1,6 @@
-"""`biped scan`: list the servos on a bus, map them to the robot's joints, flag what is off."""
+"""`biped scan`: list the servos on a bus, map them to the robot's joints, flag what is off.
+
+Exit status 1 when a joint of the robot file did not answer (the table names them)."""
 
 from __future__ import annotations
 
@@ -70,12 +72,14 @@ def run(args: argparse.Namespace) -> int:
         raise
     bus.close(torque_off=False)
     rows = [_row(info, robot, gains[info.id]) for info in found]
+    seen = {r["id"] for r in rows}
+    incomplete = 1 if any(j.servo_id not in seen for j in robot.joints) else 0
     if args.json:
         print(json.dumps(rows))
-        return 0
+        return incomplete
     _print_table(rows, robot, bus_name=f"{bus.kind} {args.port or robot.bus.port}",
                  gains_text=gains_lines({f"id {sid}": g for sid, g in gains.items()}))
-    return 0
+    return incomplete   # exit 1: a joint of the robot file did not answer
 
 
 def _print_table(rows: list[dict[str, object]], robot: RobotConfig, *, bus_name: str,
@@ -91,7 +95,8 @@ def _print_table(rows: list[dict[str, object]], robot: RobotConfig, *, bus_name:
     seen = {r["id"] for r in rows}
     missing = [j for j in robot.joints if j.servo_id not in seen]
     if missing:
-        print("missing joints: " + ", ".join(f"{j.name} (id {j.servo_id})" for j in missing))
+        print(f"missing joints ({len(missing)} of {len(robot.joints)}; exit status 1): "
+              + ", ".join(f"{j.name} (id {j.servo_id})" for j in missing))
     slow = [r["id"] for r in rows if r["return_delay_us"]]
     if slow:
         print(f"return delay > 0 on ids {slow}: rerun with --fix-return-delay")

@@ -25,6 +25,7 @@ COMMANDS: tuple[str, ...] = (
     "play",
     "capture",
     "export",
+    "import_",
     "curves",
     "scan",
     "torque",
@@ -94,7 +95,9 @@ def _main(argv: list[str] | None) -> int:
     except KeyboardInterrupt as e:
         return interrupted("", e)
     logging.basicConfig(level=getattr(logging, args.log_level), stream=sys.stderr,
-                        format="%(levelname)s %(name)s: %(message)s")
+                        # the logger's name only when debugging: a user reads the message
+                        format=("%(levelname)s %(name)s: %(message)s"
+                                if args.log_level == "DEBUG" else "%(levelname)s: %(message)s"))
     try:
         return int(args._run(args) or 0)
     except SafetyStop as e:   # e.g. a run refused to start: a safety stop, exit 1

@@ -33,11 +33,16 @@ ANGLE = Range(-math.pi, math.pi, "rad", label="[-pi, pi]")
 SPEED = Range(0.05, 20.0, "rad/s")
 #: Servo ids: 0..252 (253..255 are broadcast / reserved in both protocols).
 SERVO_ID = Range(0, 252)
+#: bus.voltage: the supply; 3 V (below every hobby servo's minimum) to 30 V (above the
+#: 24 V of the largest Dynamixel X).
+VOLTAGE = Range(3.0, 30.0, "V")
 
 
 @dataclass(frozen=True)
 class BusConfig:
-    """kind: "dynamixel" | "feetech"; model: servo model name; port: device; baud [bit/s]."""
+    """kind: "dynamixel" | "feetech"; model: servo model name; port: device; baud [bit/s];
+    voltage: the supply [V] (None: each servo model's nominal voltage); gains: ``[bus.gains]``,
+    register values every servo on the bus gets (robot/servo/gains.py names them)."""
 
     kind: str
     model: str
@@ -45,6 +50,8 @@ class BusConfig:
     baud: int = 1_000_000
     retries: int = field(default=2, metadata=spec(RETRIES))
     timeout_ms: float = field(default=20.0, metadata=spec(TIMEOUT_MS))
+    voltage: float | None = field(default=None, metadata=spec(VOLTAGE))
+    gains: Mapping[str, int] = field(default_factory=dict)
 
     @property
     def servo(self) -> ServoModel:
@@ -113,7 +120,8 @@ class JointConfig:
     0 rad; min_rad, max_rad: joint limits [rad]; max_speed_rad_s: slew limit [rad/s];
     model: this joint's servo model when it differs from ``bus.model`` (same family, e.g.
     stronger knees); fixed_rad: an extra joint (head pan, tilt, ...) held at this angle
-    [rad] while the gait runs (only for joints the gait does not drive).
+    [rad] while the gait runs (only for joints the gait does not drive); gains:
+    ``[joints.<name>.gains]``, register values overriding the bus's for this servo.
     """
 
     name: str
@@ -125,6 +133,7 @@ class JointConfig:
     max_speed_rad_s: float = field(metadata=spec(SPEED))
     model: str | None = None
     fixed_rad: float | None = field(default=None, metadata=spec(ANGLE))
+    gains: Mapping[str, int] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -166,6 +175,17 @@ class RobotConfig:
     def servo(self, joint: JointConfig) -> ServoModel:
         """The servo model of ``joint`` (its own ``model``, else the bus's)."""
         return MODELS[joint.model or self.bus.model]
+
+    def gains(self, joint: JointConfig) -> Mapping[str, int]:
+        """The gain registers ``joint``'s servo gets [register values]: its model's factory
+        values, overridden by ``[bus.gains]``, overridden by ``[joints.<name>.gains]``."""
+        return {**self.servo(joint).factory_gains, **self.bus.gains, **joint.gains}
+
+    def voltage(self, joint: JointConfig) -> float:
+        """The supply voltage ``joint``'s servo sees [V]: ``bus.voltage``, else its model's
+        nominal voltage."""
+        v = self.bus.voltage
+        return self.servo(joint).nominal_voltage if v is None else v
 
     @cached_property
     def layout(self) -> tuple[tuple[int, float], ...] | None:

@@ -6,10 +6,12 @@ Every error is one line: ``<file>: <field path>: <what is expected>, got <value>
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from pathlib import Path
 
 from robot.config.bundled import DEFAULT_ROBOT, resolve_robot_path
 from robot.config.checks import check_bus, check_joint_extras, check_joint_set, check_ticks
+from robot.config.gains_file import check_fits, parse_gains, split_gains
 from robot.config.imu_file import parse_imu
 from robot.config.joint_names import ARM_NAMES, JOINT_NAMES
 from robot.config.params import BALANCE, SPECS, canonical_name, check_value
@@ -40,8 +42,10 @@ def parse_robot(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> R
     if not isinstance(name, str) or not name:
         raise ConfigError(f"{src}: name: expected a non-empty string, got {show(name)}")
 
-    bus = build(BusConfig, src, "bus", data["bus"])
+    bus_tab, bus_gains = split_gains(src, "bus", data["bus"])
+    bus = build(BusConfig, src, "bus", bus_tab, overrides={"gains": {}})
     check_bus(src, bus)
+    bus = replace(bus, gains=parse_gains(src, "bus.gains", bus_gains, bus.servo))
     geometry = build(Geometry, src, "geometry", data["geometry"])
     mass = build(Masses, src, "mass", data["mass"])
 
@@ -59,9 +63,13 @@ def parse_robot(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> R
         if jn not in jtab:
             continue
         jp = f"joints.{jn}"
-        j = build(JointConfig, src, jp, jtab[jn], overrides={"name": jn})
+        joint_tab, joint_gains = split_gains(src, jp, jtab[jn])
+        j = build(JointConfig, src, jp, joint_tab, overrides={"name": jn, "gains": {}})
         check_joint_extras(src, jp, j, bus, extra=jn in extras)
-        resolution = MODELS[j.model or bus.model].resolution
+        servo = MODELS[j.model or bus.model]
+        check_fits(src, bus.gains, servo, jn)
+        j = replace(j, gains=parse_gains(src, f"{jp}.gains", joint_gains, servo))
+        resolution = servo.resolution
         if j.servo_id in seen:
             raise ConfigError(f"{src}: {jp}.servo_id: duplicate servo id {j.servo_id} "
                               f"(also joints.{seen[j.servo_id]})")

@@ -63,10 +63,10 @@ class Streamer(Generic[SourceT]):
         self.map = robot_map
         self.bus = bus
         self.source = source
-        self.rate_hz = rate_hz
-        self.dt = 1.0 / rate_hz
+        self.rate_hz, self.dt = rate_hz, 1.0 / rate_hz
         self._step = robot_map.max_speed * self.dt  # slew limit per tick [rad]
         self.read_every = min(max(1, read_every), max_read_every(rate_hz))  # inputs refuse more
+        bus.check_rate(rate_hz, read_every=self.read_every)   # before anything moves
         self.clock: Clock = clock or getattr(bus, "clock", None) or MonotonicClock()
         self.hold_at_end = hold_at_end
         self.watchdog_config = watchdog or WatchdogConfig()
@@ -135,8 +135,8 @@ class Streamer(Generic[SourceT]):
             self.bus.write_goals(self.map.goals(q0.tolist()))  # no snap to a stale goal
             self.bus.set_torque(ids, enabled=True)
             self._q_last = q0
-            self._pacer.start()
             arm_failsafe(self.bus, ids, self.watchdog_config.failsafe_s, dt=self.dt)
+            self._pacer.start()               # after arming: its packets take wire time
             self._stream(seconds)
         except SafetyStop as e:                  # the watchdog: unsafe or impossible to drive
             self._bus_dead = isinstance(e, BusDead)

@@ -147,9 +147,6 @@ PLOTS = {  # name: (suffix, text from the record's header, needle)
             "expected a number or a word, got a NUL byte"),
     "huge field": (".csv", lambda h: csv_text(h, [["1" * 200_000]] * 3),
                    "field larger than field limit"),
-    "20 columns": (".csv", lambda h: csv_text(["t"] + [f"cmd_j{i}" for i in range(19)],
-                                              [["0.1"] * 20] * 3),
-                   "without its 'period_error_ms' column"),
     "nested JSON": (".jsonl", lambda h: '{"t": 0.0, "cmd_r_knee": {"a": [1]}}\n' * 3,
                     "column 'cmd_r_knee': expected a number or a word, got a nested dict"),
     "not objects": (".jsonl", lambda h: "[1, 2]\n" * 3,
@@ -170,6 +167,20 @@ def test_plot_of_a_file_that_is_not_a_record(case: str, record_header: list[str]
                            monkeypatch)
     assert_refused(code, err, f"{path}: ", needle)
     assert not (tmp_path / "o.png").exists()
+
+
+def test_plot_of_a_20_column_record_is_a_picture(tmp_path: Path,
+                                                capsys: pytest.CaptureFixture[str],
+                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    """t and 19 commanded joints, nothing else (no timing, no read-back): a traceback in
+    the issue; a record plots what it has."""
+    path = tmp_path / "wide.csv"
+    path.write_text(csv_text(["t"] + [f"cmd_j{i}" for i in range(19)],
+                             [[f"{0.1 * k:g}"] * 20 for k in range(3)]))
+    code, out, err = run_cli(["plot", str(path), "--out", str(tmp_path / "o.png")], capsys,
+                             monkeypatch)
+    assert code == 0 and "Traceback" not in err, err
+    assert (tmp_path / "o.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 # ------------------------------------------------------------------------------ full disk

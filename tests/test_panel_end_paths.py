@@ -131,8 +131,8 @@ def test_bus_dies_under_the_panel(emu: Emulator, robot: RobotConfig, robot_toml:
     last = out.splitlines()[-1]
     assert code == 1, out
     assert "torque NOT confirmed off" in last and not last.endswith("torque off"), last
-    regs = [emu.registers(i) for i in robot.ids]
-    assert {r["bus_watchdog"] for r in regs} == {-1}            # tripped: stopped
+    assert wait_for(lambda: {emu.registers(i)["bus_watchdog"] for i in robot.ids} == {-1})
+    regs = [emu.registers(i) for i in robot.ids]                # tripped: stopped
     assert {r["torque_enable"] for r in regs} == {1}            # unreachable: still on
 
 

@@ -15,7 +15,6 @@ import argparse
 import logging
 import os
 import secrets
-import signal
 import time
 from pathlib import Path
 from typing import Any
@@ -27,7 +26,7 @@ from robot.panel.controller import BusSpec, LoopOptions, PanelController
 from robot.panel.presets import PresetStore, user_presets_dir
 from robot.panel.server import build_server, is_loopback, panel_url, serve_in_thread
 from robot.panel.studio import Studio, user_data_dir
-from robot.run.signals import SIGNALS, SignalLatch
+from robot.run.signals import stop_on_signals
 
 log = logging.getLogger(__name__)
 
@@ -77,16 +76,6 @@ class _Deferred:
 
     def emergency_stop(self, reason: str = "") -> None:
         self.stop = self.abort = True
-
-
-def _route_signals(target: _Deferred, latch: SignalLatch) -> None:
-    """SIGINT/SIGTERM → ``latch`` (first: safe stop, second: stop at once) for the rest of
-    the process's life: a signal that comes while the panel is already closing is
-    recorded, never the default action (the exit code stays 128 + the first one's)."""
-    def handler(signum: int, _frame: Any) -> None:
-        latch.handle(target, signum)
-    for s in SIGNALS:
-        signal.signal(s, handler)
 
 
 #: How much lower this process's CPU priority is than the loop process's (nice units).
@@ -139,41 +128,41 @@ def run(args: argparse.Namespace) -> int:
     studio_dir = Path(args.studio_dir) if args.studio_dir else user_data_dir()
     studio = Studio(controller, takes_dir=studio_dir / "takes",
                     keys_dir=studio_dir / "keyframes")
-    signals, latch = _Deferred(), SignalLatch()
-    _route_signals(signals, latch)
+    signals = _Deferred()
     server = None
     report: dict[str, Any] = {}
-    try:
-        controller.open()                 # the loop process, the bus open: or one line
-        _give_way()
+    with stop_on_signals(signals) as latch:   # to the end: a signal is never an exception
         try:
-            server = build_server(controller, host=args.host, port=args.http_port,
-                                  token=token, studio=studio)
-        except OSError as e:
-            raise ConfigError(f"--http-port {args.http_port}: cannot serve on {args.host}: "
-                              f"{e.strerror or e}") from e
-        _, local = serve_in_thread(server)
-        query = f"?token={token}" if token else ""
-        url = panel_url(args.host, int(server.server_address[1]))
-        also = f" (this machine: {local}{query})" if url != local else ""
-        print(f"biped panel: {robot.name} on the {kind} bus at {args.rate:g} Hz; open "
-              f"{url}{query}{also}", flush=True)
-        if token and not args.token:
-            print(f"biped panel: access token {token}", flush=True)
-        if not args.no_start and not signals.stop:
-            controller.start()
-        while not signals.stop and controller.loop.gone is None:
-            time.sleep(0.1)
-        if controller.loop.gone is not None:
-            log.error("%s", controller.loop.gone)
-        end = "hold" if args.hold else "torque off"
-        print(f"biped panel: stopping (ramp out, rest, {end}; again: torque off now)",
-              flush=True)
-    finally:
-        report = controller.shutdown(abort=lambda: signals.abort)  # first: a second
-        if server is not None:                                    # signal acts at once
-            server.shutdown()
-            server.server_close()
-    line, safe = _farewell(report, aborted=signals.abort)
-    print(f"biped panel: stopped; {line}", flush=True)
+            controller.open()             # the loop process, the bus open: or one line
+            _give_way()
+            try:
+                server = build_server(controller, host=args.host, port=args.http_port,
+                                      token=token, studio=studio)
+            except OSError as e:
+                raise ConfigError(f"--http-port {args.http_port}: cannot serve on "
+                                  f"{args.host}: {e.strerror or e}") from e
+            _, local = serve_in_thread(server)
+            query = f"?token={token}" if token else ""
+            url = panel_url(args.host, int(server.server_address[1]))
+            also = f" (this machine: {local}{query})" if url != local else ""
+            print(f"biped panel: {robot.name} on the {kind} bus at {args.rate:g} Hz; open "
+                  f"{url}{query}{also}", flush=True)
+            if token and not args.token:
+                print(f"biped panel: access token {token}", flush=True)
+            if not args.no_start and not signals.stop:
+                controller.start()
+            while not signals.stop and controller.loop.gone is None:
+                time.sleep(0.1)
+            if controller.loop.gone is not None:
+                log.error("%s", controller.loop.gone)
+            end = "hold" if args.hold else "torque off"
+            print(f"biped panel: stopping (ramp out, rest, {end}; again: torque off now)",
+                  flush=True)
+        finally:
+            report = controller.shutdown(abort=lambda: signals.abort)  # first: a second
+            if server is not None:                                    # signal acts at once
+                server.shutdown()
+                server.server_close()
+        line, safe = _farewell(report, aborted=signals.abort)
+        print(f"biped panel: stopped; {line}", flush=True)
     return latch.exit_code(None) if safe else 1

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from robot.bus.lease import BusBusy
-from robot.errors import BipedError, ConfigError
+from robot.errors import BipedError, BusError, ConfigError
 from robot.panel.options import HostSpec, PanelStateError
 
 log = logging.getLogger(__name__)
@@ -46,6 +46,7 @@ def _encode(result: object) -> tuple[str, Any]:
         return "ok", result
     kind = ("conflict" if isinstance(result, (BusBusy, PanelStateError)) else
             "config" if isinstance(result, ConfigError) else
+            "bus" if isinstance(result, BusError) else
             "biped" if isinstance(result, BipedError) else "internal")
     return kind, str(result) if kind != "internal" else f"{type(result).__name__}: {result}"
 
@@ -57,6 +58,8 @@ def _decode(kind: str, payload: Any) -> Any:
         raise PanelStateError(payload)
     if kind == "config":
         raise ConfigError(payload)
+    if kind == "bus":
+        raise BusError(payload)
     if kind == "biped":
         raise BipedError(payload)
     raise RuntimeError(f"the control loop failed: {payload}")
@@ -210,8 +213,9 @@ def child_main(fd: int) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     conn = Connection(fd)
     spec, level = conn.recv()
-    logging.basicConfig(level=level, stream=sys.stderr,
-                        format="%(levelname)s %(name)s: %(message)s")
+    logging.basicConfig(level=level, stream=sys.stderr,  # as robot.cli writes its own
+                        format=("%(levelname)s %(name)s: %(message)s"
+                                if level <= logging.DEBUG else "%(levelname)s: %(message)s"))
     sys.setswitchinterval(0.0005)  # the loop thread gets the interpreter back quickly
     host = LoopHost(spec)
     try:

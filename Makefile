@@ -36,7 +36,8 @@ unit: $(STAMP) system-deps
 
 # The wheel, installed (not editable) into a fresh venv and run from a directory outside
 # the checkout: proves the package ships everything it needs (configs, panel files, the
-# sim bus entry point), and that a user can copy a bundled robot file to start from. Dependencies come from pip's cache or the registry.
+# sim bus entry point), and that a user can copy a bundled robot file to start from.
+# Dependencies come from pip's cache or the registry.
 wheel-check: $(STAMP)
 	@set -eu; tmp=$$(mktemp -d); trap 'rm -rf "$$tmp"' EXIT; start=$$(date +%s); \
 	rm -rf build; \

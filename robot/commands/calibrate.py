@@ -134,8 +134,8 @@ def _limits(bus: Bus, robot: RobotConfig, zeros: dict[str, int], signs: dict[str
                     "press Enter ")
                 ends.append(_position(bus, j))
             span = abs(wrapped_delta(ends[0], ends[1], res)) / per_rad
-            lo, hi = limits_from_ends(ends[0], ends[1], zero=zeros[j.name], sign=sign, resolution=res,
-                                      servo_limits=servo_limits,
+            lo, hi = limits_from_ends(ends[0], ends[1], zero=zeros[j.name], sign=sign,
+                                      resolution=res, servo_limits=servo_limits,
                                       ticks_per_rad=per_rad)
             if span >= MOVE_THRESHOLD_RAD and lo < hi:
                 out[j.name] = (lo, hi)

@@ -158,7 +158,7 @@ def test_a_used_servo_is_found_on_every_bus_kind(kind: str, tmp_path: Path,
             emu.set_register(sid, "baud_rate", codes[baud])
         assert setup(emu, toml, "--joint", joint.name, "--yes") == 0, capsys.readouterr().err
         out = capsys.readouterr().out
-        assert f"found a {robot.bus.model} at id {sid}, {baud} baud" in out
+        assert f"found: {robot.bus.model} at id {sid}, {baud} baud" in out
         regs = emu.registers_of(0)
         assert regs["id"] == 5
         if family in BAUD_CODES:

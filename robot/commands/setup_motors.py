@@ -85,7 +85,7 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
                     return 1
             found = find_servo(bus, robot, progress=lambda m: print(f"  {m}", flush=True))
             check_model(found, robot, joint)
-            print(f"  found a {robot.bus.model} at id {found.id}, {found.baud} baud")
+            print(f"  found: {robot.bus.model} at id {found.id}, {found.baud} baud")
             changes = assign(bus, found, joint, robot)
             done = "; ".join(changes) if changes else "already set, nothing changed"
             print(f"{joint.name}: id {joint.servo_id} at {robot.bus.baud} baud, checked "

@@ -22,8 +22,12 @@ from robot.motion.posing import PoseMove
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    p = subparsers.add_parser("torque", help="enable or disable torque on every joint",
-                              description=__doc__)
+    p = subparsers.add_parser(
+        "torque", help="enable or disable torque on every joint",
+        description="Turn torque on, holding the present position (on), or release every "
+                    "joint (off). 'on' refuses, with torque untouched, if a joint is outside "
+                    "its limits; otherwise each servo's goal becomes its present position "
+                    "before torque comes on, so nothing moves.")
     p.add_argument("state", choices=("on", "off"))
     add_robot_args(p, gait=False)
     add_bus_args(p)

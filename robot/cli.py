@@ -38,6 +38,7 @@ COMMANDS: tuple[str, ...] = (
     "monitor",
     "robustness",
     "tune",
+    "identify",
 )
 
 

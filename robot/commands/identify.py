@@ -45,6 +45,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
                      help=f"parameters to fit (default: all but max_velocity and kd_scale; "
                           f"valid: {', '.join(FITTED)})")
     fit.add_argument("--seed", type=int, default=0, help="sampler seed (default 0)")
+    fit.add_argument("--keep-stall", action="store_true",
+                     help="keep the model's stall torque (the resistance follows kt): for "
+                          "logs that never drive the servo to full duty")
     check = one_line_errors(sub.add_parser("check", help="replay logs in the servo model"))
     check.add_argument("logs", nargs="+", metavar="LOG", help="pendulum logs (.json, .json.gz)")
     check.add_argument("--model", required=True, metavar="NAME|FILE",
@@ -124,7 +127,8 @@ def _fit(args: argparse.Namespace) -> int:
     print(f"fitting {', '.join(params)} of {args.motor} on {len(train)} logs "
           f"({len(held)} held out), {args.trials} trials ...")
     result = fit_physics(train, MODELS[args.motor], start, params=params, trials=args.trials,
-                         seed=args.seed, offset=args.offset, source=source)
+                         seed=args.seed, offset=args.offset, keep_stall=args.keep_stall,
+                         source=source)
     train_err = _errors(train, result.physics, args.offset)
     held_err = _errors(held, result.physics, args.offset) if held else []
     fit = {"train_error_rad": sum(train_err) / len(train_err), "trials": result.trials,

@@ -72,7 +72,7 @@ def load_servo_file(path: str | Path) -> ServoPhysics:
 
 def _toml(value: object) -> str:
     if isinstance(value, float):
-        return "inf" if value == math.inf else repr(value)
+        return repr(value)
     if isinstance(value, (list, tuple)):
         return "[" + ", ".join(_toml(v) for v in value) + "]"
     return json.dumps(value) if isinstance(value, str) else repr(value)
@@ -83,7 +83,8 @@ def servo_file_text(physics: ServoPhysics, *, fit: Mapping[str, object] | None =
     """The TOML text of a model file for ``physics`` (``fit``: the [fit] table)."""
     lines = [f"# {line}" for line in comment.splitlines()]
     lines += [f"model = {_toml(physics.name)}", f"law = {_toml(physics.law)}"]
-    lines += [f"{name} = {_toml(float(getattr(physics, name)))}" for name in _NUMBERS]
+    lines += [f"{name} = {_toml(float(getattr(physics, name)))}" for name in _NUMBERS
+              if math.isfinite(getattr(physics, name))]   # max_velocity inf: no limit
     lines += ["", "[sources]"]
     lines += [f"{k} = {_toml(v)}" for k, v in physics.sources.items()]
     if fit:

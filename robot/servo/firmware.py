@@ -117,6 +117,7 @@ LOG_GAIN_REGISTERS: dict[str, tuple[str, ...]] = {
 }
 
 
-def log_gains(physics: ServoPhysics, kp: int) -> dict[str, int]:
-    """The gain registers a pendulum log's ``kp`` stands for (the others at 0)."""
-    return dict.fromkeys(LOG_GAIN_REGISTERS[physics.law], kp)
+def log_gains(model: ServoModel, physics: ServoPhysics, kp: int) -> dict[str, int]:
+    """The gain registers during a pendulum log: the model's factory values with the
+    register the log's ``kp`` names set to it."""
+    return {**model.factory_gains, **dict.fromkeys(LOG_GAIN_REGISTERS[physics.law], kp)}

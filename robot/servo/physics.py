@@ -101,18 +101,20 @@ def from_datasheet(name: str, law: str, *, stall_torque: float, no_load_speed: f
                    voltage: float, max_duty: float = 1.0, friction_share: float,
                    viscous_share: float, tau_s: float, note: str) -> ServoPhysics:
     """A model from a datasheet's stall torque [N m] and no-load speed [rad/s] at
-    ``voltage`` [V]: b = stall / speed = kt^2/R and stall = kt V d / R give kt and R;
-    Coulomb friction is ``friction_share`` of the stall torque and viscous friction
-    ``viscous_share`` of b (shares carried over from an identified servo, named in
-    ``note``); the armature is b times a mechanical time constant ``tau_s`` [s]."""
-    b = stall_torque / no_load_speed
+    ``voltage`` [V]. Coulomb friction is ``friction_share`` of the stall torque and viscous
+    friction ``viscous_share`` of b = kt^2/R (shares carried over from an identified servo,
+    named in ``note``); the no-load speed is where the drive meets them,
+    stall (1 - friction_share) = b (1 + viscous_share) speed, which gives b; stall =
+    kt V d / R and b = kt^2 / R then give kt and R. The armature is b times a mechanical
+    time constant ``tau_s`` [s]."""
+    b = stall_torque * (1 - friction_share) / ((1 + viscous_share) * no_load_speed)
     kt = b * voltage * max_duty / stall_torque
     sheet = f"datasheet: {stall_torque:.3g} N m stall, {no_load_speed:.3g} rad/s at {voltage:g} V"
     return ServoPhysics(
         name=name, law=law, kt=kt, resistance=kt * kt / b, armature=b * tau_s,
         coulomb=friction_share * stall_torque, viscous=viscous_share * b,
         nominal_voltage=voltage, max_duty=max_duty,
-        sources={"kt": f"{sheet} (kt = b V d / stall, b = stall / speed)",
+        sources={"kt": f"{sheet} (kt = b V d / stall, b from the no-load speed)",
                  "resistance": f"{sheet} (R = kt^2 / b)",
                  "armature": f"estimate: b x {tau_s * 1000:g} ms mechanical time constant",
                  "coulomb": f"{friction_share:.3g} x stall torque, {note}",

@@ -23,6 +23,7 @@ from robot.servo.physics import ServoPhysics, from_datasheet
 _BAM_STS3215 = "Rhoban/bam bam/params/feetech_sts3215_7_4V/m1.json (identified, 7.4 V)"
 _BAM_STS3215_12V = "Rhoban/bam params/feetech_sts3215_12V/m1.json (identified, 12 V)"
 _BAM_MX64 = "Rhoban/bam bam/params/mx64/m1.json (identified MX-64)"
+_BAM_XL330 = "Rhoban/bam bam/params/xl330/m1.json at 96001ff (identified, 7.4 V)"
 
 
 
@@ -38,8 +39,10 @@ class Shares(NamedTuple):
 
 
 
-#: XL330-M288: this project's fit (robot/configs/servos/XL330-M288.toml) at 7.4 V.
-X_SHARES = Shares(0.045, 0.2, 0.025, "shares of the identified XL330-M288 (robot/configs/servos)")
+#: XL330-M288, this project's fit (robot/configs/servos/XL330-M288.toml) at 7.4 V: Coulomb
+#: 0.0182 N m of 0.794 N m stall; viscous 0.0123 of kt^2/R 0.0246; armature 0.00150 / 0.0246.
+#: Its Stribeck and load terms are not carried (a datasheet model stays Coulomb-viscous).
+X_SHARES = Shares(0.023, 0.50, 0.061, "shares of the identified XL330-M288 (robot/configs/servos)")
 #: MX-64 (bam): 0.0904 N m of 5.90 N m stall at 15 V; 0.0117 of 0.666; 0.01195 / 0.666.
 MX_SHARES = Shares(0.0153, 0.0176, 0.018, "shares of " + _BAM_MX64)
 #: STS3215 (bam, 7.4 V): 0.0524 N m of 3.25 N m stall; 0.0591 of 0.549; 0.0284 / 0.549.
@@ -68,11 +71,28 @@ _STS3215 = ServoPhysics(
              "stribeck": "none (bam M1 model)", "stribeck_speed": "unused",
              "load_friction": "none (bam M1 model)"})
 
+#: Rhoban/bam's XL330 M1 (Coulomb-viscous): the start of this project's fit, which ships as
+#: robot/configs/servos/XL330-M288.toml and replaces it (robot.config.servo_file).
+_XL330 = ServoPhysics(
+    name="XL330-M288", law="dynamixel_x", kt=0.3866957639281311, resistance=4.017129222290597,
+    armature=0.0018141672784458866, coulomb=0.01283272036582759, viscous=0.003661672282824312,
+    nominal_voltage=7.4, gain_scale=0.5,
+    sources={"kt": _BAM_XL330, "resistance": _BAM_XL330, "armature": _BAM_XL330,
+             "coulomb": _BAM_XL330, "viscous": _BAM_XL330,
+             "nominal_voltage": "the recordings' supply (7.4 V; the datasheet's is 5 V)",
+             "max_duty": "e-Manual: PWM Limit 885 = 100 %",
+             # Present PWM is P / 256 of the error in pulses: half the manual's P / 128
+             "gain_scale": "the XL330 recordings' Present PWM: P / 256 "
+                           "(tests/test_servo_model.py checks it on the logs)",
+             "kd_scale": "the manual's register scale (no recordings)",
+             "stribeck": "none (bam M1)", "stribeck_speed": "unused",
+             "load_friction": "none (bam M1)", "max_velocity": "none: Profile Velocity 0"})
+
 PHYSICS: dict[str, ServoPhysics] = {
     "XL430-W250": _sheet("XL430-W250", X_SHARES),
     "XM430-W350": _sheet("XM430-W350", X_SHARES),
     "XC430-W150": _sheet("XC430-W150", X_SHARES),
-    "XL330-M288": _sheet("XL330-M288", X_SHARES),
+    "XL330-M288": _XL330,
     "AX-12A": _sheet("AX-12A", MX_SHARES),
     "AX-18A": _sheet("AX-18A", MX_SHARES),
     "MX-28": _sheet("MX-28", MX_SHARES),

@@ -34,7 +34,7 @@ from robot.errors import BusError
 from sim.mujoco.mjcf import FOOT_GEOMS, build_mjcf, standing_qpos
 from sim.mujoco.observation import BodyObservation
 from sim.mujoco.run_watch import SimRunWatch
-from sim.mujoco.servo_law import Firmware, robot_servos
+from sim.mujoco.servo_law import ChainLaw, robot_servos
 from sim.mujoco.servos import AMBIENT_C, SimServos
 from sim.mujoco.view import OffscreenRenderer, SimClock, WallPacer, check_display, launch_viewer
 from sim.mujoco.world import PUSH_WINDOW_S, TimedForces
@@ -105,10 +105,9 @@ class MujocoBus(BodyObservation, Bus):
         names = self.robot.joint_names
         self._qadr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names])
         self._act = np.array([model.actuator(n).id for n in names])
-        self._dof = np.array([model.jnt_dofadr[model.joint(n).id] for n in names])
-        law = self._law = robot_servos(self.robot)
-        law.install(model, self._act, self._dof)
-        self._firmware = Firmware(law, data.qpos[self._qadr])
+        dof = np.array([model.jnt_dofadr[model.joint(n).id] for n in names])
+        law = robot_servos(self.robot)
+        self._law = ChainLaw(model, data, law, self._act, dof, self._qadr)
         self._ground = np.flatnonzero((model.geom_bodyid == 0)
                                       & ((model.geom_contype | model.geom_conaffinity) != 0))
         self._feet = tuple(model.geom(n).id for n in FOOT_GEOMS)
@@ -200,10 +199,7 @@ class MujocoBus(BodyObservation, Bus):
 
     def set_torque(self, ids: Iterable[int], *, enabled: bool) -> None:
         idx = self._indices(ids)
-        present = self.data.qpos[self._qadr]
-        self._servos.set_torque(idx, enabled, present)
-        if enabled:
-            self._firmware.reset(present, np.array(idx, dtype=np.intp))
+        self._servos.set_torque(idx, enabled, self.data.qpos[self._qadr])
         self._apply_torque()
 
     def write_goals(self, goals: Mapping[int, int]) -> None:
@@ -225,7 +221,7 @@ class MujocoBus(BodyObservation, Bus):
         load = servos.load_percent(force).tolist()
         temperature = servos.temperature.tolist()
         overloaded = servos.overloaded().tolist()
-        volts = self.robot.bus.servo.nominal_voltage
+        volts = self.robot.voltage(self.robot.joints[0])   # one supply for the bus
         sids = self.servo_map.ids
         return {sids[i]: ServoState(id=sids[i], position=ticks[i], load=load[i],
                                     temperature=temperature[i], voltage=volts,
@@ -241,18 +237,7 @@ class MujocoBus(BodyObservation, Bus):
         return np.rint(sm.zero + sm.sign * q * sm.ticks_per_rad).astype(np.int64)
 
     def _apply_torque(self) -> None:
-        self._law.set_torque(self.model, self._act, self._dof, self._servos.enabled)
-
-    def _control_tick(self, span: float) -> None:
-        """Once per control tick of ``span`` [s]: the load-dependent friction from the state
-        now, and the ctrl where the law depends on the position (dead band, I term)."""
-        m, d, law = self.model, self.data, self._law
-        if law.variable_friction:
-            m.dof_frictionloss[self._dof] = law.friction(
-                d.qvel[self._dof], d.actuator_force[self._act], self._servos.enabled)
-        if self._firmware.shapes:
-            d.ctrl[self._act] = self._firmware.shape(self._servos.setpoint,
-                                                     d.qpos[self._qadr], span)
+        self._law.set_torque(self._servos.enabled)
 
     def advance(self, deadline: float) -> None:
         """Step the physics until data.time == deadline [s] exactly (a last partial step
@@ -262,7 +247,7 @@ class MujocoBus(BodyObservation, Bus):
         t0 = float(d.time)
         if deadline <= t0:
             return
-        self._control_tick(deadline - t0)
+        self._law.tick(self._servos.setpoint, deadline - t0)
         while (event := self._next_event()) < deadline - _TIME_EPS:
             if event > d.time:
                 self._physics_to(event)
@@ -304,9 +289,7 @@ class MujocoBus(BodyObservation, Bus):
         m, d, opt, servos, dt = self.model, self.data, self._opt, self._servos, self._dt
         while (remaining := stop - d.time) > _TIME_EPS:
             if not servos.settled:
-                setpoint = servos.slew(min(dt, remaining))
-                d.ctrl[self._act] = (self._firmware.shape(setpoint, d.qpos[self._qadr], 0.0)
-                                     if self._firmware.shapes else setpoint)
+                d.ctrl[self._act] = self._law.ctrl(servos.slew(min(dt, remaining)))
             if remaining < dt:
                 opt.timestep = remaining
                 try:

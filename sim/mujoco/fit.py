@@ -54,15 +54,20 @@ def _clip(name: str, value: float) -> float:
 
 def fit_physics(logs: Sequence[PendulumLog], servo: ServoModel, start: ServoPhysics, *,
                 params: Sequence[str] = DEFAULT_PARAMS, trials: int = 800, seed: int = 0,
-                offset: float = 0.0, fit_offset: bool = False, source: str = "fitted",
+                offset: float = 0.0, fit_offset: bool = False, keep_stall: bool = False,
+                source: str = "fitted",
                 progress: Callable[[int, float], None] | None = None) -> FitResult:
     """Fit ``params`` of ``start`` to ``logs`` with the rig at ``offset`` [rad] (or the
     offset fitted too, with ``fit_offset``): about ``trials``
     CMA-ES evaluations from ``seed``, a generation at a time (every candidate of a
-    generation replays in one MuJoCo model). Each fitted value is sourced as ``source``."""
+    generation replays in one MuJoCo model). Each fitted value is sourced as ``source``.
+    ``keep_stall``: the resistance follows kt so that the stall torque stays the start's
+    (for logs that never saturate the servo, which cannot tell it)."""
     unknown = sorted(set(params) - set(BOUNDS))
     if unknown:
         raise ValueError(f"cannot fit {unknown[0]}; valid: {', '.join(BOUNDS)}")
+    if keep_stall:
+        params = [p for p in params if p != "resistance"]
     dims = len(params) + fit_offset
     popsize = 4 + int(3 * math.log(dims))
     bench = PendulumBench(logs, servo, copies=popsize)
@@ -70,8 +75,13 @@ def fit_physics(logs: Sequence[PendulumLog], servo: ServoModel, start: ServoPhys
     if fit_offset:
         x0["offset"] = 0.0
 
+    stall = start.kt / start.resistance   # [N m / (V duty)]
+
     def physics_of(x: Mapping[str, float]) -> ServoPhysics:
-        return start.with_values({k: math.exp(x[k]) for k in params}, source=source)
+        values = {k: math.exp(x[k]) for k in params}
+        if keep_stall:
+            values["resistance"] = values.get("kt", start.kt) / stall
+        return start.with_values(values, source=source)
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     with warnings.catch_warnings():   # x0 / sigma0: deprecated in 4.9, kept until 6.0

@@ -133,3 +133,39 @@ class Firmware:
             self.integral += (target - q) * dt
             out = out + a.ki_over_kp * self.integral
         return out
+
+
+class ChainLaw:
+    """The law installed in one MuJoCo model for a chain of servos: actuators ``act``
+    driving dofs ``dof`` whose positions are ``qpos[qadr]``; the torque starts off."""
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, arrays: ServoArrays,
+                 act: Ints, dof: Ints, qadr: Ints) -> None:
+        self.model, self.data, self.arrays = model, data, arrays
+        self.act, self.dof, self.qadr = act, dof, qadr
+        arrays.install(model, act, dof)
+        self.firmware = Firmware(arrays, data.qpos[qadr])
+        self.enabled = np.zeros(len(act), dtype=bool)
+
+    def set_torque(self, enabled: npt.NDArray[np.bool_]) -> None:
+        """Torque per servo; a servo turned on restarts its I term at the present position."""
+        turned_on = enabled & ~self.enabled
+        if turned_on.any():
+            self.firmware.reset(self.data.qpos[self.qadr], turned_on)
+        self.enabled = enabled.copy()
+        self.arrays.set_torque(self.model, self.act, self.dof, self.enabled)
+
+    def ctrl(self, setpoint: Floats, span: float = 0.0) -> Floats:
+        """The actuators' ctrl for ``setpoint`` [rad], the I term integrated over ``span``."""
+        f = self.firmware
+        return f.shape(setpoint, self.data.qpos[self.qadr], span) if f.shapes else setpoint
+
+    def tick(self, setpoint: Floats, span: float) -> None:
+        """Once per control tick of ``span`` [s]: the state-dependent friction from the
+        state now, and the ctrl where the law depends on the position."""
+        m, d, a = self.model, self.data, self.arrays
+        if a.variable_friction:
+            m.dof_frictionloss[self.dof] = a.friction(d.qvel[self.dof], d.actuator_force[self.act],
+                                                      self.enabled)
+        if self.firmware.shapes:
+            d.ctrl[self.act] = self.ctrl(setpoint, span)

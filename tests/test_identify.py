@@ -18,11 +18,10 @@ import numpy as np
 import pytest
 
 from robot import cli
-from robot.config.servo_file import load_servo_file, servo_file_text
+from robot.config.servo_file import load_servo_file, physics_for, servo_file_text
 from robot.servo.models import MODELS
 from robot.servo.pendulum_log import PendulumLog, read_log, split_logs, write_log
-from robot.servo.physics import ServoPhysics
-from robot.servo.physics_table import PHYSICS
+from robot.servo.physics import ServoPhysics, from_datasheet
 from sim.mujoco.fit import fit_physics
 from sim.mujoco.pendulum import PendulumBench
 
@@ -56,8 +55,12 @@ def test_the_datasheet_model_misses_the_xl330_recordings_by_far(
     gets) predicts the XL330 logs much worse than the identified one."""
     _, held = split_logs(sorted((DATA / "xl330").glob("*.json.gz")), 0.25)
     identified = _check(capsys, held, "XL330-M288")["mean_error_rad"]
+    m = MODELS["XL330-M288"]
+    unidentified = from_datasheet(m.name, m.gain_set, stall_torque=m.stall_torque,
+                                  no_load_speed=m.no_load_speed, voltage=m.nominal_voltage,
+                                  friction_share=0.02, viscous_share=0.1, tau_s=0.03, note="")
     sheet = tmp_path / "sheet.toml"
-    sheet.write_text(servo_file_text(PHYSICS["XL330-M288"]))
+    sheet.write_text(servo_file_text(unidentified))
     datasheet = _check(capsys, held, str(sheet))["mean_error_rad"]
     assert datasheet > 2 * identified   # type: ignore[operator]
 
@@ -101,7 +104,7 @@ def test_fit_recovers_the_parameters_of_the_model_that_made_the_logs(tmp_path: P
 
 def test_fit_command_writes_a_model_file_a_robot_can_name(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    truth = replace(PHYSICS["XL330-M288"], gain_scale=0.5)
+    truth = physics_for("XL330-M288")      # the fit starts from the bundled model
     logs = _synthetic_logs(truth, tmp_path)
     out = tmp_path / "fitted.toml"
     assert cli.main(["identify", "fit", *map(str, logs), "--motor", "XL330-M288",

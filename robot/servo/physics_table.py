@@ -39,10 +39,11 @@ class Shares(NamedTuple):
 
 
 
-#: XL330-M288, this project's fit (robot/configs/servos/XL330-M288.toml) at 7.4 V: Coulomb
-#: 0.0182 N m of 0.794 N m stall; viscous 0.0123 of kt^2/R 0.0246; armature 0.00150 / 0.0246.
-#: Its Stribeck and load terms are not carried (a datasheet model stays Coulomb-viscous).
-X_SHARES = Shares(0.023, 0.50, 0.061, "shares of the identified XL330-M288 (robot/configs/servos)")
+#: XL330-M288, this project's fit (robot/configs/servos/XL330-M288.toml) at 7.4 V: static
+#: friction (Coulomb + Stribeck) 0.0120 N m of 0.759 N m stall; viscous 0.0142 of kt^2/R
+#: 0.0250; armature 0.00158 / 0.0250. Its load term is not carried (a datasheet model stays
+#: Coulomb-viscous).
+X_SHARES = Shares(0.016, 0.57, 0.063, "shares of the identified XL330-M288 (robot/configs/servos)")
 #: MX-64 (bam): 0.0904 N m of 5.90 N m stall at 15 V; 0.0117 of 0.666; 0.01195 / 0.666.
 MX_SHARES = Shares(0.0153, 0.0176, 0.018, "shares of " + _BAM_MX64)
 #: STS3215 (bam, 7.4 V): 0.0524 N m of 3.25 N m stall; 0.0591 of 0.549; 0.0284 / 0.549.

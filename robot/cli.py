@@ -22,6 +22,7 @@ COMMANDS: tuple[str, ...] = (
     "play",
     "capture",
     "export",
+    "import_",
     "curves",
     "scan",
     "torque",
@@ -72,7 +73,9 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as e:   # --help (0) or a refused option (2, one line on stderr)
         return e.code if isinstance(e.code, int) else 2
     logging.basicConfig(level=getattr(logging, args.log_level), stream=sys.stderr,
-                        format="%(levelname)s %(name)s: %(message)s")
+                        # the logger's name only when debugging: a user reads the message
+                        format=("%(levelname)s %(name)s: %(message)s"
+                                if args.log_level == "DEBUG" else "%(levelname)s: %(message)s"))
     try:
         return int(args._run(args) or 0)
     except SafetyStop as e:   # e.g. a run refused to start: a safety stop, exit 1

@@ -31,6 +31,15 @@ def only_bus_commands(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(cli, "COMMANDS", ("scan", "torque", "pose"))
 
 
+#: Goal Position address, from the manuals (XL430-W250 116; STS3215 42).
+GOAL_ADDRESS = {"dynamixel": 116, "feetech": 42}
+
+
+def goal_writes(emu: Emulator) -> list:
+    return [p for p in emu.log() if p.instruction == "sync_write"
+            and p.address == GOAL_ADDRESS[emu.protocol]]
+
+
 def bus_args(emu: Emulator, robot_toml: Path) -> list[str]:
     return ["--bus", emu.protocol, "--port", emu.port, "--robot", str(robot_toml)]
 
@@ -47,10 +56,11 @@ def test_scan_json_is_a_clean_list(emu: Emulator, robot: RobotConfig, robot_toml
 def test_scan_table_names_missing_joints(emu: Emulator, robot_toml: Path,
                                          capsys: pytest.CaptureFixture[str]) -> None:
     emu.set_faults(missing_ids=[7, 12])
-    assert cli.main(["scan", *bus_args(emu, robot_toml)]) == 0
+    assert cli.main(["scan", *bus_args(emu, robot_toml)]) == 1    # incomplete: exit 1
     out = capsys.readouterr().out
     assert "16 servo(s)" in out
-    assert "missing joints: l_hip_yaw (id 7), l_ankle_roll (id 12)" in out
+    assert "missing joints (2 of 18; exit status 1): l_hip_yaw (id 7), l_ankle_roll (id 12)" \
+        in out
 
 
 def test_scan_at_wrong_baud_names_the_rate(emu: Emulator, robot_toml: Path,
@@ -82,7 +92,7 @@ def test_pose_rest_ramps_within_slew_and_ends_at_rest(
     assert cli.main(["pose", "rest", *bus_args(emu, robot_toml), "--speed", str(speed),
                      "--rate", str(rate)]) == 0
     assert "torque left ON" in capsys.readouterr().out
-    writes = [p for p in emu.log() if p.instruction == "sync_write"]
+    writes = goal_writes(emu)      # (torque on also sync-writes the gains first)
     assert len(writes) > 20
     ticks = np.array([[p.values[i] for i in robot.ids] for p in writes])
     assert np.array_equal(ticks[0], [2048] * len(robot.ids))  # starts where it stood
@@ -102,7 +112,7 @@ def test_pose_ctrl_c_stops_and_holds(emu: Emulator, robot: RobotConfig,
     proc = subprocess.Popen(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env={**os.environ, "MUJOCO_GL": "egl"})
     def knee_goal() -> int:
-        writes = [p for p in emu.log() if p.instruction == "sync_write"]
+        writes = goal_writes(emu)
         return writes[-1].values[4] if writes else 2048
 
     rest_knee = ServoMap(robot).goals(ServoMap(robot).vector(robot.rest).tolist())[4]

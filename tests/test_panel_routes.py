@@ -98,7 +98,8 @@ def test_the_table_holds_the_documented_endpoints(spied: tuple[int, list, list])
     _, routes, _ = spied
     expected = {("GET", p) for p in ("/", "/index.html", "/panel.js", "/panel.css", "/input.js",
                                      "/studio.js", "/api/state", "/api/params", "/api/presets",
-                                     "/api/live", "/api/takes", "/api/sequences")}
+                                     "/api/live", "/api/takes", "/api/sequences",
+                                     "/api/show/audio")}
     expected |= {("POST", "/api/" + p) for p in (
         "params", "preset", "save", "start", "stop", "estop", "reset", "record", "play",
         "pose/release", "pose/capture", "pose/clear", "pose/save", "sequence/play")}

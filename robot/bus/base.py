@@ -10,6 +10,10 @@ from abc import ABC, abstractmethod
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from types import TracebackType
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from robot.bus.wire_time import TickWire
 
 
 @dataclass(frozen=True)
@@ -48,7 +52,7 @@ class ServoState:
 class Bus(ABC):
     """A chain of servos. Use as a context manager; ``close()`` turns torque off."""
 
-    #: "dynamixel" | "feetech" | "sim"
+    #: "dynamixel" | "dynamixel1" | "feetech" | "lx" | "sim"
     kind: str = "abstract"
 
     @abstractmethod
@@ -104,11 +108,37 @@ class Bus(ABC):
         when there is none. This default is for buses without one: it does nothing."""
         return None
 
+    def max_rate_hz(self, *, read_every: int) -> float | None:
+        """The fastest control rate the wire carries with a read-back every ``read_every``
+        ticks [Hz]; None when the wire sets no practical limit (the default)."""
+        return None
+
+    def check_rate(self, rate_hz: float, *, read_every: int) -> None:
+        """ConfigError when the wire cannot carry goals at ``rate_hz`` [Hz] with a read-back
+        every ``read_every`` ticks (the LX bus: one packet per servo). Default: any rate."""
+        return None
+
     def release(self, ids: Iterable[int]) -> None:
         """Torque off on ``ids`` at once, in one packet that needs no reply where the bus
         allows (an emergency, or a bus that stopped answering); confirm with
         ``set_torque(ids, enabled=False)`` while the bus answers. Default: ``set_torque``."""
         self.set_torque(ids, enabled=False)
+
+    #: The servos' longest return delay as measured when the bus opened [s] (0: unknown).
+    return_delay_s: float = 0.0
+
+    def tick_wire(self, read_every: int) -> TickWire | None:
+        """What one control tick puts on the wire (robot.bus.wire_time), reading the state
+        back every ``read_every`` ticks; None for buses without a serial wire (this
+        default)."""
+        return None
+
+    def read_gains(self, servo_id: int, *, model: int | None = None) -> dict[str, int] | None:
+        """The position-control gain registers of ``servo_id`` [register values, named as in
+        robot/servo/gains.py], by its joint's servo model (else by ``model``, its model
+        number); None when the model is unknown or the bus has no gain registers (this
+        default, for buses without them)."""
+        return None
 
     def read_positions(self, ids: Iterable[int]) -> dict[int, int]:
         """Present positions [ticks] of ``ids``."""
@@ -121,3 +151,10 @@ class Bus(ABC):
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
         self.close()
+
+
+def bus_rate(bus: Bus, rate_hz: float = 200.0, *, read_every: int = 10) -> float:
+    """``rate_hz`` [Hz], or the fastest the bus's wire carries if that is lower (an LX
+    chain: no sync write), for loops whose rate the user did not choose (holding a pose)."""
+    top = bus.max_rate_hz(read_every=read_every)
+    return rate_hz if top is None else min(rate_hz, float(int(top)))

@@ -1,7 +1,7 @@
 """One factory picks the bus backend (like pyserial's ``serial_for_url``).
 
 The hardware buses (``dynamixel`` = Protocol 2.0, ``dynamixel1`` = Protocol 1.0,
-``feetech``) are built in. Other kinds are plugins: a
+``feetech``, ``lx`` = HiWonder/LewanSoul LX serial bus servos) are built in. Other kinds are plugins: a
 distribution declares an entry point in the group ``biped.buses`` (biped's own
 pyproject.toml declares ``sim = "sim:open_bus"``), naming a callable
 ``(robot, *, port, baud, **options) -> Bus``; ``register_bus`` adds one at run time. So
@@ -19,7 +19,10 @@ from robot.errors import ConfigError
 
 #: Entry-point group where bus plugins are declared.
 ENTRY_POINT_GROUP = "biped.buses"
-HARDWARE = ("dynamixel", "dynamixel1", "feetech")
+#: "lx": the HiWonder/LewanSoul LX servos' own protocol (LX-16A, LX-224, LX-224HV); named
+#: after the model prefix users see on the servo (the brand changed from LewanSoul to
+#: HiWonder; the errors list every kind).
+HARDWARE = ("dynamixel", "dynamixel1", "feetech", "lx")
 
 BusFactory = Callable[..., Bus]   # (robot, *, port: str | None, baud: int | None, **options)
 
@@ -75,6 +78,10 @@ def make_bus(kind: str | None, *, robot: RobotConfig, port: str | None = None,
             from robot.bus.dynamixel1 import Dynamixel1Bus
 
             return Dynamixel1Bus(port, baud=baud, robot=robot, **options)  # type: ignore[arg-type]
+        if kind == "lx":
+            from robot.bus.lx import LxBus
+
+            return LxBus(port, baud=baud, robot=robot, **options)  # type: ignore[arg-type]
         from robot.bus.feetech import FeetechBus
 
         return FeetechBus(port, baud=baud, robot=robot, **options)  # type: ignore[arg-type]

@@ -48,6 +48,9 @@ DYNAMIXEL_X: dict[str, Register] = {
     "led": Register(65, 1),
     "status_return_level": Register(68, 1),
     "hardware_error_status": Register(70, 1),
+    "position_d_gain": Register(80, 2),
+    "position_i_gain": Register(82, 2),
+    "position_p_gain": Register(84, 2),
     "bus_watchdog": Register(98, 1),
     "profile_acceleration": Register(108, 4),
     "profile_velocity": Register(112, 4),
@@ -79,6 +82,10 @@ DYNAMIXEL_P1: dict[str, Register] = {
     "shutdown": Register(18, 1),
     "torque_enable": Register(24, 1),
     "led": Register(25, 1),
+    "cw_compliance_margin": Register(26, 1),     # AX only (MX: DYNAMIXEL_MX1_GAINS)
+    "ccw_compliance_margin": Register(27, 1),
+    "cw_compliance_slope": Register(28, 1),
+    "ccw_compliance_slope": Register(29, 1),
     "goal_position": Register(30, 2),
     "moving_speed": Register(32, 2),
     "torque_limit": Register(34, 2),
@@ -108,6 +115,9 @@ FEETECH_STS: dict[str, Register] = {
     "max_voltage_limit": Register(14, 1),
     "min_voltage_limit": Register(15, 1),
     "max_torque_limit": Register(16, 2),
+    "p_coefficient": Register(21, 1),
+    "d_coefficient": Register(22, 1),
+    "i_coefficient": Register(23, 1),
     "homing_offset": Register(31, 2),
     "operating_mode": Register(33, 1),
     "torque_enable": Register(40, 1),
@@ -129,6 +139,34 @@ FEETECH_STS: dict[str, Register] = {
 
 TABLES: dict[str, dict[str, Register]] = {
     "dynamixel_x": DYNAMIXEL_X, "dynamixel_p1": DYNAMIXEL_P1, "feetech_sts": FEETECH_STS,
+}
+
+# ROBOTIS e-Manual, MX-28 (Protocol 1.0 firmware) RAM table: D Gain(26), I Gain(27),
+# P Gain(28), where the AX-12A keeps its compliance margins and slopes.
+DYNAMIXEL_MX1_GAINS: dict[str, Register] = {
+    "d_gain": Register(26, 1), "i_gain": Register(27, 1), "p_gain": Register(28, 1),
+}
+
+
+def _pick(table: dict[str, Register], *names: str) -> dict[str, Register]:
+    return {n: table[n] for n in names}
+
+
+#: The gain registers of each gain set (robot/servo/gains.py: names, ranges, memory).
+GAIN_REGISTERS: dict[str, dict[str, Register]] = {
+    "dynamixel_x": _pick(DYNAMIXEL_X, "position_d_gain", "position_i_gain", "position_p_gain",
+                         "profile_acceleration", "profile_velocity"),
+    "dynamixel_ax": _pick(DYNAMIXEL_P1, "cw_compliance_margin", "ccw_compliance_margin",
+                          "cw_compliance_slope", "ccw_compliance_slope"),
+    "dynamixel_mx1": DYNAMIXEL_MX1_GAINS,
+    "feetech_sts": _pick(FEETECH_STS, "p_coefficient", "d_coefficient", "i_coefficient"),
+}
+#: The EEPROM write lock of a family, as (register, unlocked value, locked value): Feetech
+#: STS Lock(55): 0 = EEPROM writes are saved, 1 = locked (the memory table; the factory
+#: value is 1). Dynamixel needs torque off for EEPROM instead (and the AX Lock(47) locks
+#: for good until power-off: never written here).
+EEPROM_LOCK: dict[str, tuple[str, int, int] | None] = {
+    "dynamixel_x": None, "dynamixel_p1": None, "feetech_sts": ("lock", 0, 1),
 }
 
 # Hardware-error bits → normalised fault names.
@@ -166,6 +204,7 @@ ERROR_BITS: dict[str, dict[int, str]] = {
     "dynamixel_x": DYNAMIXEL_X_ERROR_BITS,
     "dynamixel_p1": DYNAMIXEL_P1_ERROR_BITS,
     "feetech_sts": FEETECH_STS_ERROR_BITS,
+    "lx": {0: "overheating", 1: "voltage", 2: "overload"},   # lx_tables.LX_ALARM_BITS
 }
 
 # Unit of one "return delay" register step [s]: Dynamixel X 2 µs, Feetech STS 2 µs.

@@ -45,7 +45,8 @@ SIGN_TRIES = 3
 #: The servo's own position-limit registers, per bus kind.
 LIMIT_REGISTERS = {"dynamixel": ("min_position_limit", "max_position_limit"),
                    "dynamixel1": ("cw_angle_limit", "ccw_angle_limit"),
-                   "feetech": ("min_angle_limit", "max_angle_limit")}
+                   "feetech": ("min_angle_limit", "max_angle_limit"),
+                   "lx": ("min_angle_limit", "max_angle_limit")}
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

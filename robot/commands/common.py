@@ -106,7 +106,7 @@ joint_speed = bounded_float(SPEED.lo, SPEED.hi, SPEED.unit, what="a joint speed"
 
 #: Every standard baud rate of the supported servo families [bit/s].
 #: The hardware bus kinds (robot.bus.factory.HARDWARE): Dynamixel 2.0, Dynamixel 1.0, Feetech.
-HARDWARE_BUSES: tuple[str, ...] = ("dynamixel", "dynamixel1", "feetech")
+HARDWARE_BUSES: tuple[str, ...] = ("dynamixel", "dynamixel1", "feetech", "lx")
 BAUD_RATES: tuple[int, ...] = tuple(sorted({b for k in HARDWARE_BUSES
                                             for b in standard_bauds(k)}))
 

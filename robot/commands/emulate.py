@@ -22,7 +22,7 @@ from robot.commands.common import add_robot_args, positive_int, robot_from
 if TYPE_CHECKING:
     from sim.emulator.chain import Emulator
 
-PROTOCOLS = ("dynamixel", "dynamixel1", "feetech")
+PROTOCOLS = ("dynamixel", "dynamixel1", "feetech", "lx")
 ALIVE_CHECK_S = 0.5          # how often the emulator process is checked [s]
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -26,17 +27,22 @@ from robot.commands.common import (
     rate_hz,
     seconds,
 )
+from robot.commands.physics_check import physics_check, physics_watch
 from robot.config.bundled import DEFAULT_GAIT
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.loop.recorder import Recorder
+from robot.loop.soundtrack import Soundtrack
 from robot.loop.take_writer import TakeWriter
+from robot.loop.telemetry import Telemetry
 from robot.motion.keyframes import SUFFIXES, load_sequence, parse_sequence
 from robot.motion.layered import LayeredEngine
 from robot.motion.scripted import PlaybackEngine
+from robot.motion.show import Cue, Show, show_of, show_of_sequence, stream_sequence
 from robot.motion.takes import SUFFIX, Take, TakeHeader, is_take, read_take
+from robot.previs.show_check import plot_check
 from robot.run.run import Run
 from robot.run.spec import RunOptions, RunSpec
 
@@ -61,7 +67,21 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--record", default=None, metavar="PATH",
                    help=f"record the replay (.csv, .jsonl or NAME{SUFFIX})")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.add_argument("--audio", default=None, type=input_file, metavar="SOUND",
+                   help="play this soundtrack in sync (default: the file's own show.audio); "
+                        "the sim then runs in real time")
+    p.add_argument("--audio-offset", type=float, default=None, metavar="SECONDS",
+                   help="show time [s] at which the audio starts (default: the file's, or 0)")
+    p.add_argument("--player", default=None, metavar="CMD",
+                   help="audio player reading a WAV on stdin (default: aplay, paplay, else "
+                        "ffplay)")
+    p.add_argument("--check-plot", default=None, type=output_file, metavar="FILE.png",
+                   help="sim bus: plot the physics check (support margin, torque by limb, "
+                        "headroom per joint)")
     add_balance_args(p)
+    p.add_argument("--balance", action="store_true", help="an imported take (biped import): "
+                   "the balance stage corrects the legs while the arms and head perform as "
+                   "authored (needs the robot's [imu])")
     p.set_defaults(set=[])
     return p
 
@@ -95,9 +115,15 @@ def run(args: argparse.Namespace) -> int:
         layer = (parse_sequence(h.keyframes, robot, source=f"{take.source}: keyframes")
                  if h.keyframes else None)
         stop = take.stop_tick if take.stop_tick is not None else len(take.t)
-        args.no_balance = args.no_balance or not h.balance
-        engine = PlaybackEngine(robot, h.params, changes=take.changes, stop_tick=stop,
-                                keyframes=layer)
+        show = show_of(h.show, take.source)
+        if show.stream:   # an imported animation: its joints as they are (--balance: legs)
+            engine = LayeredEngine(robot, h.params, keyframes=stream_sequence(take),
+                                   walk=False)
+            args.no_balance = not args.balance
+        else:
+            args.no_balance = args.no_balance or not h.balance
+            engine = PlaybackEngine(robot, h.params, changes=take.changes, stop_tick=stop,
+                                    keyframes=layer)
         rate, read_every, limit = h.rate_hz, h.read_every, None
         header = h
     elif Path(args.file).suffix in SUFFIXES:
@@ -111,12 +137,16 @@ def run(args: argparse.Namespace) -> int:
         engine = LayeredEngine(robot, params, keyframes=seq, walk=False)
         args.no_balance = True  # standing still: nothing to balance with the gait's loop
         rate, read_every, limit = args.rate or 200.0, 10, args.seconds
+        show = show_of_sequence(args.file)
         header = TakeHeader(robot=robot.name, robot_file=robot.source,
                             joints=robot.joint_names, rate_hz=rate, read_every=read_every,
                             gait=gait.name, params=params, bus=kind)
     else:
         raise ConfigError(f"FILE {args.file}: expected a take (NAME{SUFFIX}) or a keyframe "
                           f"sequence ({', '.join(SUFFIXES)})")
+    soundtrack = _soundtrack(args, show)
+    if soundtrack is not None and kind == "sim":
+        args.realtime = True          # the sound plays in real time: so does the show
     options: dict[str, Any] = (
         {"realtime": args.realtime, "view": args.view} if kind == "sim" else {})
     bus = bus_from(args, robot, kind=kind, **options)
@@ -125,16 +155,28 @@ def run(args: argparse.Namespace) -> int:
     if args.record:
         writer = (TakeWriter(args.record, header) if is_take(args.record)
                   else Recorder(args.record, robot.joint_names, robot.ids))
+    watch = physics_watch(bus)
+    observers = [o for o in (watch, soundtrack) if o is not None]
+
+    def observe(tel: Telemetry) -> None:
+        for o in observers:
+            o(tel)
     spec = RunSpec(robot=robot, source=engine, bus=bus, imu=imu, recorder=writer,
+                   observer=observe if observers else None,
                    options=RunOptions(rate_hz=rate, read_every=read_every, hold=args.hold,
-                                      seconds=limit, signals=True, watch=False))
+                                      seconds=limit, signals=True, watch=watch is not None,
+                                      stop_on_fall=watch is not None))
     playing = Run(spec)
-    with playing:
-        if isinstance(writer, TakeWriter) and isinstance(engine, PlaybackEngine):
-            for k, step in sorted(take.changes.items()):
-                writer.event(k, set=dict(step))
-            writer.event(stop, stop=True)
-        playing.stream()
+    try:
+        with playing:
+            if isinstance(writer, TakeWriter) and isinstance(engine, PlaybackEngine):
+                for k, step in sorted(take.changes.items()):
+                    writer.event(k, set=dict(step))
+                writer.event(stop, stop=True)
+            playing.stream()
+    finally:
+        if soundtrack is not None:
+            soundtrack.close()
     done = playing.result
     stats, record_error, code = done.stats, done.record_error, done.exit_code
     result = {"file": args.file, "robot": robot.name, "bus": kind, "ticks": stats.ticks,
@@ -142,6 +184,17 @@ def run(args: argparse.Namespace) -> int:
               "stop_reason": stats.stop_reason, "fault": stats.fault,
               "holding": stats.holding, "balance": imu is not None,
               "record_error": record_error, "exit_code": code}
+    if soundtrack is not None:
+        result["audio"] = {"file": str(soundtrack.show.audio_path()),
+                           "started_at_show_s": soundtrack.started_at,
+                           "warning": soundtrack.warning}
+    check = physics_check(watch, robot, done.metrics)
+    if check is not None and check.fell_at is not None:
+        code = result["exit_code"] = max(code, 1)   # the show did not hold up: incomplete
+    if check is not None:
+        result["physics"] = check.as_dict()
+        if args.check_plot:
+            plot_check(check, args.check_plot, title=f"physics check: {args.file}")
     if args.json:
         print(json.dumps(result))
     else:
@@ -151,4 +204,24 @@ def run(args: argparse.Namespace) -> int:
               f"{'holding the rest pose, torque ON' if stats.holding else 'torque off'}")
         if record_error:
             print(f"record FAILED: {record_error}")
+        if check is not None:
+            print(check.table())
+            if args.check_plot:
+                print(f"wrote {args.check_plot}")
     return code
+
+
+def _soundtrack(args: argparse.Namespace, show: Show) -> Soundtrack | None:
+    """The show's soundtrack and cues (``--audio`` / ``--audio-offset`` override the
+    file's), or None for a show with neither."""
+    if args.audio is not None:
+        show = replace(show, audio=str(Path(args.audio).resolve()))
+    if args.audio_offset is not None:
+        show = replace(show, audio_offset_s=args.audio_offset)
+    if show.audio is None and not show.cues:
+        return None
+
+    def cue(c: Cue) -> None:
+        if not args.json:
+            print(f"cue {c.t:.2f} s: {c.name}", flush=True)
+    return Soundtrack(show, on_cue=cue, player=args.player)

@@ -34,7 +34,12 @@ from robot.tuning.robustness import (
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
     p = sub.add_parser("robustness", help="walk under slopes, bumps, pushes, parameter "
-                       "changes, latency, friction and mass, with and without balance (sim)")
+                       "changes, latency, friction and mass, with and without balance (sim)",
+                       description="Walk the gait in simulation under every condition of a "
+                       "suite (slopes, bumps, pushes, live parameter changes, latency, "
+                       "friction, mass), with and without balance feedback, in parallel "
+                       "processes; print how many runs survived per condition group and "
+                       "optionally plot it (--plot).")
     add_robot_args(p)
     add_set_arg(p)
     p.add_argument("--seconds", type=seconds, default=None,
@@ -134,12 +139,14 @@ def plot_survival(table: Sequence[tuple[str, dict[bool, tuple[int, int]]]], out:
                 ok, n = row[balance]
                 ys.append(i + (k - 0.5) * height)
                 xs.append(100.0 * ok / n if n else 0.0)
+                # n/N beside every bar, so 0 % reads as "0 of N", not as a missing row
+                ax.text(xs[-1] + 1.0, ys[-1], f"{ok}/{n}", va="center", fontsize=7)
         if ys:
             ax.barh(ys, xs, height=height, color=colour,
                     label="balance on" if balance else "open loop (--no-balance)")
     ax.set_yticks(range(len(groups)), groups)
     ax.invert_yaxis()
-    ax.set_xlim(0, 100)
+    ax.set_xlim(0, 108)
     ax.set_xlabel("survived [% of runs]")
     ax.set_title(title, loc="left", fontsize=10)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)

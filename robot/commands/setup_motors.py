@@ -15,6 +15,7 @@ from collections.abc import Callable
 from robot.bus.dynamixel import DynamixelBus
 from robot.bus.dynamixel1 import Dynamixel1Bus
 from robot.bus.feetech import FeetechBus
+from robot.bus.lx import LxBus
 from robot.bus.sdk_bus import SdkBus
 from robot.commands.common import HARDWARE_BUSES, add_robot_args, one_line_errors, robot_from
 from robot.config.robot import RobotConfig
@@ -46,11 +47,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     return one_line_errors(p)
 
 
-def _bus(args: argparse.Namespace, robot: RobotConfig) -> SdkBus:
+def _bus(args: argparse.Namespace, robot: RobotConfig) -> SdkBus | LxBus:
     kind = args.bus or robot.bus.kind
     if kind != robot.bus.kind:
         raise ConfigError(f"--bus {kind}: robot {robot.name} ({robot.source}) has "
                           f"{robot.bus.kind} servos; use --bus {robot.bus.kind}")
+    if kind == "lx":      # one rate; ping reports the robot file's model (none on the wire)
+        return LxBus(args.port or robot.bus.port, retries=robot.bus.retries,
+                     timeout_ms=robot.bus.timeout_ms, model=robot.bus.model,
+                     check_health=False)
     cls: type[SdkBus] = {"dynamixel": DynamixelBus, "dynamixel1": Dynamixel1Bus}.get(
         kind, FeetechBus)
     # No robot on the bus: a servo at id 1 is a new servo, not joint 1 (and no health check).
@@ -80,7 +85,7 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
                     return 1
             found = find_servo(bus, robot, progress=lambda m: print(f"  {m}", flush=True))
             check_model(found, robot, joint)
-            print(f"  found a {robot.bus.model} at id {found.id}, {found.baud} baud")
+            print(f"  found: {robot.bus.model} at id {found.id}, {found.baud} baud")
             changes = assign(bus, found, joint, robot)
             done = "; ".join(changes) if changes else "already set, nothing changed"
             print(f"{joint.name}: id {joint.servo_id} at {robot.bus.baud} baud, checked "

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 
+from robot.bus.base import bus_rate
 from robot.bus.servo_map import ServoMap
 from robot.commands.common import (
     add_bus_args,
@@ -21,8 +22,12 @@ from robot.motion.posing import PoseMove
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    p = subparsers.add_parser("torque", help="enable or disable torque on every joint",
-                              description=__doc__)
+    p = subparsers.add_parser(
+        "torque", help="enable or disable torque on every joint",
+        description="Turn torque on, holding the present position (on), or release every "
+                    "joint (off). 'on' refuses, with torque untouched, if a joint is outside "
+                    "its limits; otherwise each servo's goal becomes its present position "
+                    "before torque comes on, so nothing moves.")
     p.add_argument("state", choices=("on", "off"))
     add_robot_args(p, gait=False)
     add_bus_args(p)
@@ -40,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
             return 0
         sm = ServoMap(robot)
         here = PoseMove(robot, sm.from_positions(bus.read_positions(sm.ids)))
-        stats = Streamer(sm, bus, here, hold_at_end=True).run()
+        stats = Streamer(sm, bus, here, rate_hz=bus_rate(bus), hold_at_end=True).run()
         if stats.fault or not stats.holding:
             print(f"stopped: {stats.stop_reason}; torque OFF")
             return 1

@@ -26,7 +26,13 @@ from robot.errors import ConfigError
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
     p = sub.add_parser("tune", help="find gait and balance parameters that walk robustly "
-                       "on this robot (sim, Optuna) and write them as a preset")
+                       "on this robot (sim, Optuna) and write them as a preset",
+                       description="Search gait and balance parameters for this robot in "
+                       "simulation (Optuna): each trial walks the robustness suite and is "
+                       "scored by survival and walk quality. The best parameters are written "
+                       "as a gait preset (--out) with a table against the starting preset, "
+                       "the optimisation history and the parameter importance as PNGs. "
+                       "--sensitivity only measures how much each parameter matters.")
     add_robot_args(p)
     add_set_arg(p)
     p.add_argument("--sensitivity", action="store_true",
@@ -67,9 +73,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
 
 def run(args: argparse.Namespace) -> int:
     import optuna
-    from tqdm import tqdm
 
     from robot.tuning.objective import Setup, check_skip, suite_for
+    from robot.tuning.progress import TrialProgress
     from robot.tuning.report import format_report, group_survival, plot_study, write_preset
     from robot.tuning.robustness import check_seconds
     from robot.tuning.space import search_space
@@ -102,18 +108,14 @@ def run(args: argparse.Namespace) -> int:
               "suite ...", file=sys.stderr, flush=True)
     setup, ref = references(study, setup, start, target_speed=args.speed)
     plan = Plan(storage, name, setup, start, knobs, args.trials, args.seed)
-    bar = tqdm(total=args.trials, desc="trials", unit="trial", file=sys.stderr,
-               disable=args.json or None)
-
-    def progress(n: int) -> None:
-        bar.update(max(0, n - bar.n))
+    progress = TrialProgress(args.trials, quiet=args.json)
     t_study = time.perf_counter()
     study = run_study(plan, jobs=jobs, progress=progress)
     from robot.tuning.study import finished
 
     done = finished(study)
     progress(done)
-    bar.close()
+    progress.close()
     study_s = time.perf_counter() - t_study
     best = best_params(study, plan)
     top = best_trial(study)
@@ -128,7 +130,7 @@ def run(args: argparse.Namespace) -> int:
     written = write_preset(out, best, name=out.stem,
                            description=f"tuned by biped tune for {robot.name} from "
                            f"'{gait.name}' ({done} trials, {args.suite} suite)")
-    pngs = plot_study(study, out.with_suffix(""))
+    pngs = plot_study(study, out.with_suffix(""), start_score=start_score)
     wall = time.perf_counter() - wall0
     per_trial = study_s * jobs / max(1, done)
     result: dict[str, Any] = {

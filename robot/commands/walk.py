@@ -93,8 +93,11 @@ def run(args: argparse.Namespace) -> int:
 
 
 def format_summary(r: dict[str, Any]) -> str:
-    lines = [f"{r['robot']} walked gait '{r['gait']}' for {r['seconds']:g} s "
-             f"on the {r['bus']} bus"]
+    # An early stop (Ctrl-C, a fall, a fault) says how long it really ran, ramps included.
+    ran = r["ticks"] / r["rate_hz"] if r.get("rate_hz") else 0.0
+    span = (f"for {r['seconds']:g} s" if r["stop_reason"] == "completed"
+            else f"for {ran:.1f} s of the {r['seconds']:g} s asked (stopped early)")
+    lines = [f"{r['robot']} walked gait '{r['gait']}' {span} on the {r['bus']} bus"]
     if "distance_m" in r:
         fell = f"YES at {r['fell_at_s']:.1f} s" if r["fell"] else "no"
         lines += [

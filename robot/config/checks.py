@@ -18,7 +18,7 @@ from robot.config.joint_names import ARM_NAMES, EXTRA_NAME, HIP_YAW_NAMES, JOINT
 from robot.config.toml_io import TomlValue, show
 from robot.errors import ConfigError
 from robot.servo import ticks as tick_math
-from robot.servo.models import BAUD_CODES, BUS_FAMILIES, MODELS
+from robot.servo.models import BAUD_CODES, BUS_FAMILIES, FIXED_BAUD, MODELS
 
 if TYPE_CHECKING:
     from robot.config.robot import BusConfig, JointConfig, RobotConfig
@@ -29,8 +29,12 @@ RAD_DIGITS = 4
 
 
 def standard_bauds(kind: str) -> list[int]:
-    """The baud rates [bit/s] the servos of bus ``kind`` ("dynamixel" | "feetech") offer."""
-    return sorted(BAUD_CODES[BUS_FAMILIES[kind]].values())
+    """The baud rates [bit/s] the servos of bus ``kind`` ("dynamixel" | "feetech" | ...)
+    offer (one, for a family without a Baud Rate register: FIXED_BAUD)."""
+    family = BUS_FAMILIES[kind]
+    if family in FIXED_BAUD:
+        return [FIXED_BAUD[family]]
+    return sorted(BAUD_CODES[family].values())
 
 
 def check_bus(src: str, bus: BusConfig) -> None:

@@ -16,3 +16,12 @@ JOINT_NAMES = LEG_NAMES + ARM_NAMES
 HIP_YAW_NAMES = ("r_hip_yaw", "l_hip_yaw")
 #: Names of extra joints: lowercase letters, digits and '_', starting with a letter.
 EXTRA_NAME = re.compile(r"^[a-z][a-z0-9_]{0,31}$")
+
+
+def limb_groups(names: tuple[str, ...] | list[str]) -> list[tuple[str, list[str]]]:
+    """``names`` by limb, for plots: ("leg joints", ...), ("arm joints", ...), ("extra
+    joints", ...): the non-empty groups, each in the given order."""
+    groups = (("leg joints", [n for n in names if n in LEG_NAMES]),
+              ("arm joints", [n for n in names if n in ARM_NAMES]),
+              ("extra joints", [n for n in names if n not in JOINT_NAMES]))
+    return [(label, group) for label, group in groups if group]

@@ -65,6 +65,7 @@ class Streamer(Generic[SourceT]):
         self.dt = 1.0 / rate_hz
         self._step = robot_map.max_speed * self.dt  # slew limit per tick [rad]
         self.read_every = max(1, read_every)
+        bus.check_rate(rate_hz, read_every=self.read_every)   # before anything moves
         self.clock: Clock = clock or getattr(bus, "clock", None) or MonotonicClock()
         self.hold_at_end = hold_at_end
         self.watchdog_config = watchdog or WatchdogConfig()
@@ -130,8 +131,8 @@ class Streamer(Generic[SourceT]):
             self.bus.write_goals(self.map.goals(q0.tolist()))  # no snap to a stale goal
             self.bus.set_torque(ids, enabled=True)
             self._q_last = q0
-            self._next = self.clock.now()
             arm_failsafe(self.bus, ids, self.watchdog_config.failsafe_s, dt=self.dt)
+            self._next = self.clock.now()     # after arming: its packets take wire time
             self._stream(seconds)
         except SafetyStop as e:                  # the watchdog: unsafe or impossible to drive
             self._bus_dead = isinstance(e, BusDead)

@@ -82,10 +82,11 @@ def parse_sequence(data: Mapping[str, Value], robot: RobotConfig, *,
                    source: str = "<memory>") -> Sequence:
     """A validated Sequence for ``robot`` (ConfigError, one line, on any problem)."""
     src = source
-    unknown = sorted(set(data) - {"name", "interpolation", "loop", "keyframe", "description"})
+    unknown = sorted(set(data) - {"name", "interpolation", "loop", "keyframe", "description",
+                                  "show"})
     if unknown:
         raise ConfigError(f"{src}: {unknown[0]}: unknown key; valid: name, interpolation, "
-                          "loop, keyframe, description")
+                          "loop, keyframe, description, show (robot.motion.show)")
     name = data.get("name", Path(src).stem.removesuffix(".keys"))
     if not isinstance(name, str) or not name:
         raise ConfigError(f"{src}: name: expected a non-empty string, got {show(name)}")

@@ -63,13 +63,15 @@ class TakeHeader:
     note: str = ""
     #: A keyframe sequence layered on the gait (robot.motion.keyframes.Sequence.as_json()).
     keyframes: Mapping[str, JsonValue] | None = None
+    #: The show: a joint stream to play as recorded, audio, cues (robot.motion.show).
+    show: Mapping[str, JsonValue] | None = None
 
     def as_json(self) -> dict[str, Any]:
         return {"take": VERSION, "robot": self.robot, "robot_file": self.robot_file,
                 "joints": list(self.joints), "rate_hz": self.rate_hz,
                 "read_every": self.read_every, "gait": self.gait,
                 "params": self.params.as_dict(), "bus": self.bus, "balance": self.balance,
-                "note": self.note, "keyframes": self.keyframes}
+                "note": self.note, "keyframes": self.keyframes, "show": self.show}
 
 
 @dataclass(frozen=True)
@@ -141,13 +143,16 @@ def _header(where: str, h: JsonValue) -> TakeHeader:
     keys = h.get("keyframes")
     if keys is not None and not isinstance(keys, dict):
         raise _fail(where, "keyframes: expected a keyframe sequence object or null")
+    show = h.get("show")
+    if show is not None and not isinstance(show, dict):
+        raise _fail(where, "show: expected a show object (robot.motion.show) or null")
     return TakeHeader(robot=strings["robot"], robot_file=strings["robot_file"],
                       joints=names, rate_hz=float(rate),
                       read_every=_int(where, h.get("read_every", 10), "read_every", 1),
                       gait=strings["gait"] or "take",
                       params=GaitParams().replace(params, where=f"{where}: params"),
                       bus=strings["bus"] or "sim", balance=h.get("balance") is True,
-                      note=strings["note"], keyframes=keys)
+                      note=strings["note"], keyframes=keys, show=show)
 
 
 def _lines(p: Path) -> list[tuple[str, JsonValue]]:

@@ -47,9 +47,12 @@ class Request:
 
 @dataclass(frozen=True)
 class Response:
+    """``headers``: more response headers (the audio route's byte ranges)."""
+
     status: int
     body: bytes
     content_type: str
+    headers: Mapping[str, str] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -151,13 +154,47 @@ def _panel_routes(c: PanelController) -> dict[tuple[str, str], Handler]:
     }
 
 
+#: Sound files the page's <audio> plays, by suffix.
+AUDIO = {".wav": "audio/wav", ".mp3": "audio/mpeg", ".ogg": "audio/ogg", ".oga": "audio/ogg",
+         ".flac": "audio/flac", ".m4a": "audio/mp4"}
+
+
+def byte_range(data: bytes, kind: str, asked: str) -> Response:
+    """``data`` whole, or the one range ``bytes=a-b`` asked (206): a media element seeks
+    only in a file served with byte ranges (RFC 9110 section 14)."""
+    ranges = {"Accept-Ranges": "bytes"}
+    unit, _, spec = asked.partition("=")
+    first, dash, last = spec.partition("-")
+    if unit.strip() != "bytes" or not dash or "," in spec or not (first or last).isdigit():
+        return Response(HTTPStatus.OK, data, kind, ranges)
+    n = len(data)
+    lo, hi = (int(first), int(last) if last.isdigit() else n - 1) if first.isdigit() \
+        else (max(0, n - int(last)), n - 1)
+    if lo >= n or lo > hi:
+        return Response(HTTPStatus.REQUESTED_RANGE_NOT_SATISFIABLE, b"", kind,
+                        {**ranges, "Content-Range": f"bytes */{n}"})
+    hi = min(hi, n - 1)
+    return Response(HTTPStatus.PARTIAL_CONTENT, data[lo:hi + 1], kind,
+                    {**ranges, "Content-Range": f"bytes {lo}-{hi}/{n}"})
+
+
 def _studio_routes(s: Studio) -> dict[tuple[str, str], Handler]:
     def sequences(_: Request) -> Reply:
         return ok({"sequences": s.sequences(), "dir": str(s.keys_dir), **s.status()})
 
+    def audio(r: Request) -> Reply:
+        """A take's soundtrack, for the page's <audio> (the browser plays the sound)."""
+        path = s.audio_file(r.query.get("take", [""])[0])
+        kind = AUDIO.get(path.suffix.lower())
+        if kind is None:
+            raise Refused(HTTPStatus.UNSUPPORTED_MEDIA_TYPE, f"{path.name}: not a sound file "
+                          f"the page plays ({', '.join(AUDIO)})")
+        return byte_range(path.read_bytes(), kind, r.headers.get("range", ""))
+
     return {
         ("GET", "/api/takes"): lambda _: ok({"takes": s.takes(), "dir": str(s.takes_dir)}),
         ("GET", "/api/sequences"): sequences,
+        ("GET", "/api/show/audio"): audio,
         ("POST", "/api/record"): _studio(s, lambda b: {"take": s.record(b.get("name"))}),
         ("POST", "/api/play"): _studio(s, lambda b: s.play(b.get("name"))),
         ("POST", "/api/pose/release"): _studio(s, lambda b: s.release(b.get("limb"))),

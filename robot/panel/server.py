@@ -13,6 +13,7 @@ Endpoints (JSON in and out; errors are ``{"error": "..."}``, never an empty repl
   GET  /api/live     WebSocket (robot.panel.live): the state, parameters and studio status
                      pushed 20 times a second; the page uses it instead of polling
   GET  /api/takes | /api/sequences        recorded takes, saved keyframe sequences
+  GET  /api/show/audio?take=NAME          a show take's soundtrack (byte ranges: the page seeks)
   POST /api/record {"name"?} | /api/play {"name"}   record a take (ends with stop), replay
   POST /api/pose/release {"limb"} | /api/pose/capture | /api/pose/clear | /api/pose/save
        {"name"} | /api/sequence/play {"name", "layer": bool}: posing by hand (panel.studio)
@@ -191,7 +192,7 @@ class _Handler(BaseHTTPRequestHandler):
         self.send_response(response.status)
         self.send_header("Content-Type", response.content_type)
         self.send_header("Content-Length", str(len(response.body)))
-        for k, v in HEADERS.items():
+        for k, v in {**HEADERS, **response.headers}.items():
             self.send_header(k, v)
         if self.close_connection:
             self.send_header("Connection", "close")

@@ -29,6 +29,7 @@ from robot.motion.keyframes import Sequence, load_sequence, parse_sequence, sequ
 from robot.motion.layered import LayeredEngine
 from robot.motion.posing import Capture, limb_joints, limbs
 from robot.motion.scripted import PlaybackEngine, RecordingEngine
+from robot.motion.show import Show, show_of, stream_sequence
 from robot.motion.takes import SUFFIX, TakeHeader, read_take
 from robot.panel.controller import PanelController, PanelStateError
 from robot.run.release import release
@@ -61,6 +62,7 @@ class Studio:
         self.recording: str | None = None
         self.playing: str | None = None
         self.released: str | None = None
+        self.show: Show | None = None
         self._capture: Capture | None = None
 
     # -- takes -----------------------------------------------------------------------
@@ -107,6 +109,9 @@ class Studio:
         if h.joints != self.robot.joint_names:
             raise ConfigError(f"take {take_name!r} was recorded on {h.robot}, not "
                               f"{self.robot.name}")
+        show = show_of(h.show, str(path))
+        if show.stream:   # an imported show: its joints as they are, at any rate
+            return self._play_show(take_name, stream_sequence(take), show)
         if h.rate_hz != self.c.options.rate_hz:
             raise ConfigError(f"take {take_name!r} was recorded at {h.rate_hz:g} Hz; the "
                               f"panel runs at {self.c.options.rate_hz:g} Hz (use biped play)")
@@ -123,6 +128,40 @@ class Studio:
         self.c.start(engine=engine, driver=f"take {take_name}", on_end=done)
         self.playing, self.released = take_name, None
         return {"take": take_name, "seconds": take.gait_seconds}
+
+    def _play_show(self, name: str, seq: Sequence, show: Show) -> dict[str, Any]:
+        """A show take: its stream; the page plays its audio (``show_status``)."""
+        def engine(params: GaitParams) -> GaitEngine:
+            return LayeredEngine(self.robot, params, keyframes=seq, walk=False)
+
+        def done() -> None:
+            self.playing, self.show = None, None
+        self.c.start(engine=engine, driver=f"take {name}", on_end=done)
+        self.playing, self.released, self.show = name, None, show
+        return {"take": name, "seconds": seq.duration}
+
+    def show_status(self) -> dict[str, Any] | None:
+        """The playing show's audio fields and its time [s] (the engine's: 0 at the first
+        tick after the ramp in), for the page that plays the audio; None: no show."""
+        show, streamer = self.show, self.c.streamer
+        if show is None or self.playing is None:
+            return None
+        engine = streamer.engine if streamer is not None and self.c.running else None
+        return {"take": self.playing, "t": engine.time if engine is not None else 0.0,
+                "audio": f"/api/show/audio?take={self.playing}" if show.audio else None,
+                "audio_offset_s": show.audio_offset_s,
+                "cues": [{"t": c.t, "name": c.name} for c in show.cues]}
+
+    def audio_file(self, name: object) -> Path:
+        """The sound file a take's show names (ConfigError if it has none)."""
+        take_name = _name(name, "take")
+        path = self.takes_dir / f"{take_name}{SUFFIX}"
+        if not path.is_file():
+            raise ConfigError(f"take {take_name!r}: not found")
+        audio = show_of(read_take(path).header.show, str(path)).audio_path()
+        if audio is None or not audio.is_file():
+            raise ConfigError(f"take {take_name!r}: no audio file")
+        return audio
 
     # -- posing by hand and keyframes -------------------------------------------------
     def _idle(self) -> None:
@@ -203,5 +242,5 @@ class Studio:
         cap = self._capture
         return {"recording": self.recording, "playing": self.playing,
                 "released": self.released, "limbs": list(limbs(self.robot)),
-                "keyframes": len(cap.times) if cap else 0,
+                "keyframes": len(cap.times) if cap else 0, "show": self.show_status(),
                 "capture_joints": list(cap.joints) if cap else []}

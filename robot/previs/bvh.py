@@ -3,7 +3,8 @@
 The skeleton is the robot's kinematic chain (robot.gait.ik): the pelvis (root), each hip (yaw,
 roll, pitch about one centre), knee (pitch), ankle (pitch, roll) and the sole as its end
 site; a chest at the shoulder height, each shoulder (pitch, roll) and elbow (pitch), the
-hand as the end site. Extra joints (head, ...) have no known geometry and are left out.
+hand as the end site; extra joints (head pan and tilt, a jaw, a tail) where
+robot/config/extra_joints.py lays them out, one bone each.
 
 Axes: BVH's convention, Y up (as Blender's and Maya's importers expect), X to the
 robot's left, Z forward: (X, Y, Z) = (y, z, x) of REP-103. A proper rotation, so angles
@@ -26,6 +27,7 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
+from robot.config.extra_joints import extra_layout, link_length
 from robot.config.robot import RobotConfig
 from robot.gait.ik import leg_fk_full
 
@@ -88,6 +90,13 @@ def skeleton(robot: RobotConfig) -> list[Bone]:
                 Bone(f"{side}_elbow", f"{side}_shoulder", (0.0, 0.0, -g.upper_arm),
                      _three([("y", j(f"{side}_elbow"))]), end=(0.0, 0.0, -g.forearm)),
             ]
+    link = link_length(robot)
+    tip = {"tail": (-link, 0.0, 0.0), "jaw": (link, 0.0, 0.0)}
+    layout = extra_layout(robot)
+    inner = {e.parent for e in layout}
+    bones += [Bone(e.name, e.parent or "pelvis", e.offset, _three([(e.axis, e.name)]),
+                   end=None if e.name in inner else tip.get(e.kind, (0.0, 0.0, link)))
+              for e in layout]
     return bones
 
 

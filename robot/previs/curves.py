@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from robot.config.joint_names import limb_groups
 from robot.gait.expressions import CHANNELS
 
 # Channels grouped by body part, as the paper groups its expressions.
@@ -67,19 +68,23 @@ def curves_figure(times: npt.NDArray[np.float64],
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    legs = [i for i, n in enumerate(joint_names) if "shoulder" not in n and "elbow" not in n]
-    arms = [i for i, n in enumerate(joint_names) if i not in legs]
-    panels = len(CHANNEL_GROUPS) + 1 + (1 if arms else 0)
+    limbs = limb_groups(joint_names)
+    panels = len(CHANNEL_GROUPS) + len(limbs)
     fig, axes = plt.subplots(panels, 1, figsize=(14, 3.2 * panels), sharex=True,
                              layout="constrained")
     for ax, (group, names) in zip(axes, CHANNEL_GROUPS.items(), strict=False):
-        for n, colour in zip(names, palette(len(names)), strict=True):
-            ax.plot(times, channels[n], label=n, lw=1.2, color=colour)
+        for k, (n, colour) in enumerate(zip(names, palette(len(names)), strict=True)):
+            # A channel equal to an earlier one (Atau_L = Atau_R at a straight walk) is
+            # drawn dashed over it and says so, instead of vanishing under it.
+            same = next((m for m in names[:k] if np.allclose(channels[m], channels[n])), None)
+            ax.plot(times, channels[n], "--" if same else "-", lw=2.0 if same else 1.2,
+                    color=colour, label=f"{n} (= {same})" if same else n)
         ax.set_title(group, loc="left", fontsize=10)
         ax.set_ylabel("channel [rig units]")
         outside_legend(ax, n=len(names))
     rest = axes[len(CHANNEL_GROUPS):]
-    for ax, idx, label in zip(rest, (legs, arms), ("leg joints", "arm joints"), strict=False):
+    for ax, (label, members) in zip(rest, limbs, strict=True):
+        idx = [joint_names.index(n) for n in members]
         for i, colour in zip(idx, palette(len(idx)), strict=True):
             ls = "-" if joint_names[i].startswith("r_") else "--"
             ax.plot(times, q[i], ls, label=joint_names[i], lw=1.2, color=colour)
@@ -90,7 +95,9 @@ def curves_figure(times: npt.NDArray[np.float64],
         ax.grid(alpha=0.3)
         ax.set_xlabel("t [s]")
         ax.tick_params(labelbottom=True)
-    fig.suptitle(title)
+    fig.suptitle(f"{title}\nrig units: the paper's Maya rig's lengths and angles, as its "
+                 "equations give them; the robot scales lengths by its leg length "
+                 "(docs/gait.md)", fontsize=10)
     return fig
 
 

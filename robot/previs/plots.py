@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from robot.config.joint_names import limb_groups
 from robot.errors import ConfigError
 from robot.gait.expressions import CHANNELS
 from robot.previs.curves import outside_legend, palette, plot_curves
@@ -59,12 +60,24 @@ def read_table(path: str | Path) -> Table:
         raise ConfigError(f"{path}: file not found") from None
     except (json.JSONDecodeError, UnicodeDecodeError) as e:
         raise ConfigError(f"{path}: not a valid record file: {e}") from e
+    if rows and p.suffix == ".jsonl" and "take" in rows[0]:
+        rows, names = _take_rows(rows)
     if not rows or "t" not in names:
         raise ConfigError(f"{path}: no rows with a 't' column; expected a `biped walk "
                           "--record` or `biped curves` file")
     cols = {n: np.array([_num(r.get(n)) for r in rows]) for n in names if n != "state"}
     states = tuple(str(r.get("state", "")) for r in rows)
     return Table(cols, states, str(p))
+
+
+def _take_rows(rows: list[dict[str, Any]]) -> tuple[list[dict[str, Any]], list[str]]:
+    """A take (robot/motion/takes.py) as record rows: its stream lines' t, state and the
+    commanded angles as cmd_<joint> (a take keeps no read-back)."""
+    joints = rows[0].get("joints") or []
+    out = [{"t": r.get("t"), "state": r.get("state", ""),
+            **{f"cmd_{j}": v for j, v in zip(joints, r.get("q") or [], strict=False)}}
+           for r in rows[1:] if isinstance(r, dict) and "tick" in r]
+    return out, ["t", "state", *(f"cmd_{j}" for j in joints)]
 
 
 def kind_of(table: Table) -> str:
@@ -102,11 +115,17 @@ def record_figure(table: Table) -> Any:
     c = table.columns
     t = c["t"] - c["t"][0]
     names = table.joints("cmd_")
-    legs = [n for n in names if "shoulder" not in n and "elbow" not in n]
-    arms = [n for n in names if n not in legs]
-    groups = [(g, label) for g, label in ((legs, "leg joints"), (arms, "arm joints")) if g]
-    fig, axes = plt.subplots(len(groups) + 3, 1, figsize=(14, 3.0 * (len(groups) + 3)),
-                             sharex=True, layout="constrained")
+    groups = [(g, label) for label, g in limb_groups(names)]
+    limbs = [(f"{side} leg", [n for n in g if n.startswith(s)]) for g, label in groups
+             if label == "leg joints" for side, s in (("right", "r_"), ("left", "l_"))]
+    limbs += [(label.removesuffix(" joints"), g) for g, label in groups if label != "leg joints"]
+    loads = [(label, [n for n in g if f"load_{n}" in c]) for label, g in limbs]
+    loads = [(label, g) for label, g in loads if g] or [("loads", [])]
+    temps = [(label, [n for n in g if f"temp_{n}" in c]) for g, label in groups]
+    temps = [(label, g) for label, g in temps if g] or [("temperatures", [])]
+    panels = len(groups) + 1 + len(temps) + len(loads)
+    fig, axes = plt.subplots(panels, 1, figsize=(14, 3.0 * panels), sharex=True,
+                             layout="constrained")
     for ax, (group, label) in zip(axes, groups, strict=False):
         for n, col in zip(group, palette(len(group)), strict=True):
             ax.plot(t, c[f"cmd_{n}"], "-", color=col, lw=1.1, label=n)
@@ -118,7 +137,13 @@ def record_figure(table: Table) -> Any:
         ax.set_ylabel("angle [rad]")
         outside_legend(ax, n=len(group))
     timing = axes[len(groups)]
-    timing.plot(t, c["period_error_ms"], lw=0.8, color="tab:blue", label="period error")
+    errors = c.get("period_error_ms", np.zeros(len(t)))
+    if not np.any(np.nan_to_num(errors)):   # an unpaced simulation: no wall clock to miss
+        timing.text(0.5, 0.5, "no loop timing: the simulation ran unpaced, faster than real "
+                    "time (run with --realtime to pace it to the wall clock)",
+                    ha="center", va="center", transform=timing.transAxes, fontsize=9,
+                    bbox={"facecolor": "white", "edgecolor": "0.7"}, zorder=5)
+    timing.plot(t, errors, lw=0.8, color="tab:blue", label="period error")
     timing.set_ylabel("period error [ms]")
     if "overruns" in c:
         count = timing.twinx()
@@ -129,17 +154,20 @@ def record_figure(table: Table) -> Any:
         dt = np.diff(t)
         rate = 1.0 / np.median(dt[dt > 0]) if (dt > 0).any() else 0.0
         timing.set_title(f"loop timing (median rate {rate:.0f} Hz, "
-                         f"p99 period error {np.nanpercentile(c['period_error_ms'], 99):.3f} ms)",
+                         f"p99 period error {np.nanpercentile(errors, 99):.3f} ms)",
                          loc="left", fontsize=10)
     timing.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.06, 1.0), borderaxespad=0.0)
-    for ax, prefix, unit in ((axes[-2], "temp_", "temperature [°C]"),
-                             (axes[-1], "load_", "load [% of max torque]")):
-        joints = table.joints(prefix)
+    first = len(groups) + 1
+    panels_of = [(ax, "temp_", f"temperatures: {label}", g, "temperature [°C]")
+                 for ax, (label, g) in zip(axes[first:], temps, strict=False)]
+    panels_of += [(ax, "load_", f"loads: {label}", g, "load [% of max torque]")
+                  for ax, (label, g) in zip(axes[first + len(temps):], loads, strict=True)]
+    for ax, prefix, name, joints, unit in panels_of:
         for n, col in zip(joints, palette(len(joints)), strict=True):
             v = c[f"{prefix}{n}"]
             ok = np.isfinite(v)
             ax.plot(t[ok], v[ok], "-", color=col, lw=1.0, label=n)
-        ax.set_title("temperatures" if prefix == "temp_" else "loads", loc="left", fontsize=10)
+        ax.set_title(name, loc="left", fontsize=10)
         ax.set_ylabel(unit)
         if joints:
             outside_legend(ax, n=len(joints))

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import logging
 
-from robot.bus.base import Bus
+from robot.bus.base import Bus, bus_rate
 from robot.bus.servo_map import ServoMap
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
@@ -23,7 +23,7 @@ def release(robot: RobotConfig, bus: Bus, limb: str) -> tuple[str, ...]:
     smap = ServoMap(robot)
     if len(joints) < len(robot.joints):
         here = PoseMove(robot, smap.from_positions(bus.read_positions(smap.ids)))
-        stats = Streamer(smap, bus, here, hold_at_end=True).run()
+        stats = Streamer(smap, bus, here, rate_hz=bus_rate(bus), hold_at_end=True).run()
         if not stats.holding:
             raise ConfigError(f"could not hold the other joints: {stats.stop_reason}")
     bus.set_torque([robot.joint(j).servo_id for j in joints], enabled=False)

@@ -22,6 +22,9 @@ Scales and where they come from:
   scale per 1 ms (an assumption; Feetech documents neither).
 - Dynamixel AX (e-Manual AX-12A, "Compliance"): no torque within the compliance margin,
   then the output rises to full over the compliance slope [pulses]; cw and ccw averaged.
+- HiWonder/LewanSoul LX: no gain registers and no published position law; full duty at
+  0.05 rad of error is assumed (what the simulation assumed for every servo before it had
+  a model), times the model's ``gain_scale``.
 """
 
 from __future__ import annotations
@@ -41,6 +44,7 @@ X_PROFILE_RPM = 0.229       # e-Manual: Profile Velocity unit [rev/min]
 MX_DUTY_PER_P = 0.158       # Rhoban/bam oscilloscope, MX-64/106 [duty / (P unit rad)]
 STS_DUTY_PER_P = 0.166      # Rhoban/bam oscilloscope, STS3215 [duty / (P unit rad)]
 CYCLE_S = 0.001             # assumed firmware cycle of the D and I terms [s]
+LX_FULL_DUTY_RAD = 0.05     # assumed error at full duty of the LX firmware [rad]
 
 
 class LawTerms(NamedTuple):
@@ -94,8 +98,13 @@ def _ax(model: ServoModel, physics: ServoPhysics, gains: Mapping[str, int]) -> L
     return LawTerms(kp, 0.0, 0.0, margin / tpr, physics.max_velocity)
 
 
+def _lx(model: ServoModel, physics: ServoPhysics, gains: Mapping[str, int]) -> LawTerms:
+    return LawTerms(physics.gain_scale / LX_FULL_DUTY_RAD, 0.0, 0.0, 0.0, physics.max_velocity)
+
+
 LAWS: dict[str, Callable[[ServoModel, ServoPhysics, Mapping[str, int]], LawTerms]] = {
     "dynamixel_x": _x, "dynamixel_mx1": _mx, "feetech_sts": _sts, "dynamixel_ax": _ax,
+    "lx": _lx,
 }
 
 
@@ -113,7 +122,7 @@ def stiffness(model: ServoModel, physics: ServoPhysics, gains: Mapping[str, int]
 LOG_GAIN_REGISTERS: dict[str, tuple[str, ...]] = {
     "dynamixel_x": ("position_p_gain",), "dynamixel_mx1": ("p_gain",),
     "feetech_sts": ("p_coefficient",),
-    "dynamixel_ax": ("cw_compliance_slope", "ccw_compliance_slope"),
+    "dynamixel_ax": ("cw_compliance_slope", "ccw_compliance_slope"), "lx": (),
 }
 
 

@@ -117,9 +117,13 @@ GAIN_SETS: dict[str, GainSet] = {
         Gain("i_coefficient", 0, 254, "eeprom", "position loop integral coefficient",
              f"{_STS}; I coefficient(23)"),
     ),
+    # HiWonder/LewanSoul LX: the Bus Servo Communication Protocol has no gain command (a
+    # position, a move time, limits, offset, load/unload, LED): nothing to set.
+    "lx": _set("lx", "lx"),
 }
 
 
 def describe(gain_set: str) -> str:
     """``name [lo..hi]`` for every gain of ``gain_set``, for messages."""
-    return ", ".join(f"{g.name} [{g.lo}..{g.hi}]" for g in GAIN_SETS[gain_set].gains.values())
+    return (", ".join(f"{g.name} [{g.lo}..{g.hi}]" for g in GAIN_SETS[gain_set].gains.values())
+            or "none (its firmware takes no gains: remove the table)")

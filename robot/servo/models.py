@@ -31,6 +31,9 @@ BAUD_CODES: dict[str, dict[int, int]] = {
     "dynamixel_p1": DYNAMIXEL_P1_BAUD,
     "feetech_sts": FEETECH_STS_BAUD,
 }
+#: Families with one fixed baud rate and no Baud Rate register [bit/s]: the LX servos talk
+#: at 115200 only (LewanSoul "Bus Servo Communication Protocol", 2. UART interface).
+FIXED_BAUD: dict[str, int] = {"lx": 115_200}
 
 
 class ServoModel(NamedTuple):
@@ -88,6 +91,10 @@ _MX1_FACTORY = MappingProxyType({"d_gain": 0, "i_gain": 0, "p_gain": 32})
 #: servo's EPROM as shipped; LeRobot's Feetech bus notes "Default is 32" when it lowers P).
 _STS_FACTORY = MappingProxyType({"p_coefficient": 32, "d_coefficient": 32, "i_coefficient": 0})
 _X_SET, _AX_SET, _MX1_SET, _STS_SET = "dynamixel_x", "dynamixel_ax", "dynamixel_mx1", "feetech_sts"
+#: LX positions 0..1000 cover 0..240 deg (0.24 deg a step): 1001 positions, each 0.24 deg
+#: wide, so ``span_deg`` 240.24 gives exactly 1000 steps per 240 deg.
+_LX_RES, _LX_SPAN = 1001, 240.24
+_KGCM = 9.80665e-2  # N m per kg cm
 
 MODELS: dict[str, ServoModel] = {
     # ROBOTIS XL430-W250-T: 1.4 N m, 57 rpm at 11.1 V; 57.2 g.
@@ -131,6 +138,20 @@ MODELS: dict[str, ServoModel] = {
     # Gains: no STS3032 memory table at hand; taken as the STS3215's (same STS firmware).
     "STS3032": ServoModel("STS3032", 1288, "feetech_sts", 4096, 0.44, (math.pi / 3) / 0.1, 0.017, 6.0,
                           gain_set=_STS_SET, factory_gains=_STS_FACTORY),
+    # HiWonder/LewanSoul LX serial bus servos. The protocol has no model number: ``number``
+    # is biped's own label (scan reports the robot file's model). No gains: the firmware
+    # takes a position and a move time, nothing else (gain set "lx" is empty).
+    # LX-16A (LewanSoul spec sheet): 17 kg cm at 7.4 V (15 at 6.6 V), 0.16 s/60 deg at
+    # 7.4 V (0.18 at 6 V), 52 g, 6-8.4 V.
+    "LX-16A": ServoModel("LX-16A", 16, "lx", _LX_RES, 17 * _KGCM, (math.pi / 3) / 0.16, 0.052, 7.4,
+                         _LX_SPAN, gain_set="lx"),
+    # LX-224 / LX-224HV (HiWonder listings, not a datasheet page: an assumption until one is
+    # at hand): 20 kg cm, 0.20 s/60 deg at 7.4 V (LX-224, 6-8.4 V) and 0.18 s/60 deg at
+    # 11.1 V (LX-224HV, 9-12.6 V); about 60 g.
+    "LX-224": ServoModel("LX-224", 224, "lx", _LX_RES, 20 * _KGCM, (math.pi / 3) / 0.20, 0.060, 7.4,
+                         _LX_SPAN, gain_set="lx"),
+    "LX-224HV": ServoModel("LX-224HV", 2240, "lx", _LX_RES, 20 * _KGCM, (math.pi / 3) / 0.18, 0.060,
+                           11.1, _LX_SPAN, gain_set="lx"),
 }
 
 MODELS_BY_NUMBER: dict[str, dict[int, ServoModel]] = {}
@@ -139,6 +160,7 @@ for _m in MODELS.values():
 
 BUS_FAMILIES: dict[str, str] = {
     "dynamixel": "dynamixel_x", "dynamixel1": "dynamixel_p1", "feetech": "feetech_sts",
+    "lx": "lx",
 }
 
 

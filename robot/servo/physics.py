@@ -120,8 +120,10 @@ def from_datasheet(name: str, law: str, *, stall_torque: float, no_load_speed: f
                  "coulomb": f"{friction_share:.3g} x stall torque, {note}",
                  "viscous": f"{viscous_share:.3g} x kt^2/R, {note}",
                  "nominal_voltage": "datasheet", "max_duty": "datasheet PWM limit",
-                 "gain_scale": "the manual's register scale (no recordings)",
-                 "kd_scale": "the manual's register scale (no recordings)",
+                 "gain_scale": "1: the family's scale as robot/servo/firmware.py states it "
+                               "(no recordings)",
+                 "kd_scale": "1: the family's scale as robot/servo/firmware.py states it "
+                             "(no recordings)",
                  "stribeck": "none (no recordings)", "stribeck_speed": "unused",
                  "load_friction": "none (no recordings)",
                  "max_velocity": "none: the firmware steps to the goal"})

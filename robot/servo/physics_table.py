@@ -9,8 +9,9 @@ Three kinds of entry, best first:
 2. identified by Rhoban/bam on their own recordings, numbers carried over as facts:
    STS3215 at 7.4 V (``bam/params/feetech_sts3215_7_4V/m1.json``).
 3. datasheet stall torque and no-load speed at the nominal voltage (kt and R follow), the
-   family's register scale from the manual, and the gearbox friction as shares of an
-   identified servo of the same kind (named in each source).
+   family's register scale from the manual (an assumption for the LX series, which
+   publishes none), and the gearbox friction as shares of an identified servo of the same
+   kind (named in each source).
 """
 
 from __future__ import annotations
@@ -100,4 +101,9 @@ PHYSICS: dict[str, ServoPhysics] = {
     "STS3215": _STS3215,
     "STS3250": _sheet("STS3250", STS_SHARES, max_duty=0.97),
     "STS3032": _sheet("STS3032", STS_SHARES, max_duty=0.97),
+    # HiWonder/LewanSoul LX: serial-bus hobby servos of the STS3215's class (17-20 kg cm,
+    # metal gears): its gearbox shares.
+    "LX-16A": _sheet("LX-16A", STS_SHARES),
+    "LX-224": _sheet("LX-224", STS_SHARES),
+    "LX-224HV": _sheet("LX-224HV", STS_SHARES),
 }

@@ -18,11 +18,12 @@ import logging
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
+from robot.bus.lx import LxBus
 from robot.bus.sdk_bus import SdkBus
 from robot.bus.tables import RETURN_DELAY_UNIT_S
 from robot.config.robot import SERVO_ID, JointConfig, RobotConfig
 from robot.errors import BusError, ConfigError
-from robot.servo.models import BAUD_CODES, BUS_FAMILIES, model_name
+from robot.servo.models import BAUD_CODES, BUS_FAMILIES, FIXED_BAUD, model_name
 
 log = logging.getLogger(__name__)
 
@@ -30,7 +31,12 @@ FACTORY_ID = 1
 #: Baud rate [bit/s] as shipped: ROBOTIS X series 57600 (Baud Rate(8) = 1), Feetech STS
 #: 1 Mbps (Baud Rate(6) = 0).
 # AX-12A / MX-28 (Protocol 1.0) ship at 1 Mbps (e-Manual AX-12A, Baud Rate(4) initial 1).
-FACTORY_BAUD = {"dynamixel_x": 57_600, "dynamixel_p1": 1_000_000, "feetech_sts": 1_000_000}
+# LX servos have one rate (no Baud Rate register) and find a lone servo by a broadcast
+# ID read (robot/bus/lx.py).
+FACTORY_BAUD = {"dynamixel_x": 57_600, "dynamixel_p1": 1_000_000, "feetech_sts": 1_000_000,
+                **FIXED_BAUD}
+#: The buses setup-motors drives (LX: the same calls, on its own protocol).
+SetupBus = SdkBus | LxBus
 ALL_IDS = range(int(SERVO_ID.lo), int(SERVO_ID.hi) + 1)
 
 
@@ -50,18 +56,18 @@ class Found:
 def baud_order(family: str, robot_baud: int) -> list[int]:
     """The family's standard bauds, most likely first: factory, the robot's, then the rest
     fastest first (hobby setups favour 1 Mbps and up)."""
-    rest = sorted(BAUD_CODES[family].values(), reverse=True)
+    rest = sorted(BAUD_CODES.get(family, {}).values(), reverse=True)
     first = [FACTORY_BAUD[family], robot_baud]
     return list(dict.fromkeys(first + rest))
 
 
-def _shared_id(bus: SdkBus, sid: int, sign: str) -> SetupRefused:
+def _shared_id(bus: SetupBus, sid: int, sign: str) -> SetupRefused:
     return SetupRefused(f"more than one servo answers as id {sid} at {bus.baud} baud on "
                         f"{bus.port_name} ({sign}); nothing was written: connect only the "
                         "servo to set up")
 
 
-def _ping_all(bus: SdkBus, ids: Iterable[int]) -> list[Found]:
+def _ping_all(bus: SetupBus, ids: Iterable[int]) -> list[Found]:
     found = []
     for sid in ids:
         try:
@@ -78,7 +84,7 @@ def _ping_all(bus: SdkBus, ids: Iterable[int]) -> list[Found]:
     return found
 
 
-def _sweep(bus: SdkBus) -> list[Found]:
+def _sweep(bus: SetupBus) -> list[Found]:
     """Every servo at the current baud: a broadcast ping, else one ping per id."""
     try:
         answered = bus.broadcast_ping()
@@ -91,7 +97,7 @@ def _sweep(bus: SdkBus) -> list[Found]:
     return _ping_all(bus, sorted(answered))  # one by one: duplicates collapse in the reply
 
 
-def _try_baud(bus: SdkBus, baud: int) -> bool:
+def _try_baud(bus: SetupBus, baud: int) -> bool:
     """Switch to ``baud``; False (logged) for a rate the SDK cannot set (scservo_sdk has
     no 76800)."""
     try:
@@ -102,7 +108,7 @@ def _try_baud(bus: SdkBus, baud: int) -> bool:
     return True
 
 
-def find_servo(bus: SdkBus, robot: RobotConfig, *,
+def find_servo(bus: SetupBus, robot: RobotConfig, *,
                progress: Callable[[str], None] = log.info) -> Found:
     """The one servo on ``bus`` (open; left at its original baud). SetupRefused when none,
     or more than one, answers."""
@@ -110,7 +116,7 @@ def find_servo(bus: SdkBus, robot: RobotConfig, *,
     original = bus.baud
     try:
         bauds = [b for b in baud_order(family, robot.bus.baud) if _try_baud(bus, b)]
-        skipped = sorted(set(BAUD_CODES[family].values()) - set(bauds))
+        skipped = sorted(set(BAUD_CODES.get(family, {}).values()) - set(bauds))
         progress(f"looking for id {FACTORY_ID} at {', '.join(map(str, bauds))} baud"
                  + (f" ({', '.join(map(str, skipped))}: the SDK cannot set it)" if skipped
                     else ""))
@@ -151,7 +157,7 @@ def check_model(found: Found, robot: RobotConfig, joint: JointConfig) -> None:
             f"a {want.name}, or fix bus.model in {robot.source}")
 
 
-def _write_tolerant(bus: SdkBus, sid: int, name: str, value: int,
+def _write_tolerant(bus: SetupBus, sid: int, name: str, value: int,
                     confirm: Callable[[], bool]) -> None:
     """Write a register whose effect may change how (or whether) the status reply comes
     back (id, baud); a failed reply is fine when ``confirm()`` then sees the change."""
@@ -162,12 +168,12 @@ def _write_tolerant(bus: SdkBus, sid: int, name: str, value: int,
             raise
 
 
-def assign(bus: SdkBus, found: Found, joint: JointConfig, robot: RobotConfig) -> list[str]:
+def assign(bus: SetupBus, found: Found, joint: JointConfig, robot: RobotConfig) -> list[str]:
     """Give the one servo ``found`` the joint's id, the robot's baud and return delay 0;
     verify at the new baud. Returns what changed, in words. ``bus`` is open; it ends at the
     robot's baud."""
     family = BUS_FAMILIES[robot.bus.kind]
-    codes = {b: c for c, b in BAUD_CODES[family].items()}
+    codes = {b: c for c, b in BAUD_CODES.get(family, {}).items()}
     new_id, new_baud = joint.servo_id, robot.bus.baud
     bus.set_baud(found.baud)
     sid = found.id
@@ -178,7 +184,7 @@ def assign(bus: SdkBus, found: Found, joint: JointConfig, robot: RobotConfig) ->
     if lock:
         bus.write_register(sid, "lock", 0)
     changes: list[str] = []
-    delay = bus.read_register(sid, "return_delay_time")
+    delay = bus.read_register(sid, "return_delay_time") if "return_delay_time" in bus.table else 0
     if delay:
         bus.write_register(sid, "return_delay_time", 0)
         us = delay * RETURN_DELAY_UNIT_S[family] * 1e6

@@ -62,14 +62,22 @@ def format_report(knobs: Sequence[Knob], start: GaitParams, best: GaitParams,
     return "\n".join(lines)
 
 
-def plot_study(study: optuna.Study, prefix: str | Path) -> list[Path]:
+#: Fewer finished trials than this: the importance plot says it is a rough guide.
+FEW_TRIALS = 30
+
+
+def plot_study(study: optuna.Study, prefix: str | Path, *,
+               start_score: float | None = None) -> list[Path]:
     """history and importance PNGs at ``prefix``.history.png / .importance.png (the
-    importance needs two finished trials; PED-ANOVA, which needs no scikit-learn)."""
+    importance needs two finished trials; PED-ANOVA, which needs no scikit-learn). The
+    history has whole trial numbers and a line at the starting preset's score; the
+    importance of a handful of trials says how little it rests on."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import optuna.visualization.matplotlib as ovm
+    from matplotlib.ticker import MaxNLocator
 
     out: list[Path] = []
 
@@ -84,11 +92,20 @@ def plot_study(study: optuna.Study, prefix: str | Path) -> list[Path]:
         warnings.simplefilter("ignore")
         ax: Any = ovm.plot_optimization_history(study)
         ax.set_ylabel("score (survived + 0.9 x quality)")
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+        if start_score is not None:
+            ax.axhline(start_score, color="tab:green", ls="--", lw=1.2,
+                       label=f"starting preset ({start_score:.3f})")
+            ax.legend(fontsize=8, loc="lower right")
         save(ax, "history")
         done = study.get_trials(deepcopy=False,
                                 states=(optuna.trial.TrialState.COMPLETE,))
         if len(done) >= 2 and len({t.value for t in done}) > 1:
-            save(ovm.plot_param_importances(
-                study, evaluator=optuna.importance.PedAnovaImportanceEvaluator()),
-                "importance")
+            imp: Any = ovm.plot_param_importances(
+                study, evaluator=optuna.importance.PedAnovaImportanceEvaluator())
+            if len(done) < FEW_TRIALS:
+                imp.set_title(f"Hyperparameter Importances\nonly {len(done)} trials: a rough "
+                              f"guide; below about {FEW_TRIALS} trials the ranking can change "
+                              "with the next few", fontsize=9)
+            save(imp, "importance")
     return out

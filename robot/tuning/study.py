@@ -104,9 +104,11 @@ def objective(plan: Plan) -> Callable[[optuna.Trial], float]:
     return run
 
 
-def work(plan: Plan, worker: int = 0, parent: int | None = None) -> None:
+def work(plan: Plan, worker: int = 0, parent: int | None = None, *,
+         progress: Callable[[int, float | None], None] | None = None) -> None:
     """One worker: trials until the study holds ``plan.trials`` finished ones, or until
-    the process that started it (``parent``) is gone."""
+    the process that started it (``parent``) is gone; ``progress(finished, best score)``
+    after each of its trials (in this process: one job)."""
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     os.environ.setdefault("MUJOCO_GL", "egl")
     logging.getLogger("robot").setLevel(logging.ERROR)
@@ -116,18 +118,24 @@ def work(plan: Plan, worker: int = 0, parent: int | None = None) -> None:
     def orphaned(st: optuna.Study, _trial: optuna.trial.FrozenTrial) -> None:
         if parent is not None and os.getppid() != parent:
             st.stop()
+    def report(st: optuna.Study, _trial: optuna.trial.FrozenTrial) -> None:
+        if progress is not None:
+            top = best_trial(st)
+            progress(finished(st), top.value if top is not None else None)
     if finished(study) < plan.trials:
-        study.optimize(objective(plan), callbacks=[stop, orphaned], gc_after_trial=True)
+        study.optimize(objective(plan), callbacks=[stop, orphaned, report],
+                       gc_after_trial=True)
 
 
 def run_study(plan: Plan, *, jobs: int,
-              progress: Callable[[int], None] | None = None) -> optuna.Study:
+              progress: Callable[[int, float | None], None] | None = None) -> optuna.Study:
     """Run ``jobs`` worker processes (1: in this process) until the study is done;
-    progress(finished trials) about once a second."""
+    progress(finished trials, best score) after each trial (one job) or about once a
+    second (several)."""
     study = open_study(plan)
     study.set_user_attr("knobs", [list(k) for k in plan.knobs])
     if jobs <= 1:
-        work(plan)
+        work(plan, progress=progress)
         return study
     ctx = multiprocessing.get_context("spawn")
     procs = [ctx.Process(target=work, args=(plan, i, os.getpid()), daemon=False)
@@ -137,7 +145,8 @@ def run_study(plan: Plan, *, jobs: int,
     try:
         while any(p.is_alive() for p in procs):
             if progress is not None:
-                progress(finished(study))
+                top = best_trial(study)
+                progress(finished(study), top.value if top is not None else None)
             time.sleep(1.0)
     except KeyboardInterrupt:        # the workers get the same SIGINT and stop too
         for p in procs:

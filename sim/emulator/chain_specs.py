@@ -12,18 +12,25 @@ from dataclasses import dataclass, replace
 
 from robot.config.robot import RobotConfig
 from sim.emulator.control_tables import BAUD_CODES
-from sim.emulator.server import EmulatorError
+from sim.emulator.lx_commands import BAUD as LX_BAUD
+from sim.emulator.records import EmulatorError
 from sim.emulator.servo import ServoSpec
 from sim.emulator.servo_models import MODELS, PROTOCOL_FAMILY
 
-DEFAULT_MODEL = {"dynamixel": "XL430-W250", "dynamixel1": "AX-12A", "feetech": "STS3215"}
+DEFAULT_MODEL = {"dynamixel": "XL430-W250", "dynamixel1": "AX-12A", "feetech": "STS3215",
+                 "lx": "LX-16A"}
 DEFAULT_BAUD = 1_000_000
 # As shipped: ROBOTIS e-Manual XL430-W250 (Baud Rate(8) initial 1 = 57600, Return Delay
 # Time(9) initial 250 = 500 us, ID(7) initial 1); Feetech STS memory table (ID(5) 1, Baud
 # Rate(6) 0 = 1 Mbps, Return Delay Time(7) 0); e-Manual AX-12A (ID(3) 1, Baud Rate(4) 1 =
 # 1 Mbps, Return Delay Time(5) 250 = 500 us).
-FACTORY_BAUD = {"dynamixel": 57_600, "dynamixel1": 1_000_000, "feetech": 1_000_000}
-FACTORY_RETURN_DELAY = {"dynamixel": 250, "dynamixel1": 250, "feetech": 0}
+# LX: one rate, 115200, and no return delay register (sim/emulator/lx_commands.py).
+FACTORY_BAUD = {"dynamixel": 57_600, "dynamixel1": 1_000_000, "feetech": 1_000_000,
+                "lx": LX_BAUD}
+FACTORY_RETURN_DELAY = {"dynamixel": 250, "dynamixel1": 250, "feetech": 0, "lx": 0}
+#: The rates each family's servos listen at [bit/s].
+RATES: dict[str, list[int]] = {**{f: sorted(c.values()) for f, c in BAUD_CODES.items()},
+                               "lx": [LX_BAUD]}
 FACTORY_ID = 1
 
 
@@ -70,10 +77,10 @@ def plan_chain(protocol: str, robot: RobotConfig | None, *, ids: Sequence[int] |
         if robot is None:
             raise EmulatorError("Emulator needs a robot config or ids=[...]")
         ids = robot.ids
-    baud = baud or (robot.bus.baud if robot is not None and same_kind else DEFAULT_BAUD)
-    if baud not in BAUD_CODES[family].values():
-        raise EmulatorError(f"baud: {baud} is not a {protocol} rate; valid: "
-                            f"{sorted(BAUD_CODES[family].values())}")
+    baud = baud or (robot.bus.baud if robot is not None and same_kind else
+                    FACTORY_BAUD[protocol] if family == "lx" else DEFAULT_BAUD)
+    if baud not in RATES[family]:
+        raise EmulatorError(f"baud: {baud} is not a {protocol} rate; valid: {RATES[family]}")
     specs = []
     for sid in ids:
         joint = robot.joint_by_id(sid) if robot is not None and same_kind else None

@@ -28,12 +28,14 @@ class ServoState(Protocol):
     """One servo's table and settings, as the motion and write checks use them.
 
     mem: the control table's bytes; owner: per byte, 0 (no register) or the index + 1 of
-    its register in ``regs``; regs: the table's (name, entry) rows in order.
+    its register in ``regs``; regs: the table's (name, entry) rows in order; frozen: names
+    whose host writes are acknowledged but not stored (an injected fault).
     """
 
     family: str
     model: ServoModel
     stuck: bool
+    frozen: set[str]
     speed_tps: float
     mem: bytearray
     owner: bytearray
@@ -52,7 +54,8 @@ class ServoState(Protocol):
 
 
 def decode_value(family: str, address: int, data: bytes) -> int:
-    """A written value as the log shows it: little-endian, signed for signed registers."""
+    """A written value as the log shows it: little-endian, signed for signed registers
+    (only the X table has any)."""
     signed = family == "dynamixel_x" and any(
         reg.address == address and reg.size == len(data) and name in DXL_SIGNED
         for name, reg in TABLES[family].items())

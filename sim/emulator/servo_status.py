@@ -27,6 +27,9 @@ ERROR_BITS: dict[str, dict[int, str]] = {
     # ERRBIT_ANGLE 2, ERRBIT_OVERHEAT 4, ERRBIT_OVERELE 8, ERRBIT_OVERLOAD 32 agree).
     "feetech_sts": {0: "voltage", 1: "encoder", 2: "overheating", 3: "overcurrent",
                     5: "overload"},
+    # LewanSoul Bus Servo Communication Protocol, Table 3 (LED alarm codes): 1 over
+    # temperature, 2 over voltage, 4 locked rotor. No packet carries them (the LED does).
+    "lx": {0: "overheating", 1: "voltage", 2: "overload"},
 }
 
 #: One step of the Return Delay Time register [s], per family.

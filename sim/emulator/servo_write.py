@@ -11,11 +11,9 @@ on a goal with Torque Enable 0, which Feetech's own examples rely on).
 
 from __future__ import annotations
 
-from sim.emulator.control_tables import BAUD_CODES, INDIRECT_TARGET_RANGE, Entry, read_only
+from sim.emulator.control_tables import BAUD_CODES, INDIRECT_TARGET_RANGE, Entry
 from sim.emulator.servo_state import ServoState, WriteError, decode_value
 
-READ_ONLY: dict[str, frozenset[str]] = {
-    fam: read_only(fam) for fam in ("dynamixel_x", "dynamixel_p1", "feetech_sts")}
 #: Allowed raw values of a few registers [inclusive range]; others accept any value.
 VALID_RANGE: dict[str, tuple[int, int]] = {
     "torque_enable": (0, 1),
@@ -46,7 +44,7 @@ def plan(servo: ServoState, address: int, data: bytes) -> tuple[WriteError, dict
     torque = bool(servo.get("torque_enable"))
     values: dict[str, int] = {}
     for name, reg in touched:
-        if name in READ_ONLY[servo.family]:
+        if reg.access == "R":
             return WriteError.ACCESS, {}
         locked = reg.address < servo.eeprom_end or name.startswith("indirect_address")
         if dxl and locked and torque:
@@ -86,11 +84,14 @@ def check(servo: ServoState, name: str, value: int) -> WriteError:
 
 
 def apply(servo: ServoState, values: dict[str, int]) -> None:
-    """Store planned values (torque stays off while an X servo is in shutdown)."""
+    """Store planned values (torque stays off while an X servo is in shutdown; registers in
+    ``servo.frozen`` keep their value)."""
     shutdown = servo.family == "dynamixel_x" and servo.get("hardware_error_status") != 0
     for name, v in values.items():
         if name == "torque_enable" and shutdown:
             continue  # refused while in shutdown; the status carries the alert bit
+        if name in servo.frozen:
+            continue  # injected fault: acknowledged, not stored (a read-back shows it)
         servo.set(name, v)
     if (servo.family == "feetech_sts" and "goal_position" in values
             and "torque_enable" not in values

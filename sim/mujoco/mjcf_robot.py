@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
+from robot.config.extra_joints import UNIT, extra_axis, extra_layout, link_length
 from robot.config.joint_names import JOINT_NAMES
 from robot.config.robot import RobotConfig
 from sim.mujoco.servo_law import robot_servos
@@ -19,9 +20,8 @@ AXES = {"hip_yaw": "0 0 1", "hip_roll": "1 0 0", "hip_pitch": "0 1 0", "knee": "
         "ankle_pitch": "0 1 0", "ankle_roll": "1 0 0", "shoulder_pitch": "0 1 0",
         "shoulder_roll": "1 0 0", "elbow": "0 1 0"}
 SIDE_Y = {"r": -1.0, "l": 1.0}
-#: Extra joints (head pan, tilt, ...) are modelled as a small servo on top of the torso
-#: turning about z: held at a fixed angle, their axis does not change the walk.
-EXTRA_AXIS = "0 0 1"
+#: Extra joints (head pan, tilt, jaw, tail): placed and turned as robot/config/extra_joints.py
+#: lays them out; each a small servo with a visible link (a head on the last of a neck chain).
 EXTRA_MASS_KG = 0.02
 #: Collision bits: floor/world 1, right leg 2, left leg 4. Legs collide with the floor and
 #: the other leg; torso and arms only with the floor (never parent-child, never same leg).
@@ -87,7 +87,8 @@ def add_defaults(root: ET.Element, robot: RobotConfig) -> None:
             continue
         done.add(cls)
         group = _sub(models[servo.name], "default", class_=cls)
-        _sub(group, "joint", axis=AXES.get(j.name[2:], EXTRA_AXIS),
+        axis = AXES[j.name[2:]] if j.name in JOINT_NAMES else fmt(*UNIT[extra_axis(j.name)])
+        _sub(group, "joint", axis=axis,
              range=fmt(j.min_rad, j.max_rad))
         _sub(group, "position", ctrlrange=fmt(j.min_rad, j.max_rad))
     visual = _sub(top, "default", class_="visual")
@@ -196,12 +197,24 @@ def add_worldbody(root: ET.Element, robot: RobotConfig) -> None:
 def add_extra_joints(torso: ET.Element, robot: RobotConfig, s: float) -> None:
     """One small body per extra joint on top of the torso. Added after the legs and arms,
     so qpos and the actuators follow ``robot.joints`` order."""
-    g = robot.geometry
-    for j in robot.joints:
-        if j.name in JOINT_NAMES:
-            continue
-        b = _body(torso, f"{j.name}_link", (0, 0, g.torso_height + s), j.name, robot)
+    link = link_length(robot)
+    bodies: dict[str, ET.Element] = {}
+    for e in extra_layout(robot):
+        parent = bodies[e.parent] if e.parent else torso
+        b = bodies[e.name] = _body(parent, f"{e.name}_link", e.offset, e.name, robot)
         _inertial(b, EXTRA_MASS_KG, (0, 0, 0), (s / 2, s / 2, s / 2))
+        _sub(b, "geom", class_="visual", type="box", size=fmt(s / 2, s / 2, s / 2),
+             material="servo")
+        if e.kind == "head":
+            _sub(b, "geom", class_="visual", type="box", size=fmt(link, 0.9 * link, 0.8 * link),
+                 pos=fmt(0, 0, link), material="shell")
+        elif e.kind == "jaw":
+            _sub(b, "geom", class_="visual", type="box", size=fmt(0.6 * link, 0.7 * link,
+                                                                  0.15 * link),
+                 pos=fmt(0.5 * link, 0, -0.2 * link), material="link")
+        elif e.kind == "tail":
+            _sub(b, "geom", class_="visual", type="capsule", size=fmt(0.3 * s),
+                 fromto=fmt(0, 0, 0, -link, 0, 0), material="link")
 
 
 def add_actuators_and_sensors(root: ET.Element, robot: RobotConfig) -> None:

@@ -53,6 +53,18 @@ class BodyObservation:
             touching.append(bool(hit.any()))
         return touching[0], touching[1]
 
+    def sole_corners(self) -> list[npt.NDArray[np.float64]]:
+        """World corners (4, 3) [m] of the bottom face of each foot box that touches the
+        ground (as of the last step): the support polygon's points."""
+        out = []
+        for foot, on in zip(self._feet, self.contacts_feet(), strict=True):
+            if on:
+                sx, sy, sz = self.model.geom_size[foot]
+                local = np.array([[x, y, -sz] for x in (-sx, sx) for y in (-sy, sy)])
+                out.append(self.data.geom_xpos[foot] + local @ self.data.geom_xmat[foot]
+                           .reshape(3, 3).T)
+        return out
+
     def render(self, width: int, height: int, camera: str = "track") -> npt.NDArray[np.uint8]:
         """An offscreen RGB frame (height, width, 3) of the current state (needs MUJOCO_GL
         set, e.g. egl, before mujoco is imported). Reuses one renderer per size."""

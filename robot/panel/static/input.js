@@ -74,7 +74,8 @@
   document.addEventListener("keydown", (e) => {
     if (e.key === "Escape") { e.preventDefault(); P.run("keyboard", "/api/estop"); return; }
     const t = e.target;
-    const typing = t && (t.tagName === "INPUT" && t.type !== "checkbox"
+    // A focused slider does not eat the arrows: they steer by the documented steps.
+    const typing = t && (t.tagName === "INPUT" && t.type !== "checkbox" && t.type !== "range"
                          || t.tagName === "SELECT" || t.tagName === "TEXTAREA");
     const key = e.key.length === 1 ? e.key.toLowerCase() : e.key;
     if (typing || e.ctrlKey || e.metaKey || e.altKey || !KEYS[key] || !spec("speed")) return;

@@ -191,10 +191,17 @@ function action(id, path, body, after) {
   $(id).addEventListener("click", () => run(id, path, body ? body() : undefined, after));
 }
 
+// What an action did, in words: the state it answers is the state at that instant (a
+// stopping walk still reads "walking" while it ramps out).
+const DONE = { "/api/start": "started", "/api/stop": "stop requested: ramping out to rest",
+               "/api/estop": "emergency stop: torque off", "/api/reset": "simulation reset" };
+
 async function run(id, path, body, after) {
   try {
     const r = await api("POST", path, body);
-    say(id + ": " + (r.state || r.saved || r.preset || r.take || r.sequence || "ok"));
+    const what = DONE[path] || r.saved || r.preset || (r.take && "playing take " + r.take) ||
+      (r.sequence && "playing sequence " + r.sequence) || "ok";
+    say((id === path.split("/").pop() ? "" : id + ": ") + what);   // "keyboard: ...": who
     if (after) await after(r);
     return r;
   } catch (e) { say(e.message, true); return null; }

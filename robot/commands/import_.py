@@ -1,0 +1,103 @@
+"""`biped import ANIM --out NAME.take.jsonl`: retarget an animation (BVH, or glTF .glb /
+.gltf; ours or Blender's) onto a robot's joints as a take that `biped play` streams.
+
+Bones map to joints by name (the skeleton `biped export` writes), or through ``--map
+MAP.toml`` (bone, axis, sign, offset per joint: robot/previs/bone_map.py). Every joint-limit,
+speed and acceleration violation is listed with its time and joint, then clamped
+(``--strict``: refused, exit 2, nothing written). ``--audio`` names the soundtrack in the
+take (robot/motion/show.py).
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from robot.commands.common import (
+    add_robot_args,
+    bounded_float,
+    checked,
+    input_file,
+    output_file,
+    params_from,
+    robot_from,
+)
+from robot.errors import ConfigError
+from robot.gait.engine import GaitEngine
+from robot.motion.show import Show
+from robot.motion.takes import SUFFIX, is_take
+from robot.previs.bone_map import by_name, load_map
+from robot.previs.importing import SUFFIXES, import_animation, write_stream_take
+from robot.previs.rig import UPS
+
+#: Violations listed in full; the rest are counted.
+SHOWN = 40
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
+    p = sub.add_parser("import", help="retarget a BVH or glTF animation onto the robot as a "
+                                      "take", description=__doc__.split("\n\n")[0])
+    p.add_argument("file", metavar="ANIM", help="animation: .bvh, .glb or .gltf")
+    add_robot_args(p)
+    p.add_argument("--out", required=True, metavar=f"NAME{SUFFIX}", help="the take to write")
+    p.add_argument("--map", default=None, metavar="MAP.toml",
+                   help="bone → joint mapping for a character rigged elsewhere (default: "
+                        "bones named as `biped export` names them)")
+    p.add_argument("--up", choices=sorted(UPS), default=None,
+                   help="the rig's up axis (default: found from the rest pose)")
+    p.add_argument("--strict", action="store_true",
+                   help="refuse the import (exit 2) on any violation instead of clamping")
+    p.add_argument("--rate", type=bounded_float(20.0, 1000.0, "Hz", what="a rate"),
+                   default=200.0, help="lowest control rate of the take [Hz]; the take runs "
+                   "at a whole multiple of the animation's frame rate (default: %(default)s)")
+    p.add_argument("--max-accel", type=bounded_float(1.0, 1e5, "rad/s^2",
+                                                     what="an acceleration"),
+                   default=None, help="acceleration limit [rad/s^2] (default: each joint's "
+                                      "max speed reached in 50 ms)")
+    p.add_argument("--audio", default=None, metavar="SOUND",
+                   help="soundtrack of the show (a path relative to the take)")
+    p.add_argument("--audio-offset", type=float, default=0.0, metavar="SECONDS",
+                   help="show time [s] at which the audio starts (default: 0)")
+    p.set_defaults(set=[])
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    checked("ANIM", input_file, args.file)
+    checked("--out", output_file, args.out)
+    if Path(args.file).suffix.lower() not in SUFFIXES:
+        raise ConfigError(f"ANIM {args.file}: expected a {', '.join(SUFFIXES)} animation")
+    if not is_take(args.out):
+        raise ConfigError(f"--out {args.out}: a take's name ends in {SUFFIX}")
+    robot = robot_from(args)
+    bone_map = load_map(checked("--map", input_file, args.map), robot) if args.map \
+        else by_name(robot)
+    _, params = params_from(args, robot)
+    hold = np.asarray(GaitEngine(robot, params).start_pose())
+    got = import_animation(args.file, robot, bone_map, hold, up=args.up,
+                           min_rate=args.rate, max_accel=args.max_accel)
+    frames = got.frames
+    for v in got.violations[:SHOWN]:
+        print(f"violation: {v.line()}")
+    if len(got.violations) > SHOWN:
+        print(f"... and {len(got.violations) - SHOWN} more violations")
+    if got.violations and args.strict:
+        first = got.violations[0]
+        raise ConfigError(f"{args.file}: {len(got.violations)} violations (--strict); first: "
+                          f"{first.joint} {first.kind} at t={first.t_worst:.3f} s")
+    show = Show(stream=True, audio=args.audio, audio_offset_s=args.audio_offset,
+                up=frames.up, travel_m=tuple(float(v) for v in frames.travel[-1]))  # type: ignore[arg-type]
+    write_stream_take(args.out, robot, params, got, show,
+                      note=f"imported from {Path(args.file).name}")
+    held = [n for n in robot.joint_names if n not in frames.animated]
+    fwd, left, _ = frames.travel[-1]
+    fps = 1.0 / (frames.t[1] - frames.t[0]) if len(frames.t) > 1 else 0.0
+    print(f"wrote {args.out}: {len(frames.t)} frames at {fps:g} fps → {len(got.t)} ticks at "
+          f"{got.rate_hz:g} Hz on {robot.name}; up {frames.up}; "
+          f"{len(frames.animated)} joints animated"
+          + (f", {len(held)} held ({', '.join(held)})" if held else "")
+          + f"; root travel {fwd:+.3f} m forward, {left:+.3f} m left; "
+          f"{len(got.violations)} violations" + (" clamped" if got.violations else ""))
+    return 0

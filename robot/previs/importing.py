@@ -1,0 +1,94 @@
+"""`biped import` without the command line: an animation file (BVH, glTF) → the robot's
+joint stream at the control rate, its violations, and the take that `biped play` streams.
+
+The stream's rate is the smallest whole multiple of the animation's frame rate at or
+above ``min_rate`` (every frame is a tick: a round trip compares frame for frame);
+between frames the joints follow the monotone cubic through them (robot/motion/interp.py
+``smooth``: no overshoot, so no limit is crossed that the frames do not cross).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from robot.config.params import GaitParams
+from robot.config.robot import RobotConfig
+from robot.errors import ConfigError
+from robot.motion.interp import smooth
+from robot.motion.show import Show
+from robot.motion.takes import TakeHeader
+from robot.previs.bone_map import BoneMap
+from robot.previs.bvh_read import read_bvh
+from robot.previs.gltf_read import read_gltf
+from robot.previs.retarget import Retargeted, retarget
+from robot.previs.rig import Array, Rig
+from robot.previs.violations import Violation, check, clamp
+
+SUFFIXES = (".bvh", ".glb", ".gltf")
+#: Highest take rate [Hz] (robot.motion.takes accepts up to 2000).
+MAX_RATE_HZ = 2000.0
+
+
+def read_rig(path: str | Path) -> Rig:
+    suffix = Path(path).suffix.lower()
+    if suffix not in SUFFIXES:
+        raise ConfigError(f"{path}: expected a {', '.join(SUFFIXES)} animation")
+    return read_bvh(path) if suffix == ".bvh" else read_gltf(path)
+
+
+@dataclass(frozen=True)
+class Imported:
+    """The frames as retargeted (``frames``), the stream at ``rate_hz`` before (``raw``)
+    and after the clamp (``q``) at times ``t`` [s], and the violations of ``raw``."""
+
+    frames: Retargeted
+    rate_hz: float
+    t: Array
+    raw: Array
+    q: Array
+    violations: tuple[Violation, ...]
+
+
+def stream_rate(frame_s: float, min_rate: float) -> float:
+    fps = 1.0 / frame_s
+    rate = fps * max(1, math.ceil(min_rate / fps - 1e-9))
+    if rate > MAX_RATE_HZ:
+        raise ConfigError(f"animation at {fps:g} fps: a stream of {rate:g} Hz is above "
+                          f"{MAX_RATE_HZ:g} Hz; give a lower --rate")
+    return rate
+
+
+def import_animation(path: str | Path, robot: RobotConfig, bone_map: BoneMap, hold: Array,
+                     *, up: str | None = None, min_rate: float = 200.0,
+                     max_accel: float | None = None) -> Imported:
+    rig = read_rig(path)
+    frames = retarget(rig, robot, bone_map, hold, up=up)
+    rate = stream_rate(rig.frame_s, min_rate)
+    n = int(round(frames.t[-1] * rate)) + 1
+    t = np.arange(n) / rate
+    raw = smooth(frames.t, frames.q, t) if len(frames.t) > 1 else frames.q[:1].copy()
+    found = check(robot, t, raw, max_accel=max_accel, joints=frames.animated)
+    q = clamp(robot, t, raw, max_accel=max_accel) if found else raw
+    return Imported(frames, rate, t, raw, q, tuple(found))
+
+
+def write_stream_take(path: str | Path, robot: RobotConfig, params: GaitParams,
+                      imported: Imported, show: Show, *, note: str = "") -> None:
+    """The take: a header with the show (``stream``: play the joint angles as they are)
+    and one stream line per tick [rad, 8 decimals]."""
+    header = TakeHeader(robot=robot.name, robot_file=robot.source,
+                        joints=robot.joint_names, rate_hz=imported.rate_hz, read_every=10,
+                        gait="import", params=params, note=note, show=show.as_json())
+    lines = [json.dumps(header.as_json())]
+    for k, (t, row) in enumerate(zip(imported.t.tolist(), imported.q.tolist(), strict=True)):
+        lines.append(json.dumps({"tick": k, "t": round(t, 9), "state": "show",
+                                 "q": [round(v, 8) for v in row]}))
+    try:
+        Path(path).write_text("\n".join(lines) + "\n")
+    except OSError as e:
+        raise ConfigError(f"--out {path}: cannot write it: {e.strerror or e}") from None

@@ -22,9 +22,10 @@ Scales and where they come from:
   scale per 1 ms (an assumption; Feetech documents neither).
 - Dynamixel AX (e-Manual AX-12A, "Compliance"): no torque within the compliance margin,
   then the output rises to full over the compliance slope [pulses]; cw and ccw averaged.
-- HiWonder/LewanSoul LX: no gain registers and no published position law; full duty at
-  0.05 rad of error is assumed (what the simulation assumed for every servo before it had
-  a model), times the model's ``gain_scale``.
+- HiWonder/LewanSoul LX: no gain registers and no published position law; assumed is what
+  the simulation ran for every servo before it had a model: full duty at 0.05 rad of
+  error (times the model's ``gain_scale``) and a D term of 0.03 s (kd / kp, times
+  ``kd_scale``), which critically damped the old simulated LX-16A.
 """
 
 from __future__ import annotations
@@ -45,6 +46,7 @@ MX_DUTY_PER_P = 0.158       # Rhoban/bam oscilloscope, MX-64/106 [duty / (P unit
 STS_DUTY_PER_P = 0.166      # Rhoban/bam oscilloscope, STS3215 [duty / (P unit rad)]
 CYCLE_S = 0.001             # assumed firmware cycle of the D and I terms [s]
 LX_FULL_DUTY_RAD = 0.05     # assumed error at full duty of the LX firmware [rad]
+LX_D_S = 0.03               # assumed kd / kp of the LX firmware [s]
 
 
 class LawTerms(NamedTuple):
@@ -99,7 +101,8 @@ def _ax(model: ServoModel, physics: ServoPhysics, gains: Mapping[str, int]) -> L
 
 
 def _lx(model: ServoModel, physics: ServoPhysics, gains: Mapping[str, int]) -> LawTerms:
-    return LawTerms(physics.gain_scale / LX_FULL_DUTY_RAD, 0.0, 0.0, 0.0, physics.max_velocity)
+    kp = physics.gain_scale / LX_FULL_DUTY_RAD
+    return LawTerms(kp, kp * LX_D_S * physics.kd_scale, 0.0, 0.0, physics.max_velocity)
 
 
 LAWS: dict[str, Callable[[ServoModel, ServoPhysics, Mapping[str, int]], LawTerms]] = {

@@ -109,6 +109,10 @@ MODELS: dict[str, ServoModel] = {
     # Gains: e-Manual XC430-W150 RAM table, Position D 0 / I 0 / P 460.
     "XC430-W150": ServoModel("XC430-W150", 1070, "dynamixel_x", 4096, 1.6, 70 * _RPM, 0.065, 12.0,
                              gain_set=_X_SET, factory_gains=_x(0, 0, 460)),
+    # ROBOTIS e-Manual XL330-M288-T: 0.52 N m (5.0 V, 1.47 A), 103 rpm (5.0 V), 18 g; model
+    # number 1200. Gains: e-Manual XL330-M288 RAM table, Position D 0 / I 0 / P 400.
+    "XL330-M288": ServoModel("XL330-M288", 1200, "dynamixel_x", 4096, 0.52, 103 * _RPM, 0.018, 5.0,
+                             gain_set=_X_SET, factory_gains=_x(0, 0, 400)),
     # ROBOTIS e-Manual AX-12A: 1.5 N m (12 V, 1.5 A), 59 rpm (12 V), 54.6 g; 0..300 deg in
     # 1024 steps (0.29 deg); model number 12.
     "AX-12A": ServoModel("AX-12A", 12, "dynamixel_p1", 1024, 1.5, 59 * _RPM, 0.0546, 12.0, 300.0,
@@ -123,6 +127,13 @@ MODELS: dict[str, ServoModel] = {
     # Feetech STS3215 (7.4 V): 19.5 kg cm = 1.91 N m, 0.222 s/60 deg; 55 g.
     "STS3215": ServoModel("STS3215", 777, "feetech_sts", 4096, 1.91, (math.pi / 3) / 0.222, 0.055, 7.4,
                           gain_set=_STS_SET, factory_gains=_STS_FACTORY),
+    # Feetech STS3250 (12 V): 50 kg cm = 4.90 N m, 0.133 s/60 deg (Feetech datasheet, doc.
+    # 6384135881578380868917773 A/0); model number 2825 (lerobot's Feetech table); mass not
+    # in that datasheet: 60 g estimated (the STS3215's 55 g case with a metal shell).
+    # Gains: taken as the STS3215's (same STS firmware; the public STS3250 recordings ran at
+    # P 32).
+    "STS3250": ServoModel("STS3250", 2825, "feetech_sts", 4096, 4.90, (math.pi / 3) / 0.133, 0.060,
+                          12.0, gain_set=_STS_SET, factory_gains=_STS_FACTORY),
     # Feetech STS3032: 4.5 kg cm = 0.44 N m, 0.1 s/60 deg at 6 V; 17 g.
     # Gains: no STS3032 memory table at hand; taken as the STS3215's (same STS firmware).
     "STS3032": ServoModel("STS3032", 1288, "feetech_sts", 4096, 0.44, (math.pi / 3) / 0.1, 0.017, 6.0,

@@ -86,6 +86,29 @@ NO_TRIM = BodyTrim()
 TURN_RANGE = (SPECS["turn"].lo, SPECS["turn"].hi)
 
 
+#: 5-DoF legs (no hip yaw) steer by step length: for ``turn`` [rad/step] the right stride
+#: grows and the left one shrinks by STRIDE_TURN x turn x the half gap of the feet [m], a
+#: differential drive's share (1: the stride difference that turns a wheeled robot of that
+#: track by ``turn`` per step), at most STRIDE_TURN_MAX x the stride.
+STRIDE_TURN = float(__import__("os").environ.get("ST", "1.0"))
+STRIDE_TURN_MAX = float(__import__("os").environ.get("STM", "0.5"))
+#: ... and by hip roll: the sway turns round this much earlier over the outer foot [rad
+#: of sway phase per rad/step of turn].
+TURN_SWAY = float(__import__("os").environ.get("TS", "0.0"))
+
+
+PY0 = float(__import__("os").environ.get("PY0", "0.0"))
+PYS = float(__import__("os").environ.get("PYS", "0.0"))
+
+
+def stride_turn(turn: Num, half_w: Num, stride: Num) -> Num:
+    """The stride change [m] of 5-DoF steering for ``turn`` [rad/step], feet ``half_w``
+    [m] either side of the pelvis, a stride amplitude ``stride`` [m]."""
+    d = STRIDE_TURN * turn * half_w
+    lim = STRIDE_TURN_MAX * stride
+    return lim if d > lim else -lim if d < -lim else d
+
+
 def scale(g: Geometry, p: GaitParams) -> float:
     """Metres per rig unit."""
     return g.leg_length / p.rig_leg
@@ -108,7 +131,14 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
     hip_h = p.stance * g.leg_length + g.ankle_height + s * ch["RightUpLeg_tY"]
     px = s * 0.5 * (ch["RightUpLeg_tZ"] + ch["LeftUpLeg_tZ"])
     yaw = s * (ch["RightUpLeg_tZ"] - ch["LeftUpLeg_tZ"]) / g.hip_width if leg_yaw else 0.0
-    py = p.sway * (sin_t * xm.cos(p.sway_phase) - tz * xm.sin(p.sway_phase))
+    turn = (p.turn if trim.turn == 0.0
+            else min(max(p.turn + trim.turn, TURN_RANGE[0]), TURN_RANGE[1]))
+    if leg_yaw or turn == 0.0:
+        py = p.sway * (sin_t * xm.cos(p.sway_phase) - tz * xm.sin(p.sway_phase))
+    else:   # 5-DoF steering, hip roll: the sway's turn-around earlier over one foot
+        sway_phase = p.sway_phase + TURN_SWAY * turn * sin_t
+        py = p.sway * (sin_t * xm.cos(sway_phase) - tz * xm.sin(sway_phase))
+        py = py + PY0 * turn + PYS * turn * sin_t
     pitch = p.torso_lean + trim.pitch + p.spine_gain * (ch["StZ_ik"] - ch["CtZ"])
     pelvis_rot = xm.rz_ry(yaw, pitch)
     if trim.roll != 0.0:
@@ -130,13 +160,18 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
              -hip_h + lift_l * down)
     w_r = xm.clip(ty, 0.0, 1.0) * down
     w_l = xm.clip(ty_l, 0.0, 1.0) * down
-    turn = (0.0 if not leg_yaw else p.turn if trim.turn == 0.0
-            else min(max(p.turn + trim.turn, TURN_RANGE[0]), TURN_RANGE[1]))
-    yaw_r = -0.5 * turn * tz
-    yaw_l = 0.5 * turn * tz
+    yaw_turn = turn if leg_yaw else 0.0
+    yaw_r = -0.5 * yaw_turn * tz
+    yaw_l = 0.5 * yaw_turn * tz
     r_rot = xm.rz_ry(yaw_r, -p.toe_gain * ch["RightToe_tY"] * w_r)
     l_rot = xm.rz_ry(yaw_l, -p.toe_gain * ch["LeftToe_tY"] * w_l)
-    if turn != 0.0:
+    if not leg_yaw and turn != 0.0:
+        # 5-DoF steering, step length: the right stride longer by ``dx`` and the left
+        # shorter for a left turn (both feet x - tz * dx).
+        dx = stride_turn(turn, half_w, s * 0.5 * (p.Slgt_R + p.Slgt_L)) * tz
+        r_pos = (r_pos[0] - dx, r_pos[1], r_pos[2])
+        l_pos = (l_pos[0] - dx, l_pos[1], l_pos[2])
+    if yaw_turn != 0.0:
         # Turning: the body rotates about its own vertical axis over the planted foot, so
         # each foot's position turns with its yaw too (otherwise it would have to slip).
         r_pos = _yawed(r_pos, yaw_r)

@@ -28,7 +28,9 @@ class ServoState(Protocol):
     """One servo's table and settings, as the motion and write checks use them.
 
     mem: the control table's bytes; owner: per byte, 0 (no register) or the index + 1 of
-    its register in ``regs``; regs: the table's (name, entry) rows in order.
+    its register in ``regs``; regs: the table's (name, entry) rows in order; table: name ->
+    entry; horn: where the horn actually is [ticks, before any offset, several turns in
+    the multi-turn modes]; step_target: where STS step mode takes it [ticks, actual].
     """
 
     family: str
@@ -38,6 +40,9 @@ class ServoState(Protocol):
     mem: bytearray
     owner: bytearray
     regs: list[tuple[str, Entry]]
+    table: dict[str, Entry]
+    horn: float
+    step_target: float
     eeprom_end: int
     watchdog: BusWatchdog | None
 
@@ -49,6 +54,10 @@ class ServoState(Protocol):
     def set(self, name: str, value: int) -> None: ...
 
     def set_raw(self, name: str, value: int) -> None: ...
+
+    def within_turn(self, ticks: float) -> float: ...
+
+    def hold(self) -> None: ...
 
 
 def decode_value(family: str, address: int, data: bytes) -> int:

@@ -141,9 +141,15 @@ def test_missing_servo_is_named_never_stale(bus: SdkBus, emu: Emulator,
     emu.set_faults(missing_ids=[7])
     with pytest.raises(BusError, match=r"id 7 \(l_hip_yaw\).*check power and wiring of id 7"):
         bus.read_state(robot.ids)
-    with pytest.raises(BusError, match=r"id 7 \(l_hip_yaw\): write torque_enable"):
+    # Torque on writes the gains first: a servo whose gains cannot be verified stops it
+    # before any servo takes torque.
+    with pytest.raises(BusError, match=r"id 7 \(l_hip_yaw\): read gains"):
         bus.set_torque(robot.ids, enabled=True)
-    assert emu.registers(8)["torque_enable"] == 1  # the others were still enabled
+    assert emu.registers(8)["torque_enable"] == 0
+    bus.set_torque([i for i in robot.ids if i != 7], enabled=True)
+    with pytest.raises(BusError, match=r"id 7 \(l_hip_yaw\): write torque_enable"):
+        bus.set_torque(robot.ids, enabled=False)
+    assert emu.registers(8)["torque_enable"] == 0  # the others were still disabled
     emu.clear_faults()
     assert len(bus.read_state(robot.ids)) == len(robot.ids)
 

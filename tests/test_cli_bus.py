@@ -31,6 +31,15 @@ def only_bus_commands(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(cli, "COMMANDS", ("scan", "torque", "pose"))
 
 
+#: Goal Position address, from the manuals (XL430-W250 116; STS3215 42).
+GOAL_ADDRESS = {"dynamixel": 116, "feetech": 42}
+
+
+def goal_writes(emu: Emulator) -> list:
+    return [p for p in emu.log() if p.instruction == "sync_write"
+            and p.address == GOAL_ADDRESS[emu.protocol]]
+
+
 def bus_args(emu: Emulator, robot_toml: Path) -> list[str]:
     return ["--bus", emu.protocol, "--port", emu.port, "--robot", str(robot_toml)]
 
@@ -83,7 +92,7 @@ def test_pose_rest_ramps_within_slew_and_ends_at_rest(
     assert cli.main(["pose", "rest", *bus_args(emu, robot_toml), "--speed", str(speed),
                      "--rate", str(rate)]) == 0
     assert "torque left ON" in capsys.readouterr().out
-    writes = [p for p in emu.log() if p.instruction == "sync_write"]
+    writes = goal_writes(emu)      # (torque on also sync-writes the gains first)
     assert len(writes) > 20
     ticks = np.array([[p.values[i] for i in robot.ids] for p in writes])
     assert np.array_equal(ticks[0], [2048] * len(robot.ids))  # starts where it stood
@@ -103,7 +112,7 @@ def test_pose_ctrl_c_stops_and_holds(emu: Emulator, robot: RobotConfig,
     proc = subprocess.Popen(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env={**os.environ, "MUJOCO_GL": "egl"})
     def knee_goal() -> int:
-        writes = [p for p in emu.log() if p.instruction == "sync_write"]
+        writes = goal_writes(emu)
         return writes[-1].values[4] if writes else 2048
 
     rest_knee = ServoMap(robot).goals(ServoMap(robot).vector(robot.rest).tolist())[4]

@@ -189,3 +189,47 @@ def test_servo_models_match_the_datasheets(name: str, number: int, resolution: i
     assert (m.number, m.resolution, m.span_deg) == (number, resolution, span_deg)
     assert m.no_load_speed * 60 / (2 * math.pi) == pytest.approx(rpm, rel=1e-9)
     assert m.ticks_per_rad == pytest.approx(resolution / (span_deg * math.pi / 180))
+
+
+# --------------------------------------------------------------------------------------
+# Gain registers: the driver's (robot/bus/tables.py GAIN_REGISTERS, robot/servo/models.py
+# factory values) against the emulator's transcription of each model's manual table.
+
+
+#: The models with a control table (the LX servos have commands instead, and no gains).
+TABLE_MODELS = sorted(n for n, m in driver_models.MODELS.items() if m.family in manual.TABLES)
+
+
+@pytest.mark.parametrize("name", TABLE_MODELS)
+def test_gain_registers_and_factory_values_match_the_models_manual_table(name: str) -> None:
+    ours = driver_models.MODELS[name]
+    emulated = models.MODELS[name]
+    table = manual.TABLES[emulated.layout]
+    for gain, reg in driver.GAIN_REGISTERS[ours.gain_set].items():
+        assert gain in table, f"{name}: {gain} is not in its manual table"
+        assert (reg.address, reg.size) == table[gain][:2], f"{name}: {gain}"
+        assert table[gain].access == "RW", f"{name}: {gain}"
+    servo = EmulatedServo(ServoSpec(1, name, 2048, 0, ours.resolution - 1, 1_000_000), 0.0)
+    assert {g: servo.get(g) for g in ours.factory_gains} == dict(ours.factory_gains), name
+
+
+def test_sts_gains_live_in_eeprom_and_x_ax_mx_gains_in_ram() -> None:
+    from robot.servo.gains import GAIN_SETS
+
+    for name in TABLE_MODELS:
+        m = models.MODELS[name]
+        end = manual.EEPROM_END[m.layout]
+        gain_set = GAIN_SETS[driver_models.MODELS[name].gain_set]
+        for gain, g in gain_set.gains.items():
+            in_eeprom = manual.TABLES[m.layout][gain].address < end
+            assert in_eeprom == (g.memory == "eeprom"), (name, gain)
+
+
+def test_mx28_table_has_pid_where_the_ax_has_compliance() -> None:
+    mx, ax = manual.TABLES["dynamixel_mx1"], manual.TABLES["dynamixel_p1"]
+    assert [mx[n][:2] for n in ("d_gain", "i_gain", "p_gain")] == [(26, 1), (27, 1), (28, 1)]
+    assert [ax[n][:2] for n in ("cw_compliance_margin", "ccw_compliance_margin",
+                                "cw_compliance_slope", "ccw_compliance_slope")] == [
+        (26, 1), (27, 1), (28, 1), (29, 1)]
+    assert not {"cw_compliance_slope", "ccw_compliance_slope"} & set(mx)
+    assert (mx["p_gain"].initial, mx["baud_rate"].initial) == (32, 34)   # 34 = 57600

@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from robot.bus import lx_packet, lx_wire
-from robot.bus.tables import ERROR_BITS, LX_ALARM_BITS, LX_BROADCAST_ID, LX_COMMANDS
+from robot.bus.lx_tables import LX_ALARM_BITS, LX_BROADCAST_ID, LX_COMMANDS
+from robot.bus.tables import ERROR_BITS
 from robot.config.bundled import ROBOTS_DIR
 from robot.config.robot_file import load_robot
 from robot.errors import ConfigError

@@ -202,7 +202,7 @@ def test_live_table_refreshes_in_place_on_a_terminal(emu: Emulator, robot: Robot
     reader.join(5)  # the rest of the output, up to the terminal's hang-up
     os.close(master)
     out = b"".join(chunks).decode()
-    lines_per_table = 2 + len(robot.ids) + 1  # title, header, joints, summary
+    lines_per_table = 2 + len(robot.ids) + 2  # title, header, joints, gains, summary
     assert out.count(f"\x1b[{lines_per_table}F\x1b[J") >= 3
     assert out.count("r_knee ") == out.count("\x1b[J") + 1
     assert_limp_and_no_goal(emu, robot)

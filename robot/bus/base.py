@@ -10,6 +10,10 @@ from abc import ABC, abstractmethod
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from types import TracebackType
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from robot.bus.wire_time import TickWire
 
 
 @dataclass(frozen=True)
@@ -119,6 +123,22 @@ class Bus(ABC):
         allows (an emergency, or a bus that stopped answering); confirm with
         ``set_torque(ids, enabled=False)`` while the bus answers. Default: ``set_torque``."""
         self.set_torque(ids, enabled=False)
+
+    #: The servos' longest return delay as measured when the bus opened [s] (0: unknown).
+    return_delay_s: float = 0.0
+
+    def tick_wire(self, read_every: int) -> TickWire | None:
+        """What one control tick puts on the wire (robot.bus.wire_time), reading the state
+        back every ``read_every`` ticks; None for buses without a serial wire (this
+        default)."""
+        return None
+
+    def read_gains(self, servo_id: int, *, model: int | None = None) -> dict[str, int] | None:
+        """The position-control gain registers of ``servo_id`` [register values, named as in
+        robot/servo/gains.py], by its joint's servo model (else by ``model``, its model
+        number); None when the model is unknown or the bus has no gain registers (this
+        default, for buses without them)."""
+        return None
 
     def read_positions(self, ids: Iterable[int]) -> dict[int, int]:
         """Present positions [ticks] of ``ids``."""

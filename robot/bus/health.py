@@ -126,6 +126,7 @@ def check(bus: SdkRegisters) -> list[str]:
                             "wiring (and ids with `biped scan`)")
         for sid in present:
             raw = bus.read_register(sid, "return_delay_time")
+            bus.return_delay_s = max(bus.return_delay_s, raw * RETURN_DELAY_UNIT_S[bus.family])
             if raw:
                 warnings.append(return_delay_warning(bus, sid, raw))
     for w in warnings:

@@ -3,7 +3,7 @@
 No vendor Python package is worth depending on (checked: ``pylx16a`` 1.1.1, last release
 2022-04; ``lewansoul-lx16a`` 0.1, 2019; ``lx16a`` 0.0.2, 2020; ``lewanlib`` 0.1.1; HiWonder
 ships its Python only as scripts inside its robots' images), and the protocol is small:
-``robot.bus.lx_packet`` frames it, ``robot.bus.tables.LX_COMMANDS`` holds the commands.
+``robot.bus.lx_packet`` frames it, ``robot.bus.lx_tables.LX_COMMANDS`` holds the commands.
 
 What the protocol makes different from the other buses (docs/hardware.md, "LX servos"):
 
@@ -34,9 +34,9 @@ from robot.bus.limits import TickLimits
 from robot.bus.lx_packet import encode, value, word
 from robot.bus.lx_port import LX_VALUES, LxPort
 from robot.bus.lx_status import LxStatus
+from robot.bus.lx_tables import LX_BAUD, LX_BROADCAST_ID
 from robot.bus.lx_wire import check_rate, max_rate_hz
 from robot.bus.sdk_port import PORT_ERRORS, READ_BLOCK_S
-from robot.bus.tables import LX_BAUD, LX_BROADCAST_ID
 from robot.config.robot import RobotConfig
 from robot.errors import BusError
 from robot.servo.models import MODELS

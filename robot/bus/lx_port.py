@@ -17,8 +17,8 @@ from typing import NamedTuple
 import serial
 
 from robot.bus.lx_packet import ReplyParser, encode, value
+from robot.bus.lx_tables import LX_BAUD, LX_BROADCAST_ID, LX_COMMANDS
 from robot.bus.sdk_port import PORT_ERRORS
-from robot.bus.tables import LX_BAUD, LX_BROADCAST_ID, LX_COMMANDS
 from robot.config.robot import RobotConfig
 from robot.errors import BusError
 

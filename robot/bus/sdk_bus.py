@@ -13,15 +13,16 @@ import time
 from collections.abc import Iterable, Mapping
 from typing import Any, ClassVar
 
-from robot.bus import failsafe, health
+from robot.bus import failsafe, gain_writer, health, rate_check
 from robot.bus.base import Bus, ServoInfo, ServoState
 from robot.bus.limits import TickLimits
 from robot.bus.sdk_port import PORT_ERRORS
 from robot.bus.sdk_registers import SdkRegisters
 from robot.bus.sync_read import BlockSyncRead, Reply
 from robot.bus.tables import COMM_WATCHDOG, RETURN_DELAY_UNIT_S
+from robot.bus.wire_time import TickWire, tick_wire
 from robot.config.robot import RobotConfig
-from robot.servo.models import model_name
+from robot.servo.models import MODELS_BY_NUMBER, model_name
 
 log = logging.getLogger(__name__)
 
@@ -51,6 +52,7 @@ class SdkBus(SdkRegisters, Bus):
         self._reader = BlockSyncRead(self.sdk, first.address,
                                      last.address + last.size - first.address)
         self._writer: Any = None
+        self._gains_done: set[int] = set()   # ids whose gains were written since open()
 
     # ------------------------------------------------------------------ hooks
     def _make_packet_handler(self) -> Any:
@@ -65,6 +67,8 @@ class SdkBus(SdkRegisters, Bus):
             return
         port = self.port_class(self.port_name)
         port.timeout_ms = self.timeout_ms
+        self._gains_done.clear()
+        self.return_delay_s = 0.0       # measured again by the health check
         self._port = port
         self._ph = self._make_packet_handler()
         self.set_baud(self.baud)
@@ -178,18 +182,38 @@ class SdkBus(SdkRegisters, Bus):
     def release(self, ids: Iterable[int]) -> None:
         """Torque off on ``ids`` in one sync write (no status reply to wait for)."""
         ids = sorted(set(ids))
-        if not ids:
-            return
-        reg = self.table["torque_enable"]
-
-        def send() -> tuple[None, int, int]:
-            group = self.sdk.GroupSyncWrite(self._port, self._ph, reg.address, reg.size)
-            for sid in ids:
-                group.addParam(sid, [0])
-            return None, group.txPacket(), 0
-
-        self._transact("sync write torque_enable=0", None, send)
+        self.sync_write(self.table["torque_enable"], dict.fromkeys(ids, 0), "torque_enable=0")
         self._torqued.difference_update(ids)
+
+    def set_torque(self, ids: Iterable[int], *, enabled: bool) -> None:
+        """Torque on or off; before the first torque-on of a servo since ``open()``, its
+        gains from the robot file are written and verified (robot.bus.gain_writer)."""
+        ids = sorted(set(ids))
+        pending = [sid for sid in ids if sid not in self._gains_done] if enabled else []
+        if pending:
+            gain_writer.apply(self, pending)
+            self._gains_done.update(pending)
+        super().set_torque(ids, enabled=enabled)
+
+    def max_rate_hz(self, *, read_every: int) -> float | None:
+        wire = self.tick_wire(read_every)
+        return None if wire is None else wire.max_rate_hz
+
+    def check_rate(self, rate_hz: float, *, read_every: int) -> None:
+        rate_check.check_rate(self, rate_hz, read_every)
+
+    def tick_wire(self, read_every: int) -> TickWire | None:
+        if self.robot is None:
+            return None
+        return tick_wire(self.family, servos=len(self.robot.ids), baud=self.baud,
+                         goal_size=self._goal_size, block_size=self._reader.length,
+                         read_every=read_every)
+
+    def read_gains(self, servo_id: int, *, model: int | None = None) -> dict[str, int] | None:
+        joint = self.robot.joint_by_id(servo_id) if self.robot else None
+        servo = (self.robot.servo(joint) if self.robot and joint else
+                 MODELS_BY_NUMBER.get(self.family, {}).get(model if model is not None else -1))
+        return None if servo is None else gain_writer.read(self, servo_id, servo.gain_set)
 
     def write_goals(self, goals: Mapping[int, int]) -> None:
         if not goals:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from types import ModuleType
 from typing import Any, ClassVar
 
@@ -34,6 +34,8 @@ class SdkRegisters:
     kind: str
     family: ClassVar[str]
     sdk: ClassVar[ModuleType]
+    #: The servos' longest return delay, as the health check read it on open [s].
+    return_delay_s: float = 0.0
 
     def __init__(self, port: str, *, baud: int, robot: RobotConfig | None = None,
                  retries: int | None = None, timeout_ms: float | None = None) -> None:
@@ -161,16 +163,41 @@ class SdkRegisters:
     def read_register(self, sid: int, name: str) -> int:
         """Unsigned value of register ``name`` of servo ``sid``."""
         reg = self.table[name]
-        data, _ = self._transact(f"read {name}", sid, lambda: self._ph.readTxRx(
-            self._port, sid, reg.address, reg.size))
-        return int.from_bytes(bytes(data[:reg.size]), "little")
+        return int.from_bytes(self.read_bytes(sid, reg.address, reg.size, name), "little")
+
+    def read_bytes(self, sid: int, address: int, length: int, what: str) -> bytes:
+        """``length`` bytes of servo ``sid``'s control table from ``address`` (one read);
+        ``what`` names them in errors."""
+        data, _ = self._transact(f"read {what}", sid, lambda: self._ph.readTxRx(
+            self._port, sid, address, length))
+        if data is None or len(data) < length:
+            raise self._error(sid, f"read {what}", f"short reply ({len(data or [])} of "
+                              f"{length} bytes)", self.sdk.COMM_RX_CORRUPT)
+        return bytes(data[:length])
 
     def write_register(self, sid: int, name: str, value: int) -> None:
         """Write register ``name`` of servo ``sid`` and wait for its status reply."""
-        reg = self.table[name]
+        self.write_at(sid, self.table[name], value, name)
+
+    def write_at(self, sid: int, reg: Register, value: int, what: str) -> None:
+        """Write ``value`` to ``reg`` of servo ``sid`` and wait for its status reply."""
         data = list(int(value).to_bytes(reg.size, "little", signed=value < 0))
-        self._transact(f"write {name}={value}", sid, lambda: (None, *self._ph.writeTxRx(
+        self._transact(f"write {what}={value}", sid, lambda: (None, *self._ph.writeTxRx(
             self._port, sid, reg.address, reg.size, data)))
+
+    def sync_write(self, reg: Register, values: Mapping[int, int], what: str) -> None:
+        """One sync-write packet: ``values[id]`` (unsigned) to ``reg`` of every listed servo
+        (no status reply: verify by reading back)."""
+        if not values:
+            return
+
+        def send() -> tuple[None, int, int]:
+            group = self.sdk.GroupSyncWrite(self._port, self._ph, reg.address, reg.size)
+            for sid, v in values.items():
+                group.addParam(sid, list(int(v).to_bytes(reg.size, "little")))
+            return None, group.txPacket(), 0
+
+        self._transact(f"sync write {what}", None, send)
 
     # ------------------------------------------------------------------ Bus API
     def ping(self, servo_id: int) -> int | None:

@@ -10,6 +10,7 @@ from typing import Any
 SECTIONS: dict[str, str] = {
     "core": "robot.bench.core:run_core_bench",
     "bus": "robot.bench.core:run_bus_section",
+    "wire": "robot.bench.wire:run_wire_bench",
     "loop": "robot.bench.loop:run_loop_bench",
     "sim": "robot.bench.sim:run_sim_bench",
     "panel": "robot.bench.panel:run_panel_bench",

@@ -14,6 +14,7 @@ import argparse
 import json
 import sys
 import time
+from collections.abc import Mapping
 from typing import Any
 
 from robot.bus.base import Bus
@@ -87,10 +88,11 @@ class _Screen:
 
 
 def _frame(robot: RobotConfig, sm: ServoMap, bus: Bus, *, t: float, title: str,
-           as_json: bool, strict: bool) -> list[str]:
+           as_json: bool, strict: bool,
+           gains: Mapping[int, Mapping[str, int] | None] | None = None) -> list[str]:
     """One refresh as output lines; a BusError becomes an error line unless ``strict``."""
     try:
-        table = rows(robot, sm, bus.read_state(sm.ids))
+        table = rows(robot, sm, bus.read_state(sm.ids), gains=gains)
     except BusError as e:
         if strict:
             raise
@@ -114,13 +116,14 @@ def run(args: argparse.Namespace) -> int:
         bus.open()
         try:
             bus.set_torque(sm.ids, enabled=False)
+            gains = {sid: bus.read_gains(sid) for sid in sm.ids}   # read once: they hold
             if args.once:
                 title = f"{robot.name} on {bus.kind} {port}: torque OFF"
                 for line in _frame(robot, sm, bus, t=0.0, title=title, as_json=args.json,
-                                   strict=True):
+                                   strict=True, gains=gains):
                     print(line)
             else:
-                _loop(robot, sm, bus, args, port, stopper)
+                _loop(robot, sm, bus, args, port, stopper, gains)
         finally:
             bus.close(torque_off=True)  # torque off once more (writes torque_enable only)
     if not (args.json or args.once):
@@ -129,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _loop(robot: RobotConfig, sm: ServoMap, bus: Bus, args: argparse.Namespace, port: str,
-          stopper: _Stop) -> None:
+          stopper: _Stop, gains: Mapping[int, Mapping[str, int] | None]) -> None:
     screen = _Screen(in_place=sys.stdout.isatty() and not args.json)
     period = 1.0 / args.rate
     start = deadline = time.monotonic()
@@ -137,7 +140,8 @@ def _loop(robot: RobotConfig, sm: ServoMap, bus: Bus, args: argparse.Namespace, 
         t = time.monotonic() - start
         title = (f"{robot.name} on {bus.kind} {port}: torque OFF, move the joints by hand "
                  f"(Ctrl-C to exit)  t={t:.1f} s")
-        lines = _frame(robot, sm, bus, t=t, title=title, as_json=args.json, strict=False)
+        lines = _frame(robot, sm, bus, t=t, title=title, as_json=args.json, strict=False,
+                       gains=gains)
         if args.json:
             print(lines[0], flush=True)
         else:

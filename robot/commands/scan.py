@@ -16,6 +16,7 @@ from robot.config.bundled import DEFAULT_ROBOT, ROBOTS_DIR
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from robot.errors import BusError
+from robot.setup.monitor_table import gains_lines
 
 log = logging.getLogger(__name__)
 
@@ -44,11 +45,12 @@ def _robot(args: argparse.Namespace) -> RobotConfig:
     return load_robot(DEFAULT_ROBOT)
 
 
-def _row(info: ServoInfo, robot: RobotConfig) -> dict[str, object]:
+def _row(info: ServoInfo, robot: RobotConfig,
+         gains: dict[str, int] | None = None) -> dict[str, object]:
     joint = robot.joint_by_id(info.id)
     return {"id": info.id, "model": info.model, "model_name": info.model_name,
             "firmware": info.firmware, "return_delay_us": info.return_delay_us,
-            "baud": info.baud, "joint": joint.name if joint else None}
+            "baud": info.baud, "joint": joint.name if joint else None, "gains": gains}
 
 
 def run(args: argparse.Namespace) -> int:
@@ -64,21 +66,24 @@ def run(args: argparse.Namespace) -> int:
             changed = health.fix_return_delay(bus, [s.id for s in found])
             log.warning("return delay set to 0 on ids %s", changed or "none (all were 0)")
             found = bus.scan([s.id for s in found])
+        gains = {s.id: bus.read_gains(s.id, model=s.model) for s in found}
     except BusError:
         bus.close(torque_off=False)
         raise
     bus.close(torque_off=False)
-    rows = [_row(info, robot) for info in found]
+    rows = [_row(info, robot, gains[info.id]) for info in found]
     seen = {r["id"] for r in rows}
     incomplete = 1 if any(j.servo_id not in seen for j in robot.joints) else 0
     if args.json:
         print(json.dumps(rows))
         return incomplete
-    _print_table(rows, robot, bus_name=f"{bus.kind} {args.port or robot.bus.port}")
+    _print_table(rows, robot, bus_name=f"{bus.kind} {args.port or robot.bus.port}",
+                 gains_text=gains_lines({f"id {sid}": g for sid, g in gains.items()}))
     return incomplete   # exit 1: a joint of the robot file did not answer
 
 
-def _print_table(rows: list[dict[str, object]], robot: RobotConfig, *, bus_name: str) -> None:
+def _print_table(rows: list[dict[str, object]], robot: RobotConfig, *, bus_name: str,
+                 gains_text: list[str]) -> None:
     print(f"{len(rows)} servo(s) on {bus_name}:")
     print(f"{'id':>4}  {'model':<18} {'fw':>4} {'delay':>8}  joint ({robot.name})")
     for r in rows:
@@ -86,6 +91,7 @@ def _print_table(rows: list[dict[str, object]], robot: RobotConfig, *, bus_name:
         delay = f"{r['return_delay_us']:.0f} µs" if r["return_delay_us"] is not None else "?"
         joint = r["joint"] or "(not in robot config)"
         print(f"{r['id']:>4}  {model:<18} {r['firmware'] or '?':>4} {delay:>8}  {joint}")
+    print("\n".join(gains_text))
     seen = {r["id"] for r in rows}
     missing = [j for j in robot.joints if j.servo_id not in seen]
     if missing:

@@ -131,8 +131,8 @@ class Streamer(Generic[SourceT]):
             self.bus.write_goals(self.map.goals(q0.tolist()))  # no snap to a stale goal
             self.bus.set_torque(ids, enabled=True)
             self._q_last = q0
-            self._next = self.clock.now()
             arm_failsafe(self.bus, ids, self.watchdog_config.failsafe_s, dt=self.dt)
+            self._next = self.clock.now()     # after arming: its packets take wire time
             self._stream(seconds)
         except SafetyStop as e:                  # the watchdog: unsafe or impossible to drive
             self._bus_dead = isinstance(e, BusDead)

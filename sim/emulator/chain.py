@@ -11,8 +11,9 @@ adapter and talk Dynamixel Protocol 2.0 (``sim.emulator.dxl_protocol``) or Feete
   termios; the child holds the slave open and reads that speed (``TCGETS2``) at every
   packet. A servo whose ``baud_rate`` register names another rate does not hear the packet
   (counted as ``baud_mismatch``), so "wrong baud: nothing answers" is testable.
-- Replies come back as fast as the pty allows (no wire-time emulation) after each servo's
-  return delay (``return_delay_time`` x 2 us). A missing servo costs the SDK its timeout.
+- Wire time (``sim.emulator.line``): a reply reaches the host when a real 8N1 line would
+  have carried it: after the instruction's bytes, the servo's return delay and its own
+  bytes at the baud rate, one talker at a time. A missing servo costs the SDK its timeout.
 - Hardware faults: Dynamixel X latches ``hardware_error_status`` until reboot and drops
   torque (shutdown), every status packet then carries the alert bit 0x80; Feetech's
   ``status`` register follows the injected condition live and is the reply's error byte.
@@ -35,9 +36,8 @@ adapter and talk Dynamixel Protocol 2.0 (``sim.emulator.dxl_protocol``) or Feete
   would garble the overlapping replies; here the host sees both).
 - Closing the port (``set_faults(close_port=True)``) makes the SDK's next call raise
   (``termios.error``/``SerialException``, EIO) and leaves ``PortHandler.is_using`` set.
-- dynamixel_sdk 4.1 does not byte-stuff what it sends (``addStuffing``'s result is
-  dropped when the packet grows); the emulator's parser still reads such packets by length.
-  Replies are stuffed, and the SDK unstuffs them.
+- dynamixel_sdk 4.1 does not byte-stuff what it sends; the parser reads such packets by
+  length. Replies are stuffed, and the SDK unstuffs them.
 """
 
 from __future__ import annotations
@@ -59,8 +59,8 @@ from typing import Any
 from robot.config.robot import RobotConfig
 from sim.emulator.chain_specs import FACTORY_BAUD, FACTORY_ID, factory_servos, plan_chain
 from sim.emulator.control_tables import BAUD_CODES, TABLES
-from sim.emulator.server import ChainSpec, EmulatorError, Packet
-from sim.emulator.servo_models import PROTOCOL_FAMILY
+from sim.emulator.records import ChainSpec, EmulatorError, Packet
+from sim.emulator.servo_models import MODELS, PROTOCOL_FAMILY
 from sim.emulator.servo_status import ERROR_BITS
 
 __all__ = ["ChainSpec", "Emulator", "EmulatorError", "Packet"]
@@ -68,7 +68,6 @@ __all__ = ["ChainSpec", "Emulator", "EmulatorError", "Packet"]
 log = logging.getLogger(__name__)
 
 ROOT = Path(__file__).resolve().parents[2]  # puts `sim` and `robot` on the child's path
-
 REPLY_TIMEOUT_S = 5.0        # control-channel answer [s]
 START_TIMEOUT_S = 20.0       # child start-up [s]
 
@@ -207,6 +206,7 @@ class Emulator:
                    vanish: Mapping[int, float] | None = None,
                    hw_error: Mapping[int, str | None] | None = None,
                    stuck_ids: Iterable[int] | None = None,
+                   frozen: Mapping[int, Iterable[str]] | None = None,
                    close_port: bool = False) -> None:
         """Change faults while serving; unspecified ones keep their setting.
 
@@ -216,6 +216,7 @@ class Emulator:
         "voltage" | ... (names in servo_status.ERROR_BITS) or None to end the condition;
         stuck_ids: ids whose horn is jammed from now on (they answer, take goals and
         report no error, but do not move; replaces the set);
+        frozen: id → registers that acknowledge writes but keep their value ([]: ends it);
         close_port: close the pty (the SDK then gets an error; the log stays readable).
         """
         for name, rate in (("drop_rate", drop_rate), ("corrupt_rate", corrupt_rate)):
@@ -233,6 +234,7 @@ class Emulator:
             "vanish_at": {sid: now + t for sid, t in (vanish or {}).items()},
             "hw_error": dict(hw_error or {}), "close_port": close_port,
             "stuck_ids": None if stuck_ids is None else list(stuck_ids),
+            "frozen": {sid: self._check_names(names) for sid, names in (frozen or {}).items()},
         })
 
     def clear_faults(self) -> None:
@@ -277,10 +279,16 @@ class Emulator:
 
     def set_register(self, servo_id: int, name: str, value: int) -> None:
         """Store a register without the checks a host write gets (e.g. return_delay_time)."""
-        if self.family in TABLES and name not in TABLES[self.family]:   # LX: checked there
-            raise EmulatorError(f"register {name!r} is not in the {self.family} table; "
-                                f"valid: {', '.join(TABLES[self.family])}")
+        self._check_names([name])
         self._call("set_register", servo_id, name, int(value))
+
+    def _check_names(self, names: Iterable[str]) -> list[str]:
+        """``names``, each in some servo's control table (LX: none, its servo checks)."""
+        valid = {n for s in self.spec.servos for n in TABLES.get(MODELS[s.model].layout, ())}
+        if self.family in TABLES and (bad := [n for n in names if n not in valid]):
+            raise EmulatorError(f"register {bad[0]!r} is not in the {self.family} tables; "
+                                f"valid: {', '.join(sorted(valid))}")
+        return list(names)
 
     def set_baud(self, baud: int) -> None:
         """Make every servo listen at ``baud`` [bit/s] (writes their baud_rate register)."""

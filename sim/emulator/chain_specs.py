@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 from robot.config.robot import RobotConfig
 from sim.emulator.control_tables import BAUD_CODES
 from sim.emulator.lx_commands import BAUD as LX_BAUD
-from sim.emulator.server import EmulatorError
+from sim.emulator.records import EmulatorError
 from sim.emulator.servo import ServoSpec
 from sim.emulator.servo_models import MODELS, PROTOCOL_FAMILY
 

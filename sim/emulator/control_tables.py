@@ -12,6 +12,9 @@ or 0). EEPROM is every address below ``EEPROM_END`` (saved over power-off), RAM 
 - Dynamixel Protocol 1.0: ROBOTIS e-Manual, AX-12A control table
   (https://emanual.robotis.com/docs/en/dxl/ax/ax-12a/#control-table); Baud Rate(4) is
   2000000 / (value + 1) bps.
+- MX-28 on Protocol 1.0 firmware: ROBOTIS e-Manual, MX-28 control table
+  (https://emanual.robotis.com/docs/en/dxl/mx/mx-28/#control-table): the AX layout with
+  D/I/P Gain at 26/27/28 where the AX has compliance margins and slopes.
 - Feetech STS: Feetech "STS series memory table" (FT-SMS-STS-emanual, STS3215 column);
   Torque switch(40) takes 0, 1 and 128 ("arbitrary current position correction to 2048").
 """
@@ -141,6 +144,26 @@ DYNAMIXEL_AX: dict[str, Entry] = {
     "punch": Entry(48, 2, "RW", 32),
 }
 
+_AX_GAINS = ("cw_compliance_margin", "ccw_compliance_margin", "cw_compliance_slope",
+             "ccw_compliance_slope")
+DYNAMIXEL_MX1: dict[str, Entry] = {
+    **{n: e for n, e in DYNAMIXEL_AX.items() if n not in _AX_GAINS},
+    # e-Manual MX-28 where it differs from the AX-12A: EEPROM
+    "baud_rate": Entry(4, 1, "RW", 34),              # 34 = 57600 bps
+    "ccw_angle_limit": Entry(8, 2, "RW", 4095),
+    "temperature_limit": Entry(11, 1, "RW", 80),
+    "max_voltage_limit": Entry(13, 1, "RW", 160),
+    "multi_turn_offset": Entry(20, 2, "RW", 0),
+    "resolution_divider": Entry(22, 1, "RW", 1),
+    # RAM: PID Gains (26, 27, 28): 0 ~ 254; Kd = D * 4 / 1000, Ki = I * 1000 / 2048, Kp = P / 8
+    "d_gain": Entry(26, 1, "RW", 0),
+    "i_gain": Entry(27, 1, "RW", 0),
+    "p_gain": Entry(28, 1, "RW", 32),
+    "punch": Entry(48, 2, "RW", 0),
+    "realtime_tick": Entry(50, 2, "R", 0),
+    "goal_acceleration": Entry(73, 1, "RW", 0),
+}
+
 FEETECH_STS: dict[str, Entry] = {
     # EEPROM (0-39): saved only while Lock(55) is 0.
     "firmware_major": Entry(0, 1, "R", None),
@@ -205,10 +228,14 @@ FEETECH_STS: dict[str, Entry] = {
     "acceleration_multiplier": Entry(86, 1, "RW", None),   # in effect when Acceleration is 0
 }
 
+#: Control tables by layout: a family's own (its key), or a model's where it differs
+#: ("dynamixel_mx1": servo_models.ServoModel.table).
 TABLES: dict[str, dict[str, Entry]] = {
     "dynamixel_x": DYNAMIXEL_X, "dynamixel_p1": DYNAMIXEL_AX, "feetech_sts": FEETECH_STS,
+    "dynamixel_mx1": DYNAMIXEL_MX1,
 }
-EEPROM_END: dict[str, int] = {"dynamixel_x": 64, "dynamixel_p1": 24, "feetech_sts": 40}
+EEPROM_END: dict[str, int] = {"dynamixel_x": 64, "dynamixel_p1": 24, "feetech_sts": 40,
+                              "dynamixel_mx1": 24}
 
 #: Values where the manual prints "-" (firmware, sensors, tuning the factory sets per
 #: unit): what this emulator reports. The manual's initial values are in the tables.
@@ -217,6 +244,8 @@ UNPRINTED: dict[str, dict[str, int]] = {
                     "present_temperature": 35},
     "dynamixel_p1": {"firmware_version": 24, "present_voltage": 120,
                      "present_temperature": 35, "torque_limit": 1023, "moving_speed": 0},
+    "dynamixel_mx1": {"firmware_version": 36, "present_voltage": 120,
+                      "present_temperature": 35, "torque_limit": 1023, "moving_speed": 0},
     "feetech_sts": {"firmware_major": 3, "firmware_minor": 10, "max_voltage_limit": 140,
                     "p_coefficient": 32, "d_coefficient": 32, "present_voltage": 74,
                     "present_temperature": 35},
@@ -251,6 +280,6 @@ DXL_VELOCITY_UNIT_RPM = 0.229
 STS_SPEED_UNIT_TICKS_S = 1.0
 
 
-def read_only(family: str) -> frozenset[str]:
-    """Names the manual marks "R"."""
-    return frozenset(n for n, e in TABLES[family].items() if e.access == "R")
+def read_only(layout: str) -> frozenset[str]:
+    """Names the manual marks "R" (``layout``: a key of TABLES)."""
+    return frozenset(n for n, e in TABLES[layout].items() if e.access == "R")

@@ -8,69 +8,39 @@ a socketpair end carrying ``multiprocessing`` Connection messages: first the
 
 from __future__ import annotations
 
-import array
 import collections
-import fcntl
+import gc
 import os
 import random
 import select
 import signal
 import time
 import tty
-from dataclasses import dataclass, field
 from multiprocessing.connection import Connection
 from types import ModuleType
 from typing import Any
 
-from robot.errors import BipedError
 from sim.emulator import dxl1_protocol, dxl_protocol, lx_protocol, sts_protocol
-from sim.emulator.servo import EmulatedServo, ServoSpec
+from sim.emulator.line import Line, Outbox, pty_speed
+from sim.emulator.records import ChainSpec, EmulatorError, Packet
+from sim.emulator.servo import EmulatedServo
+
+__all__ = ["ChainSpec", "EmulatorError", "Packet", "child_main"]
 
 LOG_MAX = 200_000            # packets kept in the child
+#: Packets between two ``gc.freeze()`` calls: the log's records are never garbage, and a
+#: full collection that walks 200,000 of them stalls replies by tens of ms.
+FREEZE_EVERY = 2000
 QUIET_POLL_S = 0.005         # idle wake-up [s]: how fresh ``quiet_at`` stays (see serve)
-TCGETS2 = 0x802C542A         # Linux ioctl: struct termios2 (44 bytes), c_ospeed at word 10
-TERMIOS2_WORDS = 11
-TERMIOS2_OSPEED = 10
+DEFAULT_BAUD = 1_000_000     # [bit/s] when neither the pty nor the servos name a rate
 COUNTER_KEYS = ("rx_bytes", "tx_bytes", "rx_packets", "tx_packets", "rx_bad_checksum",
-                "dropped", "corrupted", "baud_mismatch", "tx_overflow")
-
-
-class EmulatorError(BipedError):
-    """The emulator was misused or its child process failed."""
-
-
-@dataclass(frozen=True)
-class Packet:
-    """One received instruction packet.
-
-    t: reception time [s, time.monotonic()]; instruction: "ping", "read", "write",
-    "reboot", "sync_read", "sync_write", "fast_sync_read", "bulk_read", ...; ids: target
-    ids in packet order; address: start address (None for ping/reboot/bulk); values:
-    written value per id (writes), start address per id (bulk read), else empty;
-    length: data length [bytes] where the instruction has one.
-    """
-
-    t: float
-    instruction: str
-    ids: tuple[int, ...]
-    address: int | None
-    values: dict[int, int] = field(default_factory=dict)
-    length: int | None = None
+                "dropped", "corrupted", "baud_mismatch", "tx_overflow", "cancelled",
+                "late_max_us", "late_over_1ms")
 
 
 #: Wire protocol codec per bus kind.
 CODECS: dict[str, ModuleType] = {"dynamixel": dxl_protocol, "dynamixel1": dxl1_protocol,
                                  "feetech": sts_protocol, "lx": lx_protocol}
-
-
-@dataclass(frozen=True)
-class ChainSpec:
-    """The chain to serve; ``plugged``: indices into ``servos`` on the bus (None: all)."""
-
-    protocol: str
-    servos: tuple[ServoSpec, ...]
-    seed: int = 0
-    plugged: tuple[int, ...] | None = None
 
 
 class _ChainServer:
@@ -93,6 +63,9 @@ class _ChainServer:
         self.missing: set[int] = set()
         self.vanish: dict[int, float] = {}
         self.quiet_at = now      # the last time the line was seen empty [s]
+        self.line = Line()
+        self.outbox = Outbox()
+        self.frozen_at = 0       # rx_packets at the last gc.freeze()
         master, slave = os.openpty()
         tty.setraw(slave)
         os.set_blocking(master, False)
@@ -111,24 +84,25 @@ class _ChainServer:
 
     def port_speed(self) -> int | None:
         """The baud rate [bit/s] the host configured on the slave, if readable."""
-        if self.slave is None:
-            return None
-        buf = array.array("I", [0] * TERMIOS2_WORDS)
-        try:
-            fcntl.ioctl(self.slave, TCGETS2, buf)
-        except OSError:
-            return None
-        return int(buf[TERMIOS2_OSPEED]) or None
+        return None if self.slave is None else pty_speed(self.slave)
 
     # ------------------------------------------------------------------ wire
-    def on_bytes(self, data: bytes) -> None:
+    def on_bytes(self, data: bytes, now: float) -> None:
+        """Bytes from the host, read at ``now`` [s]: execute each complete packet and
+        schedule its replies after the wire time of the bytes and the return delays."""
         self.counters["rx_bytes"] += len(data)
         before = self.parser.bad_checksum
         frames = self.parser.feed(data)
         self.counters["rx_bad_checksum"] += self.parser.bad_checksum - before
+        speed = self.port_speed()
+        baud = float(speed or self.servos[0].baud or DEFAULT_BAUD)
+        if self.outbox.next_at is not None:
+            # The host talks before the replies it asked for are out: it gave up on them
+            # (a timeout, a bad reply). The rest of the chain stays silent.
+            self.counters["cancelled"] += self.outbox.clear()
+            self.line.free_at = now
+        self.line.instruction(now, len(data), baud)
         for servo_id, inst, params in frames:
-            now = time.monotonic()
-            speed = self.port_speed()
             present = [s for i, s in enumerate(self.servos) if i in self.plugged
                        and s.servo_id not in self.missing
                        and self.vanish.get(s.servo_id, float("inf")) > now]
@@ -136,8 +110,9 @@ class _ChainServer:
             if present and not listening:
                 self.counters["baud_mismatch"] += 1
                 continue
-            for s in listening:
-                s.update(now, quiet_until=self.quiet_at)
+            for s in listening:     # motion is lazy: bring the addressed servos to now
+                if servo_id in (s.servo_id, self.codec.BROADCAST_ID):
+                    s.update(now, quiet_until=self.quiet_at)
             # Servos sharing an id all execute the packet and all answer (on a real bus
             # their replies collide); each layer holds at most one servo per id.
             layers: list[dict[int, EmulatedServo]] = []
@@ -159,29 +134,38 @@ class _ChainServer:
             self.counters[h.instruction] = self.counters.get(h.instruction, 0) + 1
             self.log.append(Packet(now, h.instruction, h.ids, h.address, h.values, h.length))
             for r in (r for hl in handled for r in hl.replies):
-                self.send(r.data, r.delay_s)
+                self.schedule(r.data, r.delay_s, baud)
 
-    def send(self, data: bytes, delay_s: float) -> None:
+    def schedule(self, data: bytes, delay_s: float, baud: float) -> None:
+        """Queue one status packet: lost or garbled as the faults say, else released when
+        its last byte would reach the host (``line.Line.reply``)."""
         if self.rng.random() < self.drop_rate:
             self.counters["dropped"] += 1
             return
         if self.rng.random() < self.corrupt_rate:
             self.counters["corrupted"] += 1
             data = data[:-1] + bytes([data[-1] ^ 0xFF])   # the checksum / CRC high byte
-        if delay_s > 0:
-            time.sleep(delay_s)
-        if self.master is None:
-            return
-        try:
-            n = os.write(self.master, data)
-        except (BlockingIOError, OSError):
-            n = 0
-        if n < len(data):
-            self.counters["tx_overflow"] += 1
-        self.counters["tx_bytes"] += n
-        self.counters["tx_packets"] += 1
+        self.outbox.put(self.line.reply(delay_s, len(data), baud), data)
+
+    def release(self, now: float) -> None:
+        """Write every reply due at ``now`` [s] to the host; count how late [µs]."""
+        for at, data in self.outbox.due(now):
+            if self.master is None:
+                return
+            late_us = round((time.monotonic() - at) * 1e6)
+            self.counters["late_max_us"] = max(self.counters["late_max_us"], late_us)
+            self.counters["late_over_1ms"] += late_us > 1000
+            try:
+                n = os.write(self.master, data)
+            except (BlockingIOError, OSError):
+                n = 0
+            if n < len(data):
+                self.counters["tx_overflow"] += 1
+            self.counters["tx_bytes"] += n
+            self.counters["tx_packets"] += 1
 
     def close_port(self) -> None:
+        self.outbox.clear()
         for fd in (self.master, self.slave):
             if fd is not None:
                 os.close(fd)
@@ -198,6 +182,7 @@ class _ChainServer:
             for s in self.servos:
                 s.conditions.clear()
                 s.stuck = False
+                s.frozen = set()
             return None
         if cmd == "log":
             out = list(self.log)
@@ -244,6 +229,8 @@ class _ChainServer:
         if f.get("stuck_ids") is not None:
             for s in self.servos:
                 self.advance(s).stuck = s.servo_id in f["stuck_ids"]
+        for sid, names in (f.get("frozen") or {}).items():
+            self.by_id(sid).frozen = set(names)
         for sid, kind in (f.get("hw_error") or {}).items():
             s = self.by_id(sid)
             s.conditions = {kind} if kind else set()
@@ -255,18 +242,24 @@ class _ChainServer:
         self.conn.send(("ready", self.path))
         while True:
             fds: list[Any] = [self.conn] + ([self.master] if self.master is not None else [])
-            readable, _, _ = select.select(fds, [], [], QUIET_POLL_S)
+            due = self.outbox.next_at
+            wait = QUIET_POLL_S if due is None else min(QUIET_POLL_S,
+                                                        max(0.0, due - time.monotonic()))
+            readable, _, _ = select.select(fds, [], [], wait)
+            now = time.monotonic()
             if self.master not in readable:
-                self.quiet_at = time.monotonic()
+                self.quiet_at = now
             if self.master is not None and self.master in readable:
                 try:
                     data = os.read(self.master, 4096)
-                except (BlockingIOError, InterruptedError):
-                    data = b""
-                except OSError:      # EIO: nobody has the slave open (cannot happen: we do)
+                except OSError:      # EAGAIN, EINTR; EIO: nobody has the slave open
                     data = b""
                 if data:
-                    self.on_bytes(data)
+                    self.on_bytes(data, now)
+            self.release(time.monotonic())
+            if self.counters["rx_packets"] >= self.frozen_at + FREEZE_EVERY:
+                self.frozen_at = self.counters["rx_packets"]
+                gc.freeze()
             if self.conn in readable:
                 try:
                     cmd, args = self.conn.recv()

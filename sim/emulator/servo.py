@@ -56,7 +56,8 @@ class EmulatedServo:
         self.spec = spec
         self.model = MODELS[spec.model]
         self.family = self.model.family
-        self.table: dict[str, Entry] = TABLES[self.family]
+        layout = self.model.layout                      # its control table's key
+        self.table: dict[str, Entry] = TABLES[layout]
         self.mem = bytearray(max(r.address + r.size for r in self.table.values()))
         self.owner = bytearray(len(self.mem))  # 0: no register; else index+1
         self.regs = list(self.table.items())
@@ -64,6 +65,7 @@ class EmulatedServo:
             self.owner[reg.address:reg.address + reg.size] = bytes([i + 1]) * reg.size
         self.conditions: set[str] = set()   # injected hardware faults (names of ERROR_BITS)
         self.stuck = False                  # injected jam: the horn does not move
+        self.frozen: set[str] = set()       # injected: registers that ignore host writes
         self.speed_tps = self.model.no_load_speed * self.model.ticks_per_rad
         self._p1_errors = 0   # Protocol 1.0 has no error register: the status byte only
         codes = {b: c for c, b in BAUD_CODES[self.family].items()}
@@ -71,7 +73,7 @@ class EmulatedServo:
             raise ValueError(f"servo {spec.servo_id}: baud {spec.baud} is not a "
                              f"{self.family} rate; valid: {sorted(codes)}")
         values = {n: e.initial for n, e in self.table.items() if e.initial is not None}
-        values.update(UNPRINTED[self.family])
+        values.update({**UNPRINTED[layout], **self.model.initial})
         values.update(model_number=self.model.number, id=spec.servo_id,
                       baud_rate=codes[spec.baud], return_delay_time=spec.return_delay,
                       present_position=spec.zero_ticks, goal_position=spec.zero_ticks)
@@ -85,7 +87,7 @@ class EmulatedServo:
         self._t = now
         self.watchdog = BUS_WATCHDOG[self.family]
         self.heard = now    # time of the last instruction packet addressed to this servo [s]
-        self.eeprom_end = EEPROM_END[self.family]   # EEPROM below, RAM from here
+        self.eeprom_end = EEPROM_END[layout]   # EEPROM below, RAM from here
         self._saved = bytes(self.mem[:self.eeprom_end])   # EEPROM as kept over power-off
         self._ram_at_power_on = bytes(self.mem[self.eeprom_end:])
         self.pending: tuple[int, bytes] | None = None     # a Reg Write waiting for Action
@@ -175,10 +177,6 @@ class EmulatedServo:
         for name, value in self.pinned.items():
             self.set_raw(name, value)
 
-    def within_turn(self, ticks: float) -> float:
-        """``ticks`` [actual] brought into the encoder's one turn."""
-        return ticks % (self.model.resolution * 360.0 / self.model.span_deg)
-
     def hold(self) -> None:
         """Goal := where the horn is (registers refreshed): after a reset, power-on, a mode
         change or the multi-turn clear, the servo holds its place."""
@@ -261,8 +259,8 @@ class EmulatedServo:
         kept = {name: self.get(name) for name in keep}
         for name, e in self.table.items():
             self.set_raw(name, e.initial if e.initial is not None else 0)
-        for name, v in {**UNPRINTED[self.family], "model_number": self.model.number,
-                        **kept}.items():
+        for name, v in {**UNPRINTED[self.model.layout], **self.model.initial,
+                        "model_number": self.model.number, **kept}.items():
             self.set_raw(name, v)
         self._saved = bytes(self.mem[:self.eeprom_end])
         self.hold()
@@ -288,7 +286,7 @@ class EmulatedServo:
         self.update(now)
         self.mem[:self.eeprom_end] = self._saved
         self.mem[self.eeprom_end:] = self._ram_at_power_on
-        self.horn = self.within_turn(self.horn)   # the turn count is not kept over power-off
+        self.horn = servo_frame.within_turn(self, self.horn)   # the turn count is not kept over power-off
         self.hold()
         self._t = self.heard = now
 

@@ -19,9 +19,10 @@ Registers (each written only where the servo's table has it):
 :func:`estimate` is the kinematic emulator's motor state: a DC motor with no load on its
 horn (torque = stall x (duty - speed / no-load speed)) driven by the firmware's position
 law where it holds a position (X: KPP = P / 128 of PWM 885 per tick, e-Manual; STS 0.166
-duty per P unit and radian, measured on an STS3215 by Rhoban/bam; AX: full output over the
-compliance slope past the margin), by the speed it travels at where it moves (the duty
-that sustains it against back-EMF), and by the command in PWM / wheel modes. With nothing
+duty per P unit and radian, measured on an STS3215 by Rhoban/bam, and 0.158 on MX-64/106
+for the MX Protocol 1.0 P Gain; AX: full output over the compliance slope past the
+margin), by the speed it travels at where it moves (the duty that sustains it against
+back-EMF), and by the command in PWM / wheel modes. With nothing
 on the horn a free servo reads load ~0 and a jammed one (``stuck``) its holding effort.
 """
 
@@ -43,6 +44,7 @@ P1_LOAD_CW_BIT = 10
 #: Position-law scales (see the module doc).
 X_KPP_DIVISOR = 128.0
 STS_DUTY_PER_P_RAD = 0.166
+MX_DUTY_PER_P_RAD = 0.158
 #: Stall (locked-rotor) current at the nominal voltage [A], where a datasheet gives one:
 #: Feetech STS3215 (7.4 V): 2.7 A; ROBOTIS e-Manual XM430-W350 (12 V): 2.3 A.
 STALL_CURRENT_A: dict[str, float] = {"STS3215": 2.7, "XM430-W350": 2.3}
@@ -67,6 +69,9 @@ def holding_duty(servo: ServoState, error_ticks: float) -> float:
     t = servo.table
     if "position_p_gain" in t:
         return _clip(servo.get("position_p_gain") / X_KPP_DIVISOR * error_ticks / X_PWM_FULL)
+    if "p_gain" in t:               # MX on Protocol 1.0: 0.158 duty per P unit and radian
+        per_tick = MX_DUTY_PER_P_RAD / servo.model.ticks_per_rad
+        return _clip(servo.get("p_gain") * per_tick * error_ticks)
     if "p_coefficient" in t:
         per_tick = STS_DUTY_PER_P_RAD / servo.model.ticks_per_rad
         return _clip(servo.get("p_coefficient") * per_tick * error_ticks)

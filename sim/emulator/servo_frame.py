@@ -77,6 +77,12 @@ def goal_for(servo: ServoState, actual: float) -> int:
     return ticks + offset(servo)
 
 
+def within_turn(servo: ServoState, ticks: float) -> float:
+    """``ticks`` [actual] brought into the encoder's one turn (the AX's 1024 steps span 300
+    of its 360 degrees)."""
+    return ticks % (servo.model.resolution * 360.0 / servo.model.span_deg)
+
+
 def centre_offset(servo: ServoState, actual: float) -> int:
     """STS Torque Enable = 128: the register-31 value that makes the horn at ``actual``
     read :data:`STS_CENTRE` (raw - 2048 of the raw encoder reading within the turn)."""

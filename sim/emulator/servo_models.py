@@ -9,7 +9,8 @@ resolution and the angle it spans, and the no-load speed the horn travels at.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 
 #: ``Emulator(protocol)`` -> control-table family.
 PROTOCOL_FAMILY: dict[str, str] = {
@@ -20,9 +21,11 @@ PROTOCOL_FAMILY: dict[str, str] = {
 
 @dataclass(frozen=True)
 class ServoModel:
-    """name; number: Model Number register / ping; family: key of the control tables;
-    resolution: positions (0..resolution-1); span_deg: angle they cover [deg];
-    no_load_speed: at the nominal voltage [rad/s]."""
+    """name; number: Model Number register / ping; family: the protocol family (baud
+    codes, error bits, watchdog); resolution: positions (0..resolution-1); span_deg: angle
+    they cover [deg]; no_load_speed: at the nominal voltage [rad/s]; table: its control
+    table's key in ``control_tables.TABLES`` when not the family's own; initial: the
+    model's own initial values where its manual differs from the family's table."""
 
     name: str
     number: int
@@ -30,6 +33,13 @@ class ServoModel:
     resolution: int
     no_load_speed: float
     span_deg: float = 360.0
+    table: str = ""
+    initial: Mapping[str, int] = field(default_factory=dict)
+
+    @property
+    def layout(self) -> str:
+        """Key of its control table in ``control_tables.TABLES``."""
+        return self.table or self.family
 
     @property
     def ticks_per_rad(self) -> float:
@@ -50,10 +60,16 @@ MODELS: dict[str, ServoModel] = {
     # ROBOTIS e-Manual XL430-W250: Model Number 1060; 4096 pulses/rev; no-load speed
     # 57 rev/min at 11.1 V.
     "XL430-W250": ServoModel("XL430-W250", 1060, "dynamixel_x", 4096, _rpm(57)),
-    # ROBOTIS e-Manual XM430-W350: Model Number 1020; 4096 pulses/rev; 46 rev/min at 12 V.
-    "XM430-W350": ServoModel("XM430-W350", 1020, "dynamixel_x", 4096, _rpm(46)),
-    # ROBOTIS e-Manual XC430-W150: Model Number 1070; 4096 pulses/rev; 70 rev/min at 12 V.
-    "XC430-W150": ServoModel("XC430-W150", 1070, "dynamixel_x", 4096, _rpm(70)),
+    # ROBOTIS e-Manual XM430-W350: Model Number 1020; 4096 pulses/rev; 46 rev/min at 12 V;
+    # RAM initial values Velocity I Gain(76) 1,920, Position D Gain(80) 0, Position P
+    # Gain(84) 800 (the XL430 table's are 1,000 / 4,000 / 640).
+    "XM430-W350": ServoModel("XM430-W350", 1020, "dynamixel_x", 4096, _rpm(46), initial={
+        "velocity_i_gain": 1920, "position_d_gain": 0, "position_p_gain": 800}),
+    # ROBOTIS e-Manual XC430-W150: Model Number 1070; 4096 pulses/rev; 70 rev/min at 12 V
+    # (as the driver lists it; the XC430-W150 page prints 106 rev/min at 12 V, the
+    # XC430-W240 70); RAM initial values Velocity I Gain 1,920, Position D 0, Position P 460.
+    "XC430-W150": ServoModel("XC430-W150", 1070, "dynamixel_x", 4096, _rpm(70), initial={
+        "velocity_i_gain": 1920, "position_d_gain": 0, "position_p_gain": 460}),
     # ROBOTIS e-Manual AX-12A: Model Number 12; 0..1023 over 0..300 deg (0.29 deg);
     # 59 rev/min at 12 V.
     "AX-12A": ServoModel("AX-12A", 12, "dynamixel_p1", 1024, _rpm(59), 300.0),
@@ -61,7 +77,8 @@ MODELS: dict[str, ServoModel] = {
     "AX-18A": ServoModel("AX-18A", 18, "dynamixel_p1", 1024, _rpm(97), 300.0),
     # ROBOTIS e-Manual MX-28 (Protocol 1.0 firmware; the 2.0 firmware reports 30): Model
     # Number 29; 4096 steps/rev; 55 rev/min at 12 V.
-    "MX-28": ServoModel("MX-28", 29, "dynamixel_p1", 4096, _rpm(55)),
+    # Its own table (D/I/P Gain at 26/27/28: control_tables.DYNAMIXEL_MX1).
+    "MX-28": ServoModel("MX-28", 29, "dynamixel_p1", 4096, _rpm(55), table="dynamixel_mx1"),
     # Feetech STS3215 (7.4 V): memory table Model(3-4) reads 777 (= 3 * 256 + 9); 4096
     # steps/rev (12-bit magnetic encoder, 0.088 deg/step); no-load 0.222 s/60 deg.
     "STS3215": ServoModel("STS3215", 777, "feetech_sts", 4096, _per_60deg(0.222)),

@@ -28,7 +28,8 @@ class ServoState(Protocol):
     """One servo's table and settings, as the motion and write checks use them.
 
     mem: the control table's bytes; owner: per byte, 0 (no register) or the index + 1 of
-    its register in ``regs``; regs: the table's (name, entry) rows in order; table: name ->
+    its register in ``regs``; regs: the table's (name, entry) rows in order; frozen: names
+    whose host writes are acknowledged but not stored (an injected fault); table: name ->
     entry; horn: where the horn actually is [ticks, before any offset, several turns in
     the multi-turn modes]; step_target: where STS step mode takes it [ticks, actual].
     """
@@ -36,6 +37,7 @@ class ServoState(Protocol):
     family: str
     model: ServoModel
     stuck: bool
+    frozen: set[str]
     speed_tps: float
     mem: bytearray
     owner: bytearray
@@ -55,13 +57,12 @@ class ServoState(Protocol):
 
     def set_raw(self, name: str, value: int) -> None: ...
 
-    def within_turn(self, ticks: float) -> float: ...
-
     def hold(self) -> None: ...
 
 
 def decode_value(family: str, address: int, data: bytes) -> int:
-    """A written value as the log shows it: little-endian, signed for signed registers."""
+    """A written value as the log shows it: little-endian, signed for signed registers
+    (only the X table has any)."""
     signed = family == "dynamixel_x" and any(
         reg.address == address and reg.size == len(data) and name in DXL_SIGNED
         for name, reg in TABLES[family].items())

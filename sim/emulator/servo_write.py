@@ -140,13 +140,15 @@ def _check_x(servo: ServoState, name: str, value: int) -> WriteError:
 
 def apply(servo: ServoState, values: dict[str, int]) -> None:
     """Store planned values and do what they set off (module doc). Torque stays off while
-    an X servo is in shutdown."""
+    an X servo is in shutdown; registers in ``servo.frozen`` keep their value."""
     shutdown = servo.family == "dynamixel_x" and servo.get("hardware_error_status") != 0
     sts = servo.family == "feetech_sts"
     mode_before = servo_modes.mode(servo)
     for name, v in values.items():
         if name == "torque_enable" and shutdown:
             continue  # refused while in shutdown; the status carries the alert bit
+        if name in servo.frozen:
+            continue  # injected fault: acknowledged, not stored (a read-back shows it)
         if sts and name == "torque_enable" and v == STS_CENTRE_COMMAND:
             servo.set_raw("homing_offset", servo_frame.centre_offset(servo, servo.horn))
             servo.hold()
@@ -155,7 +157,7 @@ def apply(servo: ServoState, values: dict[str, int]) -> None:
     mode = servo_modes.mode(servo)
     if mode is not mode_before:
         if mode is Mode.POSITION:
-            servo.horn = servo.within_turn(servo.horn)
+            servo.horn = servo_frame.within_turn(servo, servo.horn)
         servo.hold()
         return
     if sts and mode is Mode.STEP and "goal_position" in values:

@@ -76,7 +76,7 @@ def advance(servo: ServoState, pos: float, dt: float) -> float:
     return the new position."""
     mode = servo_modes.mode(servo)
     torque = bool(servo.get("torque_enable"))
-    free = torque and not servo.stuck and dt > 0
+    free = torque and not servo.stuck     # the velocity read back does not depend on dt
     velocity, error, duty = 0.0, 0.0, None
     if mode in POSITION_MODES:
         goal = target(servo, mode)
@@ -122,7 +122,10 @@ def _feedback(servo: ServoState, mode: Mode, pos: float, velocity: float, *,
         servo.set_raw("moving_status", 0 if not servo.get("torque_enable") else (
             MOVING_PROFILE_ONGOING if moving else MOVING_IN_POSITION))
     elif servo.family == "dynamixel_p1":
-        per_unit = P1_SPEED_UNIT_RPM * servo.model.ticks_per_rad * 2 * math.pi / 60.0
+        # Joint mode: 0.111 rev/min a unit; wheel mode: the output share, 0-1023 (AX-12A
+        # e-Manual, Present Speed(38)).
+        per_unit = (servo.speed_tps / P1_SPEED_MASK if mode is Mode.PWM else
+                    P1_SPEED_UNIT_RPM * servo.model.ticks_per_rad * 2 * math.pi / 60.0)
         magnitude = min(round(abs(velocity) / per_unit), P1_SPEED_MASK)
         servo.set_raw("present_speed", magnitude | (P1_DIRECTION_BIT if velocity < 0 else 0))
     else:

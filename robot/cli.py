@@ -1,7 +1,8 @@
 """`biped` command line: a thin dispatcher over ``robot.commands.<name>`` modules.
 
 Each command module has ``add_parser(subparsers)`` and ``run(args) -> int``. Bad input gives
-one clear line on stderr and exit code 2; nothing reaches the robot.
+one clear line on stderr and exit code 2; nothing reaches the robot. A bus error (a servo
+missing or silent, the port failing) or a safety stop is one line and exit code 1.
 """
 
 from __future__ import annotations
@@ -10,11 +11,13 @@ import argparse
 import importlib
 import logging
 import os
+import signal
 import sys
 from importlib.metadata import PackageNotFoundError, version
 
 from robot.commands.common import one_line_errors
-from robot.errors import BipedError, SafetyStop
+from robot.errors import BipedError, BusError, SafetyStop
+from robot.run.signals import Interrupted, SignalLatch
 
 # Order is the order of `biped --help`.
 COMMANDS: tuple[str, ...] = (
@@ -65,12 +68,32 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    os.environ.setdefault("MUJOCO_GL", "egl")
-    parser = build_parser()
+    """Run one ``biped`` command; its exit code. SIGINT/SIGTERM are handled from here on
+    (robot.run.signals): no command is killed by them. ``argv`` None: this process is the
+    command (the console script, ``python -m robot.cli``): it exits here with the code,
+    the handlers in place to the end; otherwise (in-process callers) the old handlers
+    come back and the code is returned."""
+    latch = SignalLatch()
+    restore = latch.install()
     try:
+        code = _main(argv)
+    finally:
+        if argv is not None:
+            restore()
+    if argv is None:
+        latch.end(code)
+    return code
+
+
+def _main(argv: list[str] | None) -> int:
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    try:
+        parser = build_parser()
         args = parser.parse_args(argv)
     except SystemExit as e:   # --help (0) or a refused option (2, one line on stderr)
         return e.code if isinstance(e.code, int) else 2
+    except KeyboardInterrupt as e:
+        return interrupted("", e)
     logging.basicConfig(level=getattr(logging, args.log_level), stream=sys.stderr,
                         # the logger's name only when debugging: a user reads the message
                         format=("%(levelname)s %(name)s: %(message)s"
@@ -80,14 +103,27 @@ def main(argv: list[str] | None = None) -> int:
     except SafetyStop as e:   # e.g. a run refused to start: a safety stop, exit 1
         print(f"biped {args.command}: safety stop: {e}", file=sys.stderr)
         return 1
+    except BusError as e:     # a servo missing or silent, the port failed: hardware, exit 1
+        print(f"biped {args.command}: bus error: {e}", file=sys.stderr)
+        return 1
     except BipedError as e:
         print(f"biped {args.command}: error: {e}", file=sys.stderr)
         return 2
     except BrokenPipeError:
         return 0  # stdout closed early (e.g. piped into `head`)
-    except KeyboardInterrupt:
-        print(f"biped {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except OSError as e:      # a file no command check caught (a full disk, ...): one line
+        where = f"{e.filename}: " if e.filename else ""
+        print(f"biped {args.command}: error: {where}{e.strerror or e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as e:
+        return interrupted(f" {args.command}", e)
+
+
+def interrupted(command: str, e: KeyboardInterrupt) -> int:
+    """Say so; 128 + the signal's number (130 for SIGINT, 143 for SIGTERM)."""
+    signum = e.signum if isinstance(e, Interrupted) else signal.SIGINT
+    print(f"biped{command}: interrupted ({signal.Signals(signum).name})", file=sys.stderr)
+    return 128 + signum
 
 
 if __name__ == "__main__":

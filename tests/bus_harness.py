@@ -97,9 +97,11 @@ def bus(emu: Emulator, robot: RobotConfig) -> Iterator[SdkBus]:
 
 
 @pytest.fixture
-def robot_toml(tmp_path: Path, protocol: str) -> Path:
-    """The bundled robot with a reply timeout that tolerates a busy test machine."""
+def robot_toml(tmp_path: Path, protocol: str, request: pytest.FixtureRequest) -> Path:
+    """The bundled robot with a reply timeout that tolerates a busy test machine (the
+    test module's ``REPLY_TIMEOUT_MS`` if it sets one, else ``TEST_TIMEOUT_MS``)."""
+    timeout = getattr(request.module, "REPLY_TIMEOUT_MS", TEST_TIMEOUT_MS)
     text = (ROBOTS_DIR / f"biped18-{protocol}.toml").read_text()
     path = tmp_path / f"robot-{protocol}.toml"
-    path.write_text(text.replace("timeout_ms = 20.0", f"timeout_ms = {TEST_TIMEOUT_MS}"))
+    path.write_text(text.replace("timeout_ms = 20.0", f"timeout_ms = {timeout}"))
     return path

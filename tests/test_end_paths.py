@@ -1,18 +1,26 @@
 """Start and end paths of the one streaming loop, read at the wire on the pty emulator:
 a joint outside its limits refuses the start (nothing written), a failing gait engine
-ramps straight to rest, pose shares the loop and its watchdog, statistics stay bounded."""
+ramps straight to rest, pose shares the loop and its watchdog, statistics stay bounded;
+a signal in each window around a run's end (issue 19: the command's latch, as robot.cli
+installs it, with signals sent to this process at a known point)."""
 
 from __future__ import annotations
 
 import math
+import os
 import random
+import signal
+import threading
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
-from bus_harness import open_bus
+from bus_harness import TEST_TIMEOUT_MS, open_bus
 
 import robot.cli as cli
+from robot.bus.base import Bus
+from robot.bus.dynamixel import DynamixelBus
 from robot.bus.servo_map import ServoMap
 from robot.config.gait_file import load_gait
 from robot.config.robot import RobotConfig
@@ -20,6 +28,11 @@ from robot.config.robot_file import load_robot
 from robot.gait.engine import GaitEngine
 from robot.loop.latency import SampleStats
 from robot.loop.streamer import Streamer
+from robot.loop.telemetry import Telemetry
+from robot.motion.posing import PoseMove
+from robot.run.run import Run
+from robot.run.signals import Interrupted, SignalLatch
+from robot.run.spec import RunOptions, RunSpec
 from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
@@ -136,3 +149,142 @@ def test_bus_watchdog_armed_past_the_longest_retried_transaction(
     steps = math.ceil((1.5 * span + 2 / 200.0) / 0.020 - 1e-9)   # 1.5 x span + 2 ticks
     assert all(v == [0, steps, 0] for v in values.values()), values   # clear, arm, disarm
     assert {emu.registers(i)["bus_watchdog"] for i in robot.ids} == {0}
+
+
+# ------------------------------------------------ issue 19: signals around a run's end
+@pytest.fixture
+def command_latch() -> Iterator[SignalLatch]:
+    """SIGINT/SIGTERM handled in this process as robot.cli handles them for a command."""
+    latch = SignalLatch()
+    restore = latch.install()
+    yield latch
+    restore()
+
+
+def posing(robot: RobotConfig, bus: Bus, *, first_signal_at: int | None = None) -> Run[PoseMove]:
+    """A Run of `biped pose rest` (hold at the end, signals routed), slow enough to be
+    stopped; ``first_signal_at``: SIGINT to this process at that tick."""
+    sent: list[int] = []
+
+    def observe(tel: Telemetry) -> None:
+        if tel.tick == first_signal_at and not sent:     # once (the end notifies again)
+            sent.append(tel.tick)
+            os.kill(os.getpid(), signal.SIGINT)
+    move = PoseMove(robot, ServoMap(robot).vector(robot.rest), max_speed=0.3)
+    return Run(RunSpec(robot=robot, source=move, bus=bus, observer=observe,
+                       options=RunOptions(rate_hz=50.0, hold=True, signals=True, watch=False)))
+
+
+def wire_torque(emu: Emulator, robot: RobotConfig) -> set[int]:
+    return {emu.registers(i)["torque_enable"] for i in robot.ids}
+
+
+@pytest.mark.parametrize("protocol", ["dynamixel"])
+def test_second_signal_while_the_hold_is_finished_turns_torque_off(
+        emu: Emulator, robot: RobotConfig, command_latch: SignalLatch) -> None:
+    """Item 4's first window: the second signal lands while the streamer finishes its hold
+    (disarming the Bus Watchdog). It was counted and ignored: all 18 kept torque."""
+    class SignalOnDisarm(DynamixelBus):
+        signalled = False
+
+        def disarm_failsafe(self, ids: Iterable[int]) -> None:
+            if not self.signalled:                       # the operator's second Ctrl-C
+                self.signalled = True
+                os.kill(os.getpid(), signal.SIGINT)
+            super().disarm_failsafe(ids)
+
+    bus = SignalOnDisarm(emu.port, baud=robot.bus.baud, robot=robot,
+                         timeout_ms=TEST_TIMEOUT_MS)
+    run = posing(robot, bus, first_signal_at=5)
+    with run:
+        run.stream()
+    result = run.result
+    assert command_latch.count == 2 and result.exit_code == 130
+    assert result.stats.estop and not result.stats.holding and result.stats.torque == "off"
+    assert wire_torque(emu, robot) == {0}
+    assert {emu.registers(i)["bus_watchdog"] for i in robot.ids} == {0}
+
+
+def test_second_signal_after_the_run_ended_holding_turns_torque_off(
+        emu: Emulator, robot: RobotConfig, command_latch: SignalLatch) -> None:
+    """Item 4's second window: the loop has returned holding, the command has not yet
+    closed the bus (its handlers were restored there: -2/-15, or ignored)."""
+    run = posing(robot, open_bus(emu, robot), first_signal_at=5)
+    with run:
+        assert run.stream().holding and wire_torque(emu, robot) == {1}
+        os.kill(os.getpid(), signal.SIGTERM)
+    result = run.result
+    assert result.exit_code == 130                       # 128 + the first signal
+    assert result.stats.torque == "off" and "after it ended holding" in result.stats.stop_reason
+    assert "SIGTERM" in result.stats.stop_reason
+    assert wire_torque(emu, robot) == {0}
+
+
+def test_a_stop_before_the_stream_starts_writes_nothing(
+        emu: Emulator, robot: RobotConfig, command_latch: SignalLatch) -> None:
+    """A signal between opening the bus and the first tick: nothing is written (not a
+    torque-on and a ramp to rest), exit 128 + signal."""
+    run = posing(robot, open_bus(emu, robot))
+    with run:
+        emu.log(clear=True)
+        os.kill(os.getpid(), signal.SIGTERM)
+        stats = run.stream()
+    assert stats.torque == "untouched" and stats.ticks == 0
+    assert [p for p in emu.log() if p.instruction in WRITES] == []
+    assert run.result.exit_code == 143 and wire_torque(emu, robot) == {0}
+
+
+class Target:
+    def __init__(self) -> None:
+        self.calls: list[str] = []
+
+    def request_stop(self, reason: str = "") -> None:
+        self.calls.append(f"stop: {reason}")
+
+    def emergency_stop(self, reason: str = "") -> None:
+        self.calls.append(f"estop: {reason}")
+
+
+def test_latch_regions() -> None:
+    """The rules of robot.run.signals, by calling the handler as the interpreter would:
+    outside any region the first signal raises (once), a shielded region defers it to
+    its end, a routed one stops the target and never raises."""
+    latch = SignalLatch()
+    with pytest.raises(Interrupted) as first:
+        latch.handle(signal.SIGTERM)
+    assert first.value.signum == signal.SIGTERM
+    latch.handle(signal.SIGINT)                           # the cleanup is not interrupted
+    assert (latch.first, latch.count, latch.emergency) == (signal.SIGTERM, 2, True)
+    assert latch.exit_code(None) == 143
+
+    shielded = SignalLatch()
+    with pytest.raises(Interrupted):
+        with shielded.shielded():
+            shielded.handle(signal.SIGINT)                # only counted here
+            done = True
+    assert done
+
+    routed, target = SignalLatch(), Target()
+    with routed.routed(target):
+        routed.handle(signal.SIGINT)
+        with routed.shielded():                           # routing wins: the loop is told
+            routed.handle(signal.SIGTERM)
+    assert target.calls == ["stop: signal SIGINT",
+                            "estop: emergency stop (second signal, SIGTERM)"]
+    assert routed.exit_code(None) == 130
+
+
+def test_shield_in_another_thread_changes_nothing(command_latch: SignalLatch) -> None:
+    """A run closing in a panel thread must not defer (and later raise) the main thread's
+    signal there."""
+    from robot.run.signals import shield
+
+    def close() -> None:
+        with shield():
+            assert command_latch._shields == 0
+
+    worker = threading.Thread(target=close)
+    worker.start()
+    worker.join()
+    with shield():
+        assert command_latch._shields == 1

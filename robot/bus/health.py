@@ -136,13 +136,15 @@ def check(bus: SdkRegisters) -> list[str]:
 
 def fix_return_delay(bus: SdkRegisters, ids: Iterable[int]) -> list[int]:
     """Set return_delay_time to 0 (EEPROM, so torque off first) where it is not; returns the
-    ids changed. Feetech EEPROM is unlocked for the write and locked again."""
+    ids changed. Feetech EEPROM is unlocked for the write and locked again. Only Feetech:
+    an AX-12A's Lock (47) is another thing, "1 locks EEPROM until power-off" (e-Manual), so
+    it is never written; Dynamixel needs torque off for EEPROM, nothing more."""
     changed: list[int] = []
     for sid in ids:
         if bus.read_register(sid, "return_delay_time") == 0:
             continue
         bus.set_torque([sid], enabled=False)
-        lock = "lock" in bus.table
+        lock = bus.family == "feetech_sts"
         if lock:
             bus.write_register(sid, "lock", 0)
         bus.write_register(sid, "return_delay_time", 0)

@@ -29,6 +29,7 @@ from robot.commands.common import (
 from robot.config.robot import JointConfig, RobotConfig
 from robot.config.toml_edit import same_path, write_validated
 from robot.errors import ConfigError
+from robot.run.session import bus_session
 from robot.setup.calibration import (
     MOVE_THRESHOLD_RAD,
     detect_sign,
@@ -134,8 +135,7 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
         raise ConfigError("--zero runs step 1 alone; drop --limits or --zero")
     kind = args.bus or robot.bus.kind
     bus = bus_from(args, robot)
-    bus.open()
-    try:
+    with bus_session(bus, torque_off=True):
         bus.set_torque(robot.ids, enabled=False)
         print(f"torque OFF on {len(robot.ids)} servos: the robot is limp and will not move "
               "by itself; support it")
@@ -149,14 +149,16 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
             signs = _signs(bus, robot, ask)
             if args.limits:
                 limits = _limits(bus, robot, zeros, signs, kind, ask)
-    finally:
-        bus.close(torque_off=False)
     changes: dict[str, dict[str, int | float]] = {}
     for j in robot.joints:
         changes[j.name] = {"zero_ticks": zeros[j.name], "sign": signs[j.name]}
         if j.name in limits:
             changes[j.name].update(min_rad=limits[j.name][0], max_rad=limits[j.name][1])
-    write_validated(source, out, changes)
+    try:
+        write_validated(source, out, changes)
+    except OSError as e:
+        raise ConfigError(f"--out {out}: cannot write it: {e.strerror or e}; nothing was "
+                          "written (free some space or choose another path)") from e
     _report(robot, changes, out)
     return 0
 

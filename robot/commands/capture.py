@@ -14,6 +14,7 @@ import argparse
 from collections.abc import Callable
 from pathlib import Path
 
+from robot.bus.base import Bus
 from robot.commands.common import (
     add_bus_args,
     add_robot_args,
@@ -22,11 +23,14 @@ from robot.commands.common import (
     one_line_errors,
     output_file,
     robot_from,
+    writing,
 )
+from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.motion.keyframes import SUFFIXES, load_sequence, sequence_to_toml
 from robot.motion.posing import Capture, limb_joints
 from robot.run.release import release
+from robot.run.session import bus_session
 
 Ask = Callable[[str], str]
 
@@ -54,29 +58,15 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
     robot = robot_from(args)
     joints = limb_joints(robot, args.limb)
     bus = bus_from(args, robot)
-    bus.open()
     capture = Capture(robot, joints)
-    try:
-        release(robot, bus, args.limb)
-        print(f"{args.limb}: torque OFF on {len(joints)} joints ({', '.join(joints)}); the "
-              "rest holds. Move it by hand.")
-        while True:
-            try:
-                answer = ask(f"keyframe {len(capture.times)}: Enter captures, q finishes ")
-            except EOFError:
-                break
-            if answer.strip().lower() in ("q", "quit", "done"):
-                break
-            pose = capture.add(bus, step_s=args.every)
-            print(f"  t = {capture.times[-1]:g} s: " + ", ".join(
-                f"{j} {v:+.3f}" for j, v in zip(joints, pose, strict=True)))
-    finally:
-        bus.close(torque_off=True)
-        print("torque OFF on every servo: support the robot")
+    with bus_session(bus, torque_off=True, closed=lambda: print(
+            "torque OFF on every servo: support the robot")):
+        _pose_by_hand(robot, bus, capture, args, ask)
     if not capture.times:
         raise ConfigError("no keyframe captured; nothing was written")
     seq = capture.sequence(args.name or out.stem)
-    out.write_text(sequence_to_toml(seq))
+    with writing("--out", out):
+        out.write_text(sequence_to_toml(seq))
     try:
         load_sequence(out, robot)  # as `biped play` and `walk --keyframes` will read it
     except ConfigError as e:
@@ -84,3 +74,21 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
     print(f"wrote {out}: {len(seq.times)} keyframes over {seq.duration:g} s; play it with "
           f"`biped play {out}` or layer it with `biped walk --keyframes {out}`")
     return 0
+
+
+def _pose_by_hand(robot: RobotConfig, bus: Bus, capture: Capture, args: argparse.Namespace,
+                  ask: Ask) -> None:
+    """Release the limb, then capture a keyframe at each Enter until q or the input ends."""
+    joints = release(robot, bus, args.limb)
+    print(f"{args.limb}: torque OFF on {len(joints)} joints ({', '.join(joints)}); the "
+          "rest holds. Move it by hand.")
+    while True:
+        try:
+            answer = ask(f"keyframe {len(capture.times)}: Enter captures, q finishes ")
+        except EOFError:
+            break
+        if answer.strip().lower() in ("q", "quit", "done"):
+            break
+        pose = capture.add(bus, step_s=args.every)
+        print(f"  t = {capture.times[-1]:g} s: " + ", ".join(
+            f"{j} {v:+.3f}" for j, v in zip(joints, pose, strict=True)))

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import argparse
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, NoReturn, TypeVar
 
@@ -149,6 +150,12 @@ def _writable_dir(d: Path) -> str | None:
         return f"{d} is not a directory"
     if not os.access(d, os.W_OK | os.X_OK):
         return f"directory {d} is not writable"
+    try:
+        full = os.statvfs(d).f_bavail == 0
+    except OSError:
+        full = False                      # no statvfs there: the write will tell
+    if full:
+        return f"no space left on the device of directory {d}"
     return None
 
 
@@ -163,6 +170,16 @@ def output_file(text: str) -> str:
     if why:
         raise argparse.ArgumentTypeError(f"{why}; expected a writable file path")
     return text
+
+
+@contextmanager
+def writing(option: str, path: str | Path) -> Iterator[None]:
+    """An OSError inside the block (the disk filled up while writing, ...) becomes one
+    line naming ``option`` and ``path`` (ConfigError: exit 2)."""
+    try:
+        yield
+    except OSError as e:
+        raise ConfigError(f"{option} {path}: cannot write it: {e.strerror or e}") from e
 
 
 def output_dir(text: str) -> str:

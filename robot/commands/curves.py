@@ -15,6 +15,7 @@ from robot.commands.common import (
     rate_hz,
     robot_from,
     seconds,
+    writing,
 )
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
@@ -49,10 +50,12 @@ def run(args: argparse.Namespace) -> int:
     times = np.arange(n) / args.rate
     engine = GaitEngine(robot, gait.params)
     channels, q = engine.curves(times)
-    write_csv(args.out, times, channels, robot.joint_names, q)
+    with writing("--out", args.out):
+        write_csv(args.out, times, channels, robot.joint_names, q)
     print(f"wrote {args.out}: {n} rows, gait {gait.name}, robot {robot.name}")
     if args.plot:
-        plot_curves(args.plot, times, channels, robot.joint_names, q,
-                    title=f"gait {gait.name} on {robot.name}")
+        with writing("--plot", args.plot):
+            plot_curves(args.plot, times, channels, robot.joint_names, q,
+                        title=f"gait {gait.name} on {robot.name}")
         print(f"wrote {args.plot}")
     return 0

@@ -24,6 +24,7 @@ from robot.commands.common import (
     output_file,
     robot_from,
     seconds,
+    writing,
 )
 from robot.config.bundled import DEFAULT_ROBOT_NAME
 from robot.config.robot_file import load_robot
@@ -87,12 +88,13 @@ def run(args: argparse.Namespace) -> int:
                                                       with_channels=False)
         q = qt.T
         what, label = f"gait {gait.name}", gait.name
-    if suffix == ".bvh":
-        units = args.units or "cm"
-        frames = write_bvh(args.out, robot, q, 1.0 / args.fps, units=units)
-    else:
-        units = "m"
-        frames = write_gltf(args.out, robot, q, 1.0 / args.fps, name=label)
+    with writing("--out", args.out):
+        if suffix == ".bvh":
+            units = args.units or "cm"
+            frames = write_bvh(args.out, robot, q, 1.0 / args.fps, units=units)
+        else:
+            units = "m"
+            frames = write_gltf(args.out, robot, q, 1.0 / args.fps, name=label)
     print(f"wrote {args.out}: {frames} frames at {args.fps:g} fps of {what} on {robot.name} "
           f"({units})")
     return 0

@@ -28,6 +28,7 @@ from robot.commands.common import (
     seconds,
 )
 from robot.commands.physics_check import physics_check, physics_watch
+from robot.commands.walk import servo_words
 from robot.config.bundled import DEFAULT_GAIT
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
@@ -182,7 +183,7 @@ def run(args: argparse.Namespace) -> int:
     result = {"file": args.file, "robot": robot.name, "bus": kind, "ticks": stats.ticks,
               "rate_hz": rate, "gait_seconds": engine.time, "overruns": stats.overruns,
               "stop_reason": stats.stop_reason, "fault": stats.fault,
-              "holding": stats.holding, "balance": imu is not None,
+              "holding": stats.holding, "torque": stats.torque, "balance": imu is not None,
               "record_error": record_error, "exit_code": code}
     if soundtrack is not None:
         result["audio"] = {"file": str(soundtrack.show.audio_path()),
@@ -200,8 +201,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(f"played {args.file} on {robot.name} ({kind} bus): {stats.ticks} ticks at "
               f"{rate:g} Hz, {engine.time:.2f} s of motion, {stats.overruns} overruns; "
-              f"stopped: {stats.stop_reason}; servos "
-              f"{'holding the rest pose, torque ON' if stats.holding else 'torque off'}")
+              f"stopped: {stats.stop_reason}; servos {servo_words(stats.torque)}")
         if record_error:
             print(f"record FAILED: {record_error}")
         if check is not None:

@@ -4,7 +4,8 @@ Runs the one streaming loop (``Streamer.run`` of a ``PoseMove``): reads the pres
 if a joint is outside its limits, sets goal := present and torque on (no snap to a stale
 goal), then a minimum-jerk ramp at a fixed rate on absolute deadlines, clamped and
 slew-limited, with the watchdog. Torque stays ON at the end. Ctrl-C (or SIGTERM) stops the
-ramp and holds where it is; a second one, or any fault, turns torque off.
+ramp and holds where it is; a second one before the command ends, or any fault, turns
+torque off.
 """
 
 from __future__ import annotations
@@ -25,9 +26,10 @@ from robot.commands.common import (
     robot_from,
 )
 from robot.config.robot import RobotConfig
-from robot.loop.streamer import LoopStats, Streamer
 from robot.motion.posing import PoseMove
-from robot.run.signals import SignalLatch, stop_on_signals
+from robot.run.result import torque_words
+from robot.run.run import Run
+from robot.run.spec import RunOptions, RunSpec
 
 log = logging.getLogger(__name__)
 
@@ -57,23 +59,20 @@ def run(args: argparse.Namespace) -> int:
     sm = ServoMap(robot)
     bus = bus_from(args, robot)
     move = PoseMove(robot, pose_target(robot, args.pose, sm), max_speed=args.speed)
-    streamer = Streamer(sm, bus, move, rate_hz=args.rate, hold_at_end=True)
-    latch = SignalLatch()
-    stats: LoopStats | None = None
-    try:
-        bus.open()
+    posing = Run(RunSpec(robot=robot, source=move, bus=bus, options=RunOptions(
+        rate_hz=args.rate, hold=True, signals=True, watch=False)))
+    with posing:
         print(f"torque ON; ramping to {args.pose} (peak {args.speed:g} rad/s, "
               f"{args.rate:g} Hz)", flush=True)
-        with stop_on_signals(streamer, latch):
-            stats = streamer.run()
-    finally:
-        bus.close(torque_off=False)  # the streamer has left torque as its end requires
-    if stats.fault or stats.estop:
-        print(f"stopped: {stats.stop_reason}; torque OFF")
-    elif latch.first is not None:
+        posing.stream()
+    done = posing.result
+    stats = done.stats
+    if not stats.holding:
+        print(f"stopped: {stats.stop_reason}; {torque_words(stats)}")
+    elif posing.latch.first is not None:
         print(f"interrupted ({stats.stop_reason}): ramp stopped; holding the last goal, "
               "torque stays ON (`biped torque off` to release)")
     else:
         print(f"at {args.pose} pose after {stats.duration_s:.2f} s ({stats.ticks} steps); "
               "torque left ON (`biped torque off` to release)")
-    return latch.exit_code(stats)
+    return done.exit_code

@@ -20,6 +20,8 @@ from robot.bus.sdk_bus import SdkBus
 from robot.commands.common import HARDWARE_BUSES, add_robot_args, one_line_errors, robot_from
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
+from robot.run.session import bus_session
+from robot.run.signals import shield
 from robot.servo.models import BUS_FAMILIES
 from robot.setup.motor_setup import (
     FACTORY_BAUD,
@@ -74,8 +76,7 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
     print(f"setting up {len(joints)} {robot.bus.model} servo(s) of {robot.name} on "
           f"{bus.port_name}: ids from the robot file, {robot.bus.baud} baud, return delay 0 "
           "(a servo waits that long before every reply: latency in each control tick)")
-    bus.open()
-    try:
+    with bus_session(bus, torque_off=False):
         for joint in joints:
             if not args.yes:
                 reply = ask(f"connect only the servo for {joint.name} (id {joint.servo_id}) "
@@ -86,12 +87,11 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
             found = find_servo(bus, robot, progress=lambda m: print(f"  {m}", flush=True))
             check_model(found, robot, joint)
             print(f"  found: {robot.bus.model} at id {found.id}, {found.baud} baud")
-            changes = assign(bus, found, joint, robot)
+            with shield():           # id, baud, return delay: all of them or a signal waits
+                changes = assign(bus, found, joint, robot)
             done = "; ".join(changes) if changes else "already set, nothing changed"
             print(f"{joint.name}: id {joint.servo_id} at {robot.bus.baud} baud, checked "
                   f"({done})")
-    finally:
-        bus.close(torque_off=False)
     if not args.joint:
         print(f"done: connect the chain and check with `biped scan --robot {args.robot} "
               f"--port {bus.port_name}`")

@@ -19,6 +19,8 @@ from robot.commands.common import (
 )
 from robot.loop.streamer import Streamer
 from robot.motion.posing import PoseMove
+from robot.run.result import torque_words
+from robot.run.session import bus_session
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -37,8 +39,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
     bus = bus_from(args, robot)
-    bus.open()
-    try:
+    with bus_session(bus, torque_off=args.state == "off"):
         if args.state == "off":
             bus.set_torque(robot.ids, enabled=False)
             print(f"torque OFF on {len(robot.ids)} servos: the robot is limp, support it")
@@ -46,10 +47,8 @@ def run(args: argparse.Namespace) -> int:
         sm = ServoMap(robot)
         here = PoseMove(robot, sm.from_positions(bus.read_positions(sm.ids)))
         stats = Streamer(sm, bus, here, rate_hz=bus_rate(bus), hold_at_end=True).run()
-        if stats.fault or not stats.holding:
-            print(f"stopped: {stats.stop_reason}; torque OFF")
-            return 1
-        print(f"torque ON on {len(robot.ids)} servos, holding their present position")
-        return 0
-    finally:
-        bus.close(torque_off=False)
+    if stats.fault or not stats.holding:
+        print(f"stopped: {stats.stop_reason}; {torque_words(stats)}")
+        return 1
+    print(f"torque ON on {len(robot.ids)} servos, holding their present position")
+    return 0

@@ -15,13 +15,19 @@ from robot.commands.common import (
     add_robot_args,
     add_set_arg,
     bounded_float,
+    bounded_int,
     output_file,
     params_from,
     positive_int,
     robot_from,
     seconds,
+    writing,
 )
 from robot.errors import ConfigError
+
+#: --seed: the workers seed numpy's 32-bit generator with seed + 7919 x worker.
+MAX_SEED = 2**31 - 1
+seed = bounded_int(0, MAX_SEED, what="a seed")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
@@ -64,9 +70,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                         "postgresql:// or mysql:// URL shares one study between machines")
     p.add_argument("--study", default=None, metavar="NAME",
                    help="study name (default: ROBOT-GAIT-OUT)")
-    p.add_argument("--jobs", type=positive_int, default=None,
+    p.add_argument("--jobs", type=bounded_int(1, 256, what="a number of workers"), default=None,
                    help="worker processes (default: the number of cores)")
-    p.add_argument("--seed", type=positive_int, default=1, help="sampler seed")
+    p.add_argument("--seed", type=seed, default=1,
+                   help=f"sampler seed, an integer in [0, {MAX_SEED}] (each worker adds its "
+                        "number x 7919; numpy seeds are 32-bit)")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     return p
 
@@ -127,10 +135,11 @@ def run(args: argparse.Namespace) -> int:
     best_groups = group_survival(top.user_attrs["runs"], groups) if top else {}
     if top is not None and top.user_attrs.get("survived", 0) < ref["survived"]:
         best, best_groups = start, start_groups       # never write something worse
-    written = write_preset(out, best, name=out.stem,
-                           description=f"tuned by biped tune for {robot.name} from "
-                           f"'{gait.name}' ({done} trials, {args.suite} suite)")
-    pngs = plot_study(study, out.with_suffix(""), start_score=start_score)
+    with writing("--out", out):
+        written = write_preset(out, best, name=out.stem,
+                               description=f"tuned by biped tune for {robot.name} from "
+                               f"'{gait.name}' ({done} trials, {args.suite} suite)")
+        pngs = plot_study(study, out.with_suffix(""), start_score=start_score)
     wall = time.perf_counter() - wall0
     per_trial = study_s * jobs / max(1, done)
     result: dict[str, Any] = {

@@ -13,23 +13,31 @@ from robot.commands.common import (
     add_bus_args,
     add_robot_args,
     add_set_arg,
+    bounded_int,
     bus_from,
     input_file,
     output_file,
     params_from,
-    positive_int,
     rate_hz,
     robot_from,
     seconds,
 )
 from robot.commands.world_args import add_world_args, describe_world, world_from
+from robot.config.read_back import MAX_READ_PERIOD_S, check_read_every, max_read_every
 from robot.errors import ConfigError
 from robot.motion.keyframes import load_sequence
+from robot.run.result import TORQUE_WORDS
 from robot.run.run import execute
 from robot.run.spec import RunOptions
 from robot.run.walk import walk_spec, walk_summary
 
 log = logging.getLogger(__name__)
+
+#: --read-every: an integer in [1, the most any --rate allows] at parse time; the bound
+#: at the run's rate is checked once the rate is known (robot.loop.watchdog).
+read_every = bounded_int(1, max_read_every(2000.0), what="a read-back interval [ticks]")
+#: Read back every 10th tick: 50 ms at the default 200 Hz.
+READ_EVERY = 10
 
 
 def add_walk_args(p: argparse.ArgumentParser) -> None:
@@ -37,8 +45,11 @@ def add_walk_args(p: argparse.ArgumentParser) -> None:
     add_robot_args(p)
     add_bus_args(p, default="sim")
     p.add_argument("--rate", type=rate_hz, default=200.0, help="control rate [Hz]")
-    p.add_argument("--read-every", type=positive_int, default=10, metavar="N",
-                   help="read servos back every N ticks (default: %(default)s)")
+    p.add_argument("--read-every", type=read_every, default=READ_EVERY, metavar="N",
+                   help=f"read servos back every N ticks (default: {READ_EVERY}, fewer at "
+                        f"a low --rate); at most {MAX_READ_PERIOD_S:g} s apart (N <= "
+                        f"{MAX_READ_PERIOD_S:g} x --rate): the watchdog must see heat, "
+                        "hardware errors and a jammed servo within about a second")
     p.add_argument("--hold", action="store_true",
                    help="hold the rest pose with torque on at the end (default: torque off)")
     p.add_argument("--realtime", action="store_true", help="pace the simulation to the wall clock")
@@ -77,12 +88,14 @@ def run(args: argparse.Namespace) -> int:
         {"realtime": args.realtime, "view": args.view} if kind == "sim" else {})
     if world is not None:
         options["world"] = world
+    every = (min(READ_EVERY, max_read_every(args.rate)) if args.read_every == READ_EVERY
+             else check_read_every(args.read_every, args.rate, where="--read-every"))
     bus = bus_from(args, robot, kind=kind, **options)
     imu = imu_for(args, robot, bus)
     layer = load_sequence(args.keyframes, robot) if args.keyframes else None
     spec = walk_spec(robot, params, bus, gait=gait.name, imu=imu, keyframes=layer,
                      record=args.record, options=RunOptions(
-                         rate_hz=args.rate, read_every=args.read_every, hold=args.hold,
+                         rate_hz=args.rate, read_every=every, hold=args.hold,
                          seconds=args.seconds, stop_on_fall=args.stop_on_fall, signals=True))
     result = walk_summary(spec, execute(spec), gait=gait.name)
     if args.json:
@@ -117,10 +130,13 @@ def format_summary(r: dict[str, Any]) -> str:
         f" {r['overruns']} overruns, {r['bus_errors']} bus errors",
         f"  realtime      x{r['realtime_factor']:.1f}",
         f"  stopped       {r['stop_reason']}",
-        f"  servos        {'holding the rest pose, torque ON' if r['holding'] else 'torque off'}",
+        f"  servos        {servo_words(r['torque'])}",
     ]
     if r.get("record_error"):
         lines.append(f"  record        FAILED: {r['record_error']}")
     return "\n".join(lines)
 
 
+def servo_words(torque: str) -> str:
+    """What the servos were left doing (LoopStats.torque), in the summary's words."""
+    return "holding the rest pose, torque ON" if torque == "on" else TORQUE_WORDS[torque]

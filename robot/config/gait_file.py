@@ -70,6 +70,9 @@ def parse_gait(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> Ga
             if canon in values:
                 raise ConfigError(f"{where}: {canon} given twice (alias of {canon})")
             values[canon] = check_value(canon, v, where=where)
+    if not values:
+        raise ConfigError(f"{src}: no parameters (fps, [params] or [mapping]); a preset "
+                          "names at least one, or it would walk on the defaults unasked")
     return Gait(name=name, params=GaitParams().replace(values, where=src), source=src,
                 given=frozenset(values))
 

@@ -15,7 +15,7 @@ ARM_NAMES = tuple(f"{s}_{j}" for s in SIDES for j in ARM_JOINTS)
 JOINT_NAMES = LEG_NAMES + ARM_NAMES
 HIP_YAW_NAMES = ("r_hip_yaw", "l_hip_yaw")
 #: Names of extra joints: lowercase letters, digits and '_', starting with a letter.
-EXTRA_NAME = re.compile(r"^[a-z][a-z0-9_]{0,31}$")
+EXTRA_NAME = re.compile(r"^[a-z][a-z0-9_]{0,31}\Z")  # \Z: "$" lets a final newline in
 
 
 def limb_groups(names: tuple[str, ...] | list[str]) -> list[tuple[str, list[str]]]:

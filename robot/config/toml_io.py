@@ -8,6 +8,7 @@ and named in the message.
 
 from __future__ import annotations
 
+import json
 import math
 import stat
 import sys
@@ -67,6 +68,22 @@ def show(value: object) -> str:
         return f"{'-' if value < 0 else ''}an integer of {digits} digits"
     text = repr(value)
     return text if len(text) <= MAX_SHOWN else text[:MAX_SHOWN] + "..."
+
+
+def parse_json(text: str, *, where: str) -> JsonValue:
+    """``text`` parsed as JSON; ConfigError naming ``where`` if it is not JSON, nests too
+    deeply (RecursionError) or holds an integer past Python's digit limit (ValueError)."""
+    try:
+        value: JsonValue = json.loads(text)
+    except RecursionError:
+        raise ConfigError(f"{where}: not JSON: arrays or objects nested too deeply") \
+            from None
+    except json.JSONDecodeError as e:
+        raise ConfigError(f"{where}: not JSON: {e.msg} (column {e.colno})") from None
+    except ValueError:
+        raise ConfigError(f"{where}: not JSON: an integer has more than "
+                          f"{sys.get_int_max_str_digits()} digits") from None
+    return value
 
 
 def read_toml(path: Path) -> TomlTable:

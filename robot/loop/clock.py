@@ -37,3 +37,28 @@ class MonotonicClock:
                 return
             if remaining > self.spin_s:
                 time.sleep(remaining - self.spin_s)
+
+
+class Pacer:
+    """Absolute deadlines ``dt`` [s] apart on ``clock``: ``wait`` sleeps until the next one;
+    a deadline missed by whole slots is counted and skipped (realigned), never a burst of
+    ticks to catch up."""
+
+    def __init__(self, clock: Clock, dt: float) -> None:
+        self.clock = clock
+        self.dt = dt
+        self.next = 0.0
+
+    def start(self) -> None:
+        """The first deadline is one ``dt`` from now."""
+        self.next = self.clock.now()
+
+    def wait(self) -> tuple[float, float, int]:
+        """Sleep until the next deadline; (now [s], lateness [s], whole slots missed)."""
+        self.next += self.dt
+        self.clock.sleep_until(self.next)
+        now = self.clock.now()
+        late = now - self.next
+        missed = int(late // self.dt) if late > self.dt else 0
+        self.next += missed * self.dt
+        return now, late, missed

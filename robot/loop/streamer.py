@@ -20,7 +20,8 @@ end, by cause (docs/hardware.md, "What happens when"):
   an exception in the gait engine (the source): ramp straight to rest, torque off;
   a fault that makes driving unsafe or impossible (hardware error flag, over-temperature,
     a servo not following, a dead bus, any other exception): torque off at once.
-A fault always ends with torque off, ``hold_at_end`` or not.
+A fault always ends with torque off, ``hold_at_end`` or not (robot.loop.ending.end: a
+hold needs servos that still answer); a stop before the start: nothing is written.
 """
 
 from __future__ import annotations
@@ -36,9 +37,10 @@ import numpy as np
 from robot.bus.base import Bus
 from robot.bus.servo_map import ServoMap
 from robot.config.params import GaitParams
+from robot.config.read_back import max_read_every
 from robot.errors import BusDead, BusError, ConfigError, SafetyStop
-from robot.loop.clock import Clock, MonotonicClock
-from robot.loop.ending import arm_failsafe, finish
+from robot.loop.clock import Clock, MonotonicClock, Pacer
+from robot.loop.ending import arm_failsafe, end
 from robot.loop.latency import SampleStats
 from robot.loop.source import Feedback, JointTargets, JointVector, MotionSource, SourceT
 from robot.loop.start_check import check_inside_limits
@@ -61,17 +63,16 @@ class Streamer(Generic[SourceT]):
         self.map = robot_map
         self.bus = bus
         self.source = source
-        self.rate_hz = rate_hz
-        self.dt = 1.0 / rate_hz
+        self.rate_hz, self.dt = rate_hz, 1.0 / rate_hz
         self._step = robot_map.max_speed * self.dt  # slew limit per tick [rad]
-        self.read_every = max(1, read_every)
+        self.read_every = min(max(1, read_every), max_read_every(rate_hz))  # inputs refuse more
         bus.check_rate(rate_hz, read_every=self.read_every)   # before anything moves
         self.clock: Clock = clock or getattr(bus, "clock", None) or MonotonicClock()
         self.hold_at_end = hold_at_end
         self.watchdog_config = watchdog or WatchdogConfig()
-        self.watchdog = Watchdog(self.watchdog_config, robot_map, robot=source.robot)
-        self.observer = observer
-        self.feedback = feedback
+        self.watchdog = Watchdog(self.watchdog_config, robot_map, robot=source.robot,
+                                 read_period_s=self.read_every * self.dt)
+        self.observer, self.feedback = observer, feedback
         self._feedback_on = False
         self.telemetry = Telemetry()
         self._lock = threading.Lock()
@@ -84,7 +85,7 @@ class Streamer(Generic[SourceT]):
         self._lateness = SampleStats()
         self._overruns = 0
         self._bus_errors = 0
-        self._next = 0.0
+        self._pacer = Pacer(self.clock, self.dt)
         self._ticks = 0
 
     @property
@@ -124,15 +125,18 @@ class Streamer(Generic[SourceT]):
         is stopped: a gait ramps out) or a stop is requested."""
         wall0 = time.perf_counter()
         t_start = self.clock.now()
+        if self._stop.is_set():   # stopped before it started: nothing moves
+            return self._stats(t_start, wall0, self.telemetry.stop_reason, torque="untouched")
         ids = list(self.map.ids)
         present = self.map.from_positions(self.bus.read_positions(ids))
-        q0 = self._check_start(present)          # StartRefused: nothing moved, torque untouched
+        q0 = check_inside_limits(self.map, present, tolerance=self._step,  # StartRefused:
+                                 source=self.source.robot.source)  # nothing moved or written
         try:
             self.bus.write_goals(self.map.goals(q0.tolist()))  # no snap to a stale goal
             self.bus.set_torque(ids, enabled=True)
             self._q_last = q0
             arm_failsafe(self.bus, ids, self.watchdog_config.failsafe_s, dt=self.dt)
-            self._next = self.clock.now()     # after arming: its packets take wire time
+            self._pacer.start()               # after arming: its packets take wire time
             self._stream(seconds)
         except SafetyStop as e:                  # the watchdog: unsafe or impossible to drive
             self._bus_dead = isinstance(e, BusDead)
@@ -141,22 +145,22 @@ class Streamer(Generic[SourceT]):
             log.exception("the control loop failed")
             self._set_fault(f"exception: {type(e).__name__}: {e}")
         except BaseException:                    # KeyboardInterrupt, SystemExit: no ramp
-            self._finish(torque_off=True)
+            self._finish(hold=False)
             raise
-        estop = self._estop.is_set()
-        holding = self.hold_at_end and self._fault is None and not estop
-        self._finish(torque_off=not holding)
+        torque = self._finish(hold=self.hold_at_end and self._fault is None
+                              and not self._estop.is_set())
         reason = self._fault or self.telemetry.stop_reason or "completed"
         self.telemetry.stop_reason = reason
+        return self._stats(t_start, wall0, reason, torque=torque)
+
+    def _stats(self, t_start: float, wall0: float, reason: str | None, *, torque: str
+               ) -> LoopStats:
         return loop_stats(self._lateness, ticks=self._ticks, rate_hz=self.rate_hz,
                           duration_s=max(self.clock.now() - t_start, 1e-9),
                           overruns=self._overruns, bus_errors=self._bus_errors,
-                          wall_s=time.perf_counter() - wall0, stop_reason=reason,
-                          fault=self._fault is not None, holding=holding, estop=estop)
-
-    def _check_start(self, present: JointVector) -> JointVector:
-        return check_inside_limits(self.map, present, tolerance=self._step,
-                                   source=self.source.robot.source)
+                          wall_s=time.perf_counter() - wall0, stop_reason=reason or "stopped",
+                          fault=self._fault is not None, holding=torque == "on",
+                          estop=self._estop.is_set(), torque=torque)
 
     def _stream(self, seconds: float | None) -> None:
         src = self.source
@@ -196,11 +200,16 @@ class Streamer(Generic[SourceT]):
             log.error("safe stop: %s", reason)
         self.request_stop(reason)
 
-    def _finish(self, *, torque_off: bool) -> None:
+    def _finish(self, *, hold: bool) -> str:
+        """Hold or torque off (robot.loop.ending.end); what is known of the torque."""
+        torque, fault = end(self.bus, self.map.ids, hold=hold, estop=self._estop.is_set,
+                            confirm=lambda: self.watchdog.faults(self.bus.read_state(self.map.ids)),
+                            bus_dead=self._bus_dead, failsafe=bool(self.watchdog_config.failsafe_s))
+        if fault is not None:
+            self._set_fault(fault)
         self.telemetry.state = "estop" if self._estop.is_set() else "stopped"
-        finish(self.bus, self.map.ids, torque_off=torque_off, bus_dead=self._bus_dead,
-               failsafe=bool(self.watchdog_config.failsafe_s))
         self._notify()
+        return torque
 
     def _apply_pending(self) -> None:
         with self._lock:
@@ -220,8 +229,7 @@ class Streamer(Generic[SourceT]):
 
     # -- the one loop --------------------------------------------------------------------
     def _send(self, q: JointVector, *, state: str) -> None:
-        """(Feedback,) clamp, slew-limit, wait for the deadline, write; read back every Nth
-        tick."""
+        """(Feedback,) clamp, slew-limit, wait for the deadline, write; every Nth: read."""
         if self._feedback_on:
             q = self._feed_back(q)
         q = np.clip(self.map.clamp(q), self._q_last - self._step, self._q_last + self._step)
@@ -267,15 +275,9 @@ class Streamer(Generic[SourceT]):
             return q
 
     def _wait_deadline(self) -> None:
-        self._next += self.dt
-        self.clock.sleep_until(self._next)
-        now = self.clock.now()
-        late = now - self._next
-        if late > self.dt:
-            # Missed at least one whole slot: count it and realign, never burst to catch up.
-            missed = int(late // self.dt)
+        now, late, missed = self._pacer.wait()
+        if missed:                               # counted and realigned (loop.clock.Pacer)
             self._overruns += missed
-            self._next += missed * self.dt
             try:
                 self.watchdog.overrun()
             except SafetyStop as e:              # the bus still works: ramp out and stop

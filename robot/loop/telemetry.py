@@ -40,7 +40,9 @@ class LoopStats:
 
     fault: the run ended on a fault (watchdog, exception, failed observer): exit code 1;
     holding: it ended with torque left on (``hold_at_end`` and no fault or emergency stop);
-    estop: it ended by an emergency stop (torque off at once).
+    estop: it ended by an emergency stop (torque off at once); torque: what the bus told
+    of the servos' torque at the end (robot.loop.ending.TORQUE_STATES: "on", "off",
+    "sent": torque off sent but not confirmed, "unknown": nothing could be sent).
     """
 
     ticks: int
@@ -57,6 +59,7 @@ class LoopStats:
     fault: bool = False
     holding: bool = False
     estop: bool = False
+    torque: str = "off"
 
     def as_dict(self) -> dict[str, Any]:
         return dict(self.__dict__)
@@ -64,7 +67,7 @@ class LoopStats:
 
 def loop_stats(lateness: SampleStats, *, ticks: int, rate_hz: float, duration_s: float,
                overruns: int, bus_errors: int, wall_s: float, stop_reason: str,
-               fault: bool, holding: bool, estop: bool) -> LoopStats:
+               fault: bool, holding: bool, estop: bool, torque: str) -> LoopStats:
     """The statistics of a run from the tick-start lateness samples [s] and its counts."""
     return LoopStats(
         ticks=ticks, rate_hz=rate_hz, duration_s=duration_s, achieved_hz=ticks / duration_s,
@@ -72,4 +75,4 @@ def loop_stats(lateness: SampleStats, *, ticks: int, rate_hz: float, duration_s:
         period_error_p99_ms=lateness.percentile(99) * 1e3,
         period_error_max_ms=max(lateness.max, 0.0) * 1e3 if lateness.count else 0.0,
         overruns=overruns, bus_errors=bus_errors, wall_s=wall_s, stop_reason=stop_reason,
-        fault=fault, holding=holding, estop=estop)
+        fault=fault, holding=holding, estop=estop, torque=torque)

@@ -1,4 +1,10 @@
-"""Watchdog: turns bus errors, overruns and servo faults into a safe stop with a reason."""
+"""Watchdog: turns bus errors, overruns and servo faults into a safe stop with a reason.
+
+A servo not following is judged two ways: relative to how its goal moves (a jam or a block:
+robot.loop.following), and, as a backstop, far from its goal for several read-backs. Both
+need read-backs often enough: robot.config.read_back bounds the period everywhere it can be
+set (``--read-every``, a take's header), so no input switches the watchdog off.
+"""
 
 from __future__ import annotations
 
@@ -12,6 +18,7 @@ from robot.bus.base import ServoState
 from robot.bus.servo_map import ServoMap
 from robot.config.robot import RobotConfig
 from robot.errors import BusDead, BusError, SafetyStop
+from robot.loop.following import FollowCheck
 
 #: How many times the longest retried transaction the servos' bus watchdog must allow.
 FAILSAFE_MARGIN = 1.5
@@ -27,7 +34,8 @@ class WatchdogConfig:
     bus_error_streak: consecutive failed bus transactions before a stop;
     overrun_streak: consecutive overrunning ticks before a stop;
     max_temperature_c: [°C]; follow_error_rad: commanded - present beyond which a servo
-    is "not following" [rad]; follow_reads: consecutive read-backs it must persist;
+    is "not following" whatever its goal does [rad] (the backstop; the jam check is
+    robot.loop.following); follow_reads: consecutive read-backs it must persist;
     failsafe_s: the servos' own bus watchdog, armed while streaming: with no packet for
     this long [s] they stop by themselves (None: leave it off). It is armed at least
     ``FAILSAFE_MARGIN`` times the bus's ``retry_span_s`` plus two ticks, so a transaction
@@ -43,14 +51,17 @@ class WatchdogConfig:
 
 
 class Watchdog:
+    """The checks of one run; ``read_period_s``: time between read-backs [s]."""
+
     def __init__(self, cfg: WatchdogConfig, servo_map: ServoMap, *,
-                 robot: RobotConfig | None = None) -> None:
+                 robot: RobotConfig | None = None, read_period_s: float = 0.05) -> None:
         self.cfg = cfg
         self.map = servo_map
         self.robot = robot
         self._bus_streak = {"write": 0, "read": 0}
         self._overrun_streak = 0
         self._follow_streak = np.zeros(len(servo_map.ids), dtype=int)
+        self._follow = FollowCheck(servo_map, read_period_s=read_period_s)
 
     def _joint(self, servo_id: int) -> str:
         j = self.robot.joint_by_id(servo_id) if self.robot else None
@@ -79,6 +90,11 @@ class Watchdog:
 
     def check(self, states: Mapping[int, ServoState], q_cmd: npt.NDArray[np.float64]) -> None:
         """Raise SafetyStop on a hardware fault, overheating, or a servo not following."""
+        self.faults(states)
+        self._following(states, q_cmd)
+
+    def faults(self, states: Mapping[int, ServoState]) -> None:
+        """Raise SafetyStop on a hardware fault or overheating."""
         for sid, s in states.items():
             bad = sorted(s.errors & FAULTS)
             if bad:
@@ -86,7 +102,16 @@ class Watchdog:
             if s.temperature is not None and s.temperature > self.cfg.max_temperature_c:
                 raise SafetyStop(f"{self._joint(sid)} at {s.temperature:.0f} °C "
                                  f"(limit {self.cfg.max_temperature_c:.0f} °C)")
+
+    def _following(self, states: Mapping[int, ServoState],
+                   q_cmd: npt.NDArray[np.float64]) -> None:
         present = self.map.from_positions({i: s.position for i, s in states.items()})
+        stuck = self._follow.add(q_cmd, present)
+        if stuck is not None:
+            i, r_goal, r_present = stuck
+            raise SafetyStop(f"{self._joint(self.map.ids[i])} stopped following: its goal "
+                             f"moved over {r_goal:.2f} rad in {self._follow.window_s:.2g} s, "
+                             f"it moved {r_present:.3f} rad (jammed or blocked)")
         err = np.abs(present - q_cmd)
         lagging = err > self.cfg.follow_error_rad
         self._follow_streak = np.where(lagging, self._follow_streak + 1, 0)

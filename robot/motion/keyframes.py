@@ -33,7 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.config.robot import RobotConfig
-from robot.config.toml_io import JsonValue, TomlValue, number, read_toml, show
+from robot.config.toml_io import JsonValue, TomlValue, number, parse_json, read_toml, show
 from robot.errors import ConfigError
 from robot.motion.interp import METHODS, interpolate
 
@@ -180,13 +180,15 @@ def load_sequence(path: str | Path, robot: RobotConfig) -> Sequence:
         data: Mapping[str, Value] = read_toml(p)
     else:
         try:
-            data = json.loads(p.read_text())
+            text = p.read_text()
         except FileNotFoundError:
             raise ConfigError(f"{p}: file not found") from None
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        except (OSError, UnicodeDecodeError) as e:
             raise ConfigError(f"{p}: not a valid JSON keyframe file: {e}") from None
-        if not isinstance(data, dict):
+        value = parse_json(text, where=str(p))
+        if not isinstance(value, dict):
             raise ConfigError(f"{p}: expected a JSON object with a keyframe list")
+        data = value
     return parse_sequence(data, robot, source=str(p))
 
 

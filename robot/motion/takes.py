@@ -22,7 +22,6 @@ before anything moves; every problem is one line naming the file, the line and t
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -33,7 +32,8 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.config.params import GaitParams, canonical_name, check_value
-from robot.config.toml_io import JsonValue, number
+from robot.config.read_back import check_read_every, max_read_every
+from robot.config.toml_io import JsonValue, number, parse_json
 from robot.errors import ConfigError
 
 SUFFIX = ".take.jsonl"
@@ -148,7 +148,9 @@ def _header(where: str, h: JsonValue) -> TakeHeader:
         raise _fail(where, "show: expected a show object (robot.motion.show) or null")
     return TakeHeader(robot=strings["robot"], robot_file=strings["robot_file"],
                       joints=names, rate_hz=float(rate),
-                      read_every=_int(where, h.get("read_every", 10), "read_every", 1),
+                      read_every=check_read_every(
+                          h.get("read_every", min(10, max_read_every(rate))), float(rate),
+                          where=f"{where}: read_every"),
                       gait=strings["gait"] or "take",
                       params=GaitParams().replace(params, where=f"{where}: params"),
                       bus=strings["bus"] or "sim", balance=h.get("balance") is True,
@@ -169,10 +171,7 @@ def _lines(p: Path) -> list[tuple[str, JsonValue]]:
     for i, text in enumerate(lines, 1):
         if not text.strip():
             continue
-        try:
-            rows.append((f"{p}: line {i}", json.loads(text)))
-        except json.JSONDecodeError as e:
-            raise ConfigError(f"{p}: line {i}: not JSON: {e.msg}") from None
+        rows.append((f"{p}: line {i}", parse_json(text, where=f"{p}: line {i}")))
     if not rows:
         raise ConfigError(f"{p}: empty; expected a take header line")
     return rows
@@ -214,6 +213,9 @@ def read_take(path: str | Path) -> Take:
             states.append(str(row.get("state", "")))
         else:
             raise _fail(where, "expected a timeline line (gait_tick) or a stream line (tick)")
+    if not q and not stop:
+        raise ConfigError(f"{p}: a header only (no gait ticks, no stream lines): nothing to "
+                          "replay; record a take with `biped walk --record NAME.take.jsonl`")
     q_arr = np.asarray(q, dtype=float).reshape(len(q), n)
     return Take(header, changes, stop, np.asarray(t, dtype=float), q_arr, tuple(states),
                 source=str(p))

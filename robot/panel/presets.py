@@ -23,7 +23,7 @@ from robot.errors import ConfigError
 
 log = logging.getLogger(__name__)
 
-NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,47}$")
+NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,47}\Z")  # \Z: "$" lets a final newline in
 
 
 class PresetExistsError(ConfigError):

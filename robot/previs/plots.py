@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import csv
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -14,6 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.config.joint_names import limb_groups
+from robot.config.toml_io import parse_json
 from robot.errors import ConfigError
 from robot.gait.expressions import CHANNELS
 from robot.previs.curves import outside_legend, palette, plot_curves
@@ -43,12 +43,14 @@ def _num(v: Any) -> float:
 
 
 def read_table(path: str | Path) -> Table:
-    """Read a .csv or .jsonl file of rows into columns."""
+    """Read a .csv or .jsonl file of rows into columns; ConfigError (one line naming the
+    file, the line and the column) unless it has at least two rows, a finite ``t`` in each
+    and only plain values (no NUL byte, no nested JSON)."""
     p = Path(path)
     try:
         with p.open(newline="") as f:
             if p.suffix == ".jsonl":
-                rows = [json.loads(line) for line in f if line.strip()]
+                rows = [_json_row(p, k, line) for k, line in enumerate(f, 1) if line.strip()]
                 names = list(rows[0]) if rows else []
             elif p.suffix == ".csv":
                 reader = csv.reader(f)
@@ -58,16 +60,41 @@ def read_table(path: str | Path) -> Table:
                 raise ConfigError(f"{path}: unknown format {p.suffix!r}; valid: .csv, .jsonl")
     except FileNotFoundError:
         raise ConfigError(f"{path}: file not found") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as e:
-        raise ConfigError(f"{path}: not a valid record file: {e}") from e
+    except (UnicodeDecodeError, csv.Error, OSError) as e:
+        raise ConfigError(f"{path}: not a valid record file: {e}") from None
     if rows and p.suffix == ".jsonl" and "take" in rows[0]:
         rows, names = _take_rows(rows)
     if not rows or "t" not in names:
         raise ConfigError(f"{path}: no rows with a 't' column; expected a `biped walk "
                           "--record` or `biped curves` file")
+    _check_rows(p, rows)
     cols = {n: np.array([_num(r.get(n)) for r in rows]) for n in names if n != "state"}
     states = tuple(str(r.get("state", "")) for r in rows)
     return Table(cols, states, str(p))
+
+
+def _json_row(p: Path, k: int, line: str) -> dict[str, Any]:
+    """Line ``k`` of a .jsonl record: a flat JSON object."""
+    row = parse_json(line, where=f"{p}: line {k}")
+    if not isinstance(row, dict):
+        raise ConfigError(f"{p}: line {k}: expected a JSON object (one row), got "
+                          f"{type(row).__name__}")
+    return row
+
+
+def _check_rows(p: Path, rows: list[dict[str, Any]]) -> None:
+    """At least two rows; plain values only; ``t`` a finite number in every row."""
+    if len(rows) < 2:
+        raise ConfigError(f"{p}: {len(rows)} row; a plot needs at least 2")
+    for k, row in enumerate(rows, 1):
+        for name, v in row.items():
+            if isinstance(v, dict | list) or (isinstance(v, str) and "\0" in v):
+                raise ConfigError(f"{p}: row {k}: column {name!r}: expected a number or a "
+                                  "word, got " + ("a NUL byte" if isinstance(v, str) else
+                                                  f"a nested {type(v).__name__}"))
+        if not math.isfinite(_num(row.get("t"))):
+            raise ConfigError(f"{p}: row {k}: column 't': expected a finite time [s], got "
+                              f"{str(row.get('t'))[:40]!r}")
 
 
 def _take_rows(rows: list[dict[str, Any]]) -> tuple[list[dict[str, Any]], list[str]]:

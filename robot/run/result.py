@@ -45,8 +45,26 @@ class RunResult:
             "overruns": s.overruns, "bus_errors": s.bus_errors,
             "realtime_factor": self.realtime_factor,
             "stop_reason": s.stop_reason, "fault": s.fault, "holding": s.holding,
+            "torque": s.torque,
         })
         if self.record_error is not None:
             out["record_error"] = self.record_error
         out["exit_code"] = self.exit_code
         return out
+
+
+#: What the CLI says of the servos' torque at the end, by LoopStats.torque: only what the
+#: bus confirmed (docs/hardware.md, "What happens when").
+TORQUE_WORDS = {
+    "on": "holding, torque ON",
+    "off": "torque off",
+    "sent": "torque-off sent, not confirmed (the servos stopped answering)",
+    "unknown": "torque state UNKNOWN: nothing could be sent (the port failed); the servos "
+               "may still hold torque (docs/hardware.md, \"When the host vanishes\")",
+    "untouched": "stopped before it started: nothing moved, torque untouched",
+}
+
+
+def torque_words(stats: LoopStats) -> str:
+    """The servos' torque at the end of a run as the CLI says it (``TORQUE_WORDS``)."""
+    return TORQUE_WORDS.get(stats.torque, f"torque {stats.torque}")

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import signal
 import time
 from collections.abc import Callable
 from types import TracebackType
@@ -24,11 +25,12 @@ from robot.balance.stage import Balance, attitude_reader
 from robot.bus.servo_map import ServoMap
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
+from robot.loop.ending import finish
 from robot.loop.source import Feedback, SourceT
 from robot.loop.streamer import Streamer
 from robot.loop.telemetry import LoopStats, Telemetry
 from robot.run.result import RunResult
-from robot.run.signals import SignalLatch, stop_on_signals
+from robot.run.signals import SignalLatch, installed, shield, stop_on_signals
 from robot.run.spec import RunSpec, RunWatch, WatchedBus
 
 log = logging.getLogger(__name__)
@@ -40,13 +42,16 @@ class Run(Generic[SourceT]):
 
     def __init__(self, spec: RunSpec[SourceT]) -> None:
         self.spec = spec
-        self.latch = SignalLatch()
+        # Under a command its latch (signals before and after the stream count too).
+        outer = installed() if spec.options.signals else None
+        self.latch = outer or SignalLatch()
         self.watch: RunWatch | None = None
         self._streamer: Streamer[SourceT] | None = None
         self._stats: LoopStats | None = None
         self._result: RunResult | None = None
         self._wall0 = 0.0
         self._imu_opened = False
+        self._signals = contextlib.ExitStack()
 
     @property
     def streamer(self) -> Streamer[SourceT]:
@@ -74,6 +79,8 @@ class Run(Generic[SourceT]):
             spec.recorder.open()          # an unwritable path fails before the bus opens
         try:
             self._open()
+            if spec.options.signals:      # routed from here until closed (robot.run.signals)
+                self._signals.enter_context(stop_on_signals(self.streamer, self.latch))
         except BaseException:
             self._close()
             raise
@@ -122,11 +129,7 @@ class Run(Generic[SourceT]):
     # -- streaming -----------------------------------------------------------------------
     def stream(self) -> LoopStats:
         """Stream the source (once): until it stops, ``options.seconds`` pass, or a stop."""
-        streamer = self.streamer
-        guard = (stop_on_signals(streamer, self.latch) if self.spec.options.signals
-                 else contextlib.nullcontext())
-        with guard:
-            self._stats = streamer.run(seconds=self.spec.options.seconds)
+        self._stats = self.streamer.run(seconds=self.spec.options.seconds)
         return self._stats
 
     def request_stop(self, reason: str = "stop requested") -> None:
@@ -141,7 +144,13 @@ class Run(Generic[SourceT]):
         self.close()
 
     def close(self) -> None:
-        """Close what the run opened; then ``result`` holds the outcome (if it streamed)."""
+        """Close what the run opened; then ``result`` holds the outcome (if it streamed).
+        Signals still go to the streamer until the end (a second one: torque off)."""
+        with self._signals, shield():
+            self._close_all()
+
+    def _close_all(self) -> None:
+        self._end_hold()
         record_error = self._close()
         if self._stats is None:
             return
@@ -151,6 +160,20 @@ class Run(Generic[SourceT]):
         self._result = RunResult(stats=self._stats, wall_s=time.perf_counter() - self._wall0,
                                  seconds=self.spec.options.seconds, metrics=metrics,
                                  record_error=record_error, exit_code=code)
+
+    def _end_hold(self) -> None:
+        """A second signal after the loop ended holding (while it finished or since): it
+        asked for torque off, so torque goes off (robot.loop.ending.finish)."""
+        stats = self._stats
+        if stats is None or not stats.holding or not self.latch.emergency:
+            return
+        assert self.latch.last is not None
+        stats.torque = finish(self.spec.bus, self.spec.robot.ids, torque_off=True,
+                              bus_dead=False, failsafe=False)
+        stats.holding, stats.estop = False, True
+        stats.stop_reason = (f"emergency stop (second signal, "
+                             f"{signal.Signals(self.latch.last).name}) after it ended holding")
+        log.warning("torque off: a second signal came after the run ended holding")
 
     def _close(self) -> str | None:
         """Close what the run opened. The streamer has already left the servos as its end

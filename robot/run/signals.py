@@ -1,16 +1,36 @@
-"""SIGINT/SIGTERM for commands that stream: first → safe stop, second → emergency stop.
+"""SIGINT/SIGTERM for the command line: one latch per command, installed by ``robot.cli``
+before anything else runs and kept until the process exits, so no command is ever killed
+by a stopping signal.
 
-Exit codes (README, docs/hardware.md): 0 completed, 1 safety stop (a fault), 2 usage or
-config error, 128 + signal number when a signal stopped the run (130 SIGINT, 143 SIGTERM).
+What a signal does depends on where the command is (the latch's innermost region):
+
+- routed (``stop_on_signals(target)``: a loop is streaming): the first signal asks the
+  target to stop (``request_stop``: ramp out, rest), every later one is an emergency stop
+  (``emergency_stop``: torque off at once). Never raises.
+- shielded (``shield()``: closing the bus, a multi-write EEPROM step): only recorded; when
+  the region ends, a signal that arrived in it takes effect there (an exception after the
+  cleanup, never inside it).
+- anywhere else: the first signal raises ``Interrupted`` (a ``KeyboardInterrupt``) where
+  unwinding is safe (a prompt, a computation, opening a port), so the command's
+  ``finally`` blocks run; later signals are only recorded (cleanup is never interrupted).
+
+``latch.emergency``: two or more signals (a second Ctrl-C: torque off). Exit codes
+(README, docs/hardware.md): 0 completed, 1 safety stop (a fault), 2 usage or config
+error, 128 + the first signal's number when a signal stopped the command (130 SIGINT,
+143 SIGTERM).
 """
 
 from __future__ import annotations
 
 import logging
+import os
 import signal
-from collections.abc import Iterator
+import sys
+import threading
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Any, Protocol
+from types import FrameType
+from typing import NoReturn, Protocol
 
 from robot.loop.telemetry import LoopStats
 
@@ -25,24 +45,100 @@ class Stoppable(Protocol):
     def emergency_stop(self, reason: str = ...) -> None: ...
 
 
+class Interrupted(KeyboardInterrupt):
+    """A stopping signal unwinding a command; ``signum``: which (SIGINT or SIGTERM)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
 class SignalLatch:
-    """Remembers the first stopping signal; routes signals to a ``Stoppable``."""
+    """Remembers the stopping signals of one command and acts on them by region."""
 
     def __init__(self) -> None:
         self.first: int | None = None
+        self.last: int | None = None
         self.count = 0
+        self._routes: list[tuple[Stoppable, SignalLatch | None]] = []
+        self._shields = 0
+        self._raised = False
+        self._pending = False        # arrived while shielded, not acted on yet
+        self._ended: int | None = None
 
-    def handle(self, target: Stoppable, signum: int) -> None:
+    @property
+    def emergency(self) -> bool:
+        """Two or more signals: the operator wants torque off now."""
+        return self.count >= 2
+
+    # -- the handler (main thread, between two bytecodes of whatever runs) --------------
+    def handle(self, signum: int, _frame: FrameType | None = None) -> None:
+        if self._ended is not None:             # the command is over: leave now, same code
+            os._exit(self._ended)
+        self.record(signum)
+        if self._routes:
+            target, mirror = self._routes[-1]
+            if mirror is not None:
+                mirror.record(signum, quiet=True)
+            self._route(target, signum)
+        elif self._shields:
+            self._pending = True
+        else:
+            self._interrupt()
+
+    def record(self, signum: int, *, quiet: bool = False) -> None:
+        """Count ``signum`` (``quiet``: without saying so: another latch did)."""
         name = signal.Signals(signum).name
         self.count += 1
-        if self.first is None:
+        self.last = signum
+        if quiet:
+            self.first = self.first or signum
+        elif self.first is None:
             self.first = signum
             # Said once handled: a second signal sent before this line is one the kernel
             # may merge with the first (same number), so senders wait for it.
             log.warning("signal %s: stopping (a second signal stops at once)", name)
+        else:
+            log.warning("signal %s again: emergency stop, torque off", name)
+
+    def _route(self, target: Stoppable, signum: int) -> None:
+        name = signal.Signals(signum).name
+        if self.count == 1:
             target.request_stop(f"signal {name}")
         else:
             target.emergency_stop(f"emergency stop (second signal, {name})")
+
+    def _interrupt(self) -> None:
+        """Raise once, for the first signal; later ones only count."""
+        if self.first is not None and not self._raised:
+            self._raised = True
+            self._pending = False
+            raise Interrupted(self.first)
+
+    # -- regions ---------------------------------------------------------------------------
+    @contextmanager
+    def routed(self, target: Stoppable, *, mirror: SignalLatch | None = None
+               ) -> Iterator[None]:
+        """Signals go to ``target`` inside the block (and are counted in ``mirror`` too).
+        A signal that came before the block (shielded) stops it before it starts."""
+        if self._pending:
+            self._interrupt()
+        self._routes.append((target, mirror))
+        try:
+            yield
+        finally:
+            self._routes.pop()
+
+    @contextmanager
+    def shielded(self) -> Iterator[None]:
+        """Signals only count inside the block; one that came takes effect at its end."""
+        self._shields += 1
+        try:
+            yield
+        finally:
+            self._shields -= 1
+        if self._pending and not self._shields and not self._routes:
+            self._interrupt()
 
     def exit_code(self, stats: LoopStats | None) -> int:
         """1 for a fault, 128 + the first signal's number, else 0."""
@@ -50,16 +146,64 @@ class SignalLatch:
             return 1
         return 128 + self.first if self.first is not None else 0
 
+    # -- installing ------------------------------------------------------------------------
+    def install(self) -> Callable[[], None]:
+        """Handle SIGINT/SIGTERM (main thread); returns what restores the old handlers."""
+        old = {s: signal.signal(s, self.handle) for s in SIGNALS}
+
+        def restore() -> None:
+            for s, h in old.items():
+                signal.signal(s, h)
+        return restore
+
+    def end(self, code: int) -> NoReturn:
+        """The command is over and this process ends with ``code``, now: stdout and stderr
+        are flushed and the process exits without the interpreter's shutdown, during
+        which the handlers are gone (a signal there would kill it: exit -15, not 143).
+        Every ``finally`` of the command has run; a signal from here on exits at once
+        with the same code."""
+        self._ended = code
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        os._exit(code)
+
+
+def installed() -> SignalLatch | None:
+    """The latch handling SIGINT now (the command's), or None (no command: in-process use)."""
+    owner = getattr(signal.getsignal(signal.SIGINT), "__self__", None)
+    return owner if isinstance(owner, SignalLatch) and owner._ended is None else None
+
 
 @contextmanager
-def stop_on_signals(target: Stoppable, latch: SignalLatch) -> Iterator[SignalLatch]:
-    """Route SIGINT/SIGTERM to ``target`` inside the block; restore the old handlers."""
-    def handler(signum: int, _frame: Any) -> None:
-        latch.handle(target, signum)
-
-    old = {s: signal.signal(s, handler) for s in SIGNALS}
+def stop_on_signals(target: Stoppable, latch: SignalLatch | None = None
+                    ) -> Iterator[SignalLatch]:
+    """Route SIGINT/SIGTERM to ``target`` inside the block. Under a command (``installed``)
+    its latch routes them (and counts them in ``latch`` too); otherwise ``latch`` (or a
+    new one) handles them for the block and the old handlers come back after it."""
+    outer = installed()
+    if outer is not None:
+        with outer.routed(target, mirror=None if latch is outer else latch):
+            yield latch or outer
+        return
+    own = latch or SignalLatch()
+    restore = own.install()
     try:
-        yield latch
+        with own.routed(target):
+            yield own
     finally:
-        for s, h in old.items():
-            signal.signal(s, h)
+        restore()
+
+
+@contextmanager
+def shield() -> Iterator[None]:
+    """The command's latch's ``shielded`` region (nothing when there is no command, or
+    in another thread: signals run in the main thread and never interrupt another)."""
+    latch = installed()
+    if latch is None or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    with latch.shielded():
+        yield

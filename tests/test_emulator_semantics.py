@@ -244,3 +244,15 @@ def test_ax_wheel_mode_by_angle_limits(ax: tuple[Emulator, Any, Any]) -> None:
     start = ok(ph.read2ByteTxRx(port, 1, 36))
     assert wait_for(lambda: ok(ph.read2ByteTxRx(port, 1, 36)) != start)
     assert emu.registers(1)["moving"] == 1
+
+
+def test_x_bus_watchdog_stops_a_velocity_mode_servo(dx: tuple[Emulator, Any, Any]) -> None:
+    emu, port, ph = dx
+    assert ph.write1ByteTxRx(port, 1, X_MODE, 1) == (0, 0)
+    assert ph.write1ByteTxRx(port, 1, X_TORQUE, 1) == (0, 0)
+    assert ph.write4ByteTxRx(port, 1, X_GOAL_VEL, 100) == (0, 0)
+    assert ph.write1ByteTxRx(port, 1, 98, 1) == (0, 0)     # Bus Watchdog(98): 20 ms
+    # e-Manual: silent past the setting, the servo stops and the register reads -1.
+    assert wait_for(lambda: emu.registers(1)["bus_watchdog"] == -1)
+    regs = emu.registers(1)
+    assert regs["present_velocity"] == 0 and regs["moving"] == 0

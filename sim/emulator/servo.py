@@ -167,6 +167,8 @@ class EmulatedServo:
         if wd is not None and deadline is not None and deadline < min(now, quiet_until):
             self._advance(max(deadline, self._t))
             self.hold()                                                      # stop there
+            for name in ("goal_velocity", "goal_pwm"):     # in every mode (X: the one with it)
+                self.set_raw(name, 0)
             self.set(wd.register, wd.tripped)
         self._advance(now)
 

@@ -61,6 +61,8 @@ class EmulatedServo:
         self.mem = bytearray(max(r.address + r.size for r in self.table.values()))
         self.owner = bytearray(len(self.mem))  # 0: no register; else index+1
         self.regs = list(self.table.items())
+        self._slots = {n: (e.address, e.address + e.size, self.family == "dynamixel_x" and n in
+                           DXL_SIGNED, 1 << 8 * e.size) for n, e in self.regs}   # get / set_raw
         for i, (_, reg) in enumerate(self.regs):
             self.owner[reg.address:reg.address + reg.size] = bytes([i + 1]) * reg.size
         self.conditions: set[str] = set()   # injected hardware faults (names of ERROR_BITS)
@@ -97,31 +99,27 @@ class EmulatedServo:
 
     def get(self, name: str) -> int:
         """Value of a register by name (signed where the Dynamixel table says so)."""
-        reg = self.table[name]
-        signed = self.family == "dynamixel_x" and name in DXL_SIGNED
-        return int.from_bytes(self.mem[reg.address:reg.address + reg.size], "little",
-                              signed=signed)
+        start, end, signed, _ = self._slots[name]
+        return int.from_bytes(self.mem[start:end], "little", signed=signed)
 
     def set_raw(self, name: str, value: int) -> None:
         """Store a register by name, leaving the position model alone."""
-        reg = self.table[name]
-        self.mem[reg.address:reg.address + reg.size] = (value % (1 << 8 * reg.size)).to_bytes(
-            reg.size, "little")
+        start, end, _, modulus = self._slots[name]
+        self.mem[start:end] = (value % modulus).to_bytes(end - start, "little")
 
     def set(self, name: str, value: int) -> None:
         """Store a register by name without any check (the emulator's back door).
         ``present_position`` places the horn where the servo then reads ``value``."""
         self.set_raw(name, value)
+        self._idle = False      # at rest with nothing set since the last motion step: False
         if name == "present_position":
             self.horn = float(servo_frame.actual_goal(self, self.get(name)))
             self.step_target = self.horn
 
     def pin(self, name: str, value: int) -> None:
-        """Back door for a test: store ``value`` and keep it there (a register the motion
-        computes, such as present_load, then reads ``value`` from then on)."""
+        """Back door: store ``value``; a register motion computes then keeps it."""
         self.set(name, value)
-        if name in servo_motion.COMPUTED:
-            self.pinned[name] = value
+        self.pinned.update({name: value} if name in servo_motion.COMPUTED else {})
 
     def snapshot(self) -> dict[str, int]:
         return {name: self.get(name) for name in self.table}
@@ -175,15 +173,17 @@ class EmulatedServo:
     def _advance(self, now: float) -> None:
         dt = max(0.0, now - self._t)
         self._t = now
+        if self._idle:           # at rest and nothing set since: the registers hold
+            return
         self.horn = servo_motion.advance(self, self.horn, dt)
         for name, value in self.pinned.items():
             self.set_raw(name, value)
+        self._idle = not self.get("moving")
 
     def hold(self) -> None:
-        """Goal := where the horn is (registers refreshed): after a reset, power-on, a mode
-        change or the multi-turn clear, the servo holds its place."""
+        """Goal := where the horn is (after a reset, power-on, mode change, multi-turn clear)."""
         self.set_raw("goal_position", servo_frame.goal_for(self, self.horn))
-        self.step_target = self.horn
+        self.step_target, self._idle = self.horn, False
         self._advance(self._t)
 
     def _assert_faults(self) -> None:
@@ -199,7 +199,7 @@ class EmulatedServo:
         if self.family == "dynamixel_p1":
             self._p1_errors = value
             return
-        self.set(self.error_register, value)
+        self.set_raw(self.error_register, value)
 
     @property
     def error_bits(self) -> int:

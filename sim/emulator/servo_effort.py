@@ -84,11 +84,11 @@ def holding_duty(servo: ServoState, error_ticks: float) -> float:
     return 0.0
 
 
-def estimate(servo: ServoState, *, velocity: float, error_ticks: float,
+def estimate(servo: ServoState, *, torque_on: bool, velocity: float, error_ticks: float,
              duty: float | None) -> Effort:
-    """The motor state of the kinematic emulator: ``velocity`` [ticks/s], the position
-    error it holds against [ticks], the commanded duty in PWM / wheel modes (else None)."""
-    torque_on = bool(servo.get("torque_enable"))
+    """The motor state of the kinematic emulator: torque on or off, ``velocity``
+    [ticks/s], the position error it holds against [ticks], the commanded duty in PWM /
+    wheel modes (else None)."""
     free = velocity / servo.speed_tps if servo.speed_tps else 0.0
     if not torque_on:
         d = 0.0

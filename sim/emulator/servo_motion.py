@@ -99,14 +99,14 @@ def advance(servo: ServoState, pos: float, dt: float) -> float:
             pos += command * dt
             velocity = command
         moving = torque and velocity != 0
-    _feedback(servo, mode, pos, velocity, moving=moving)
+    _feedback(servo, mode, pos, velocity, moving=moving, torque=torque)
     servo_effort.write_effort(servo, servo_effort.estimate(
-        servo, velocity=velocity, error_ticks=error, duty=duty))
+        servo, torque_on=torque, velocity=velocity, error_ticks=error, duty=duty))
     return pos
 
 
 def _feedback(servo: ServoState, mode: Mode, pos: float, velocity: float, *,
-              moving: bool) -> None:
+              moving: bool, torque: bool) -> None:
     single = servo_modes.single_turn(servo, mode)
     present = servo_frame.present(servo, pos, single_turn=single)
     if servo.family == "feetech_sts":
@@ -119,7 +119,7 @@ def _feedback(servo: ServoState, mode: Mode, pos: float, velocity: float, *,
     if servo.family == "dynamixel_x":
         servo.set_raw("present_velocity",
                       round(velocity / dxl_velocity_unit_ticks_s(servo.model.resolution)))
-        servo.set_raw("moving_status", 0 if not servo.get("torque_enable") else (
+        servo.set_raw("moving_status", 0 if not torque else (
             MOVING_PROFILE_ONGOING if moving else MOVING_IN_POSITION))
     elif servo.family == "dynamixel_p1":
         # Joint mode: 0.111 rev/min a unit; wheel mode: the output share, 0-1023 (AX-12A

@@ -36,7 +36,8 @@ unit: $(STAMP) system-deps
 
 # The wheel, installed (not editable) into a fresh venv and run from a directory outside
 # the checkout: proves the package ships everything it needs (configs, panel files, the
-# sim bus entry point). Dependencies come from pip's cache or the registry.
+# sim bus entry point), and that a user can copy a bundled robot file to start from.
+# Dependencies come from pip's cache or the registry.
 wheel-check: $(STAMP)
 	@set -eu; tmp=$$(mktemp -d); trap 'rm -rf "$$tmp"' EXIT; start=$$(date +%s); \
 	rm -rf build; \
@@ -53,7 +54,9 @@ wheel-check: $(STAMP)
 	"$$tmp/venv/bin/python" -c 'import json, sys; r = json.load(open("walk.json")); sys.exit(0 if r["seconds"] == 0.5 else "wheel-check: walk.json: seconds != 0.5")'; \
 	"$$tmp/venv/bin/biped" curves --seconds 1 --robot biped18-feetech --gait crouch --out x.csv; \
 	test "$$(wc -l < x.csv)" -gt 1 || { echo "wheel-check: x.csv has no rows"; exit 1; }; \
-	echo "wheel-check: $$got from the wheel ran walk and curves outside the checkout in $$(( $$(date +%s) - start )) s"
+	"$$tmp/venv/bin/biped" robots copy biped18-feetech mine.toml > /dev/null; \
+	"$$tmp/venv/bin/biped" curves --seconds 1 --robot mine.toml --out mine.csv; \
+	echo "wheel-check: $$got from the wheel ran walk, curves and robots copy outside the checkout in $$(( $$(date +%s) - start )) s"
 
 test: lint typecheck unit wheel-check
 

@@ -36,6 +36,7 @@ COMMANDS: tuple[str, ...] = (
     "panel",
     "render",
     "plot",
+    "robots",
     "setup_motors",
     "calibrate",
     "find_port",

@@ -19,6 +19,7 @@ from robot.errors import ConfigError
 from robot.setup.calibration import (
     detect_sign,
     direction_words,
+    fit_limits,
     hardware_range,
     limits_from_ends,
     probe_direction,
@@ -74,6 +75,20 @@ def test_limits_are_pulled_in_and_kept_inside_the_servo() -> None:
                               servo_limits=(0, 2548))
     assert (lo, hi) == (-0.440, 0.306)
     assert hardware_range(4000, 1, RES) == pytest.approx((-math.pi, 95 / PER_RAD))
+
+
+def test_fit_limits_cuts_to_the_ticks_the_servo_has() -> None:
+    # zero 1786, sign +1: tick 0 lies 1786 x 2 pi / 4096 = 2.73969 rad below zero
+    assert fit_limits(-3.0, 1.5, zero=1786, sign=1, resolution=RES) == (-2.739, 1.5)
+    # sign -1: tick 0 is +2.73969 rad; tick 4095 is -2309 x 2 pi / 4096 = -3.542 (< -pi)
+    assert fit_limits(-3.0, 3.0, zero=1786, sign=-1, resolution=RES) == (-3.0, 2.739)
+    assert fit_limits(-0.5, 0.5, zero=2048, sign=1, resolution=RES) == (-0.5, 0.5)
+    assert fit_limits(0.0, 2.3, zero=4095, sign=1, resolution=RES) is None   # nothing reached
+    # AX-12A, 1024 ticks over 300 deg (195.57 ticks/rad): zero 40 leaves 40 / 195.57 =
+    # 0.20453 rad below it
+    per_rad = 1024 / math.radians(300)
+    assert fit_limits(-2.5, 1.5, zero=40, sign=1, resolution=1024,
+                      ticks_per_rad=per_rad) == (-0.204, 1.5)
 
 
 def test_probe_direction_and_words(robot: RobotConfig) -> None:
@@ -132,8 +147,11 @@ def test_zero_yes_writes_zero_ticks_keeping_comments(emu: Emulator, robot: Robot
     old_lines, new_lines = robot_toml.read_text().splitlines(), out.read_text().splitlines()
     assert len(old_lines) == len(new_lines)
     changed = [(a, b) for a, b in zip(old_lines, new_lines, strict=True) if a != b]
+    # the bundled robot's name becomes the file's: the user's robot is not biped18-*
+    assert (f'name = "{robot.name}"', 'name = "calibrated"') in changed
+    assert new.name == "calibrated"
     assert all(a.startswith("zero_ticks = ") and b.startswith("zero_ticks = ")
-               for a, b in changed)
+               for a, b in changed if not a.startswith("name = "))
     assert [ln for ln in new_lines if "#" in ln] == [ln for ln in old_lines if "#" in ln]
     assert_no_goal_and_torque_off(emu, robot)
 
@@ -160,15 +178,17 @@ class Hands:
     """Scripted answers to the prompts: moves joints on the emulator like a user would.
 
     truth: the real sign of each joint (ticks per positive radian); ends: where each joint
-    stops in step 3 [rad]; still: joints the user forgets to move.
+    stops in step 3 [rad]; still: joints the user forgets to move in step 2; stuck: how
+    many times each joint is left at zero when asked for its ends in step 3.
     """
 
     def __init__(self, emu: Emulator, robot: RobotConfig, truth: dict[str, int], *,
                  ends: dict[str, tuple[float, float]] | None = None,
-                 still: tuple[str, ...] = ()) -> None:
+                 still: tuple[str, ...] = (), stuck: dict[str, int] | None = None) -> None:
         self.emu, self.robot, self.truth = emu, robot, truth
-        self.ends, self.still = ends or {}, still
+        self.ends, self.still, self.stuck = ends or {}, still, dict(stuck or {})
         self.prompts: list[str] = []
+        self.moving = True
         self.zero = {j.name: 2048 + 3 * j.servo_id for j in robot.joints}
         for j in robot.joints:
             hold(emu, j.servo_id, self.zero[j.name])
@@ -186,10 +206,13 @@ class Hands:
             self.at(name, 0.0)
         elif "direction)" in prompt and name not in self.still:
             self.at(name, 0.4 if "(+ direction)" in prompt else -0.4)
-        elif "one end" in prompt:
-            self.at(name, self.ends[name][0])
-        elif "the other end" in prompt:
-            self.at(name, self.ends[name][1])
+        elif "one end" in prompt or "the other end" in prompt:
+            first = "one end" in prompt
+            if first:
+                self.moving = self.stuck.get(name, 0) <= 0
+                self.stuck[name] = self.stuck.get(name, 0) - 1
+            # a stuck joint reads zero at both ends (a dead servo, or the user skipped it)
+            self.at(name, self.ends[name][0 if first else 1] if self.moving else 0.0)
         return ""
 
 
@@ -199,18 +222,16 @@ def test_signs_are_confirmed_or_flipped_by_hand_moves(emu: Emulator, robot: Robo
     truth = {j.name: j.sign for j in robot.joints}
     truth["r_knee"] = -truth["r_knee"]
     truth["l_elbow"] = -truth["l_elbow"]                      # probed in the - direction
-    hands = Hands(emu, robot, truth, still=("r_ankle_roll",))
+    hands = Hands(emu, robot, truth)
     emu.log(clear=True)
     out = tmp_path / "signed.toml"
     args = cli.build_parser().parse_args(calib_args(emu, robot_toml, out))
     assert calibrate.run(args, ask=hands) == 0
     new = load_robot(out)
-    assert {j.name: j.sign for j in new.joints} == truth | {"r_ankle_roll": robot.joint(
-        "r_ankle_roll").sign}
+    assert {j.name: j.sign for j in new.joints} == truth
     assert {j.name: j.zero_ticks for j in new.joints} == hands.zero
     text = capsys.readouterr().out
-    assert "r_knee: -" in text and "(flipped)" in text
-    assert "r_ankle_roll: no move seen; sign kept" in text
+    assert "r_knee: -" in text and "(flipped)" in text and "NOT measured" not in text
     assert hands.prompts[0].startswith("step 1: hold the robot in its zero pose")
     assert any(p.startswith("l_elbow (id 18): move it so that the elbow bends")
                for p in hands.prompts)
@@ -244,3 +265,115 @@ def test_input_ending_early_writes_nothing(emu: Emulator, robot_toml: Path, tmp_
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "input ended" in err and "nothing was written" in err
     assert not out.exists()
+
+
+def test_a_joint_that_never_moved_is_flagged_and_the_exit_says_incomplete(
+        emu: Emulator, robot: RobotConfig, robot_toml: Path, tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """A dead servo or a skipped joint: its sign is not measured. The file still gets every
+    measured value (the flipped r_knee, every zero), the summary flags the two joints, and
+    the exit code is 1 (incomplete)."""
+    truth = {j.name: j.sign for j in robot.joints}
+    truth["r_knee"] = -truth["r_knee"]
+    hands = Hands(emu, robot, truth, still=("r_ankle_roll", "l_elbow"))
+    out = tmp_path / "signed.toml"
+    args = cli.build_parser().parse_args(calib_args(emu, robot_toml, out))
+    assert calibrate.run(args, ask=hands) == 1
+    new = load_robot(out)
+    assert {j.name: j.sign for j in new.joints} == truth           # the still ones: as before
+    assert {j.name: j.zero_ticks for j in new.joints} == hands.zero
+    captured = capsys.readouterr()
+    rows = {line.split()[0]: line for line in captured.out.splitlines() if line.startswith(
+        tuple(truth))}
+    flagged = {name for name, line in rows.items() if "NOT measured" in line}
+    assert flagged == {"r_ankle_roll", "l_elbow"}
+    assert "r_ankle_roll: no move seen in 3 tries; sign NOT measured" in captured.out
+    err = captured.err.strip()
+    assert len(err.splitlines()) == 1 and "incomplete" in err, err
+    assert "r_ankle_roll (sign)" in err and "l_elbow (sign)" in err
+    assert sum(p.startswith("r_ankle_roll (id 6): move it") for p in hands.prompts) == 3
+
+
+def test_limits_ask_again_at_once_and_keep_every_measured_joint(
+        emu: Emulator, robot: RobotConfig, robot_toml: Path, tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """In step 3 r_knee stays put once (asked again at once, then measured); l_knee never
+    moves: its limits stay as they were, flagged, exit 1, and the zeros, signs and the other
+    joints' limits are written (the file was refused whole before, after all 54 prompts)."""
+    truth = {j.name: j.sign for j in robot.joints}
+    ends = {j.name: (j.max_rad - 0.1, j.min_rad + 0.1) for j in robot.joints}
+    hands = Hands(emu, robot, truth, ends=ends, stuck={"r_knee": 1, "l_knee": 3})
+    out = tmp_path / "limits.toml"
+    args = cli.build_parser().parse_args(calib_args(emu, robot_toml, out, "--limits"))
+    assert calibrate.run(args, ask=hands) == 1
+    step3 = [p for p in hands.prompts if "free range" in p or p.startswith("put ")][
+        len(robot.joints):]                                      # after step 2's put-backs
+    knee = [p.split(":")[1].strip()[:24] for p in step3 if p.startswith("r_knee")]
+    assert knee == ["hold it at one end of it", "hold it at the other end",
+                    "hold it at one end of it", "hold it at the other end"]
+    assert sum(p.startswith("l_knee (id 10): hold it at one end") for p in step3) == 3
+    new = load_robot(out)
+    assert {j.name: j.zero_ticks for j in new.joints} == hands.zero
+    tick = 1 / PER_RAD
+    old_knee = robot.joint("r_knee")
+    assert new.joint("r_knee").min_rad == pytest.approx(old_knee.min_rad + 0.12,
+                                                        abs=tick + 1e-3)
+    l_knee = new.joint("l_knee")
+    assert (l_knee.min_rad, l_knee.max_rad) == (robot.joint("l_knee").min_rad,
+                                                robot.joint("l_knee").max_rad)
+    captured = capsys.readouterr()
+    assert "r_knee: the two ends are only 0.00 rad apart" in captured.out
+    assert "l_knee: limits NOT measured in 3 tries" in captured.out
+    assert "l_knee (limits)" in captured.err and "r_knee" not in captured.err
+    assert_no_goal_and_torque_off(emu, robot)
+
+
+def test_zero_with_a_horn_off_centre_narrows_the_limits_and_writes(
+        emu: Emulator, robot: RobotConfig, robot_toml: Path, tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """The issue's shoulder: zero_ticks 1786 puts the bundled -3.0 rad below tick 0
+    (1786 - 3.0 x 4096 / 2 pi = -170). Tick 0 is 1786 ticks below zero: 1786 x 2 pi / 4096
+    = 2.73969 rad, so min_rad -2.739 (rounded inward); max_rad +1.5 fits and stays. l_knee
+    at 3400: tick 4095 is 695 ticks = 1.06612 rad above zero, so its limits become
+    [0, 1.066] and its rest angle 1.1 moves to 1.066. r_knee at 4095: the servo reaches
+    nothing of [0, 2.3] (sign +1), so that joint keeps its old values and the exit is 1."""
+    for j in robot.joints:
+        hold(emu, j.servo_id, 2048)
+    hold(emu, robot.joint("r_shoulder_pitch").servo_id, 1786)
+    hold(emu, robot.joint("l_knee").servo_id, 3400)
+    out = tmp_path / "calibrated.toml"
+    assert cli.main(calib_args(emu, robot_toml, out, "--zero", "--yes")) == 0
+    new = load_robot(out)
+    shoulder = new.joint("r_shoulder_pitch")
+    assert (shoulder.zero_ticks, shoulder.min_rad, shoulder.max_rad) == (1786, -2.739, 1.5)
+    knee = new.joint("l_knee")
+    assert (knee.zero_ticks, knee.min_rad, knee.max_rad) == (3400, 0.0, 1.066)
+    assert new.rest["l_knee"] == 1.066
+    unchanged = [j for j in new.joints if j.name not in ("r_shoulder_pitch", "l_knee")]
+    assert all((j.min_rad, j.max_rad) == (robot.joint(j.name).min_rad,
+                                          robot.joint(j.name).max_rad) for j in unchanged)
+    text = capsys.readouterr().out
+    assert ("r_shoulder_pitch: limits [-3.000, +1.500] -> [-2.739, +1.500] rad: from "
+            "zero_ticks 1786") in text
+    assert "rest.l_knee: +1.100 -> +1.066 rad" in text
+
+    hold(emu, robot.joint("r_knee").servo_id, 4095)
+    again = tmp_path / "again.toml"
+    assert cli.main(calib_args(emu, robot_toml, again, "--zero", "--yes")) == 1
+    captured = capsys.readouterr()
+    kept = load_robot(again).joint("r_knee")
+    assert kept.zero_ticks == robot.joint("r_knee").zero_ticks
+    assert load_robot(again).joint("r_shoulder_pitch").min_rad == -2.739
+    assert "r_knee: from zero_ticks 4095 its servo reaches" in captured.out
+    assert "r_knee (zero, sign and limits" in captured.err
+    assert_no_goal_and_torque_off(emu, robot)
+
+
+def test_the_closing_hint_names_the_bus_and_port(emu: Emulator, robot_toml: Path,
+                                                 tmp_path: Path,
+                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "mine.toml"
+    assert cli.main(calib_args(emu, robot_toml, out, "--zero", "--yes")) == 0
+    hint = f"`biped monitor --robot {out} --bus {emu.protocol} --port {emu.port}`"
+    assert hint in capsys.readouterr().out
+    assert load_robot(out).name == "mine"

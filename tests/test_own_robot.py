@@ -32,6 +32,7 @@ def five_dof_with_head(tmp_path: Path) -> Path:
     """The legs-only robot without hip yaw, XM430 knees and a head pan servo (id 20)."""
     s = LEGS.read_text()
     s = re.sub(r"(?ms)^\[joints\.[rl]_hip_yaw\].*?(?=^\[)", "", s)
+    s = re.sub(r"(?m)^hip_yaw_link = .*\n", "", s)       # no hip yaw servo, no such link
     for side in "rl":
         s = s.replace(f"[joints.{side}_knee]\n", f'[joints.{side}_knee]\nmodel = "XM430-W350"\n')
     s = s.replace("[rest]", f"""[joints.head_pan]
@@ -82,6 +83,28 @@ def test_five_dof_legs_reach_their_targets_with_yaw_zero(five: RobotConfig) -> N
             worst = max(worst, miss)
         assert q["head_pan"] == HEAD_RAD
     assert worst < 1e-4                       # [m]: 0.1 mm
+
+
+def test_five_dof_legs_need_no_hip_yaw_mass(five: RobotConfig, tmp_path: Path) -> None:
+    """The file has no mass.hip_yaw_link: the robot's mass is the rest of the links, and the
+    simulated model weighs that much less than the same file with the 0.06 kg link back in
+    (MuJoCo's own body masses, summed)."""
+    path = five_dof_with_head(tmp_path)
+    assert "hip_yaw_link" not in path.read_text()
+    legs = load_robot(LEGS)
+    assert five.mass.hip_yaw_link == 0.0
+    assert five.mass.total == pytest.approx(legs.mass.total - 2 * legs.mass.hip_yaw_link)
+    with_link = tmp_path / "with_link.toml"
+    with_link.write_text(path.read_text().replace("[mass]", "[mass]\nhip_yaw_link = 0.06", 1))
+    heavy = build_mjcf(load_robot(with_link)).model()
+    model = build_mjcf(five).model()
+    assert model.body("r_hip_yaw_link").mass[0] == 0.0
+    assert float(heavy.body_mass.sum() - model.body_mass.sum()) == pytest.approx(0.12)
+    six = tmp_path / "six.toml"
+    six.write_text(re.sub(r"(?m)^hip_yaw_link = .*\n", "", LEGS.read_text()))
+    with pytest.raises(ConfigError, match=r"mass\.hip_yaw_link: missing \(the robot has hip "
+                                          r"yaw joints"):
+        load_robot(six)
 
 
 def test_six_dof_legs_do_turn(tmp_path: Path) -> None:

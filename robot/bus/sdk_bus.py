@@ -121,8 +121,10 @@ class SdkBus(SdkRegisters, Bus):
     # ------------------------------------------------------------------ Bus API
     def broadcast_ping(self) -> dict[int, int] | None:
         """``{id: model number}`` of every servo that answers one broadcast ping at the
-        current baud (``{}`` when none does), or None when the SDK has no broadcast ping
-        (scservo_sdk). A garbled reply (two servos sharing an id) raises BusError."""
+        current baud (``{}`` when none does), or None when the protocol has no broadcast
+        ping: scservo_sdk has none, and dynamixel_sdk's Protocol 1.0 handler returns
+        COMM_NOT_AVAILABLE without sending anything (its API reference: "Available only in
+        Protocol 2.0"). A garbled reply (two servos sharing an id) raises BusError."""
         fn = getattr(self._ph, "broadcastPing", None)
         if fn is None:
             return None
@@ -133,6 +135,8 @@ class SdkBus(SdkRegisters, Bus):
             except PORT_ERRORS as e:
                 port.is_using = False
                 raise self._error(None, "broadcast ping", f"port error: {e}", None) from e
+        if result == getattr(self.sdk, "COMM_NOT_AVAILABLE", None):
+            return None
         if result not in (self.sdk.COMM_SUCCESS, self.sdk.COMM_RX_TIMEOUT):
             raise self._error(None, "broadcast ping", self._ph.getTxRxResult(result), result)
         return {int(sid): int(v[0]) for sid, v in data.items()}

@@ -6,8 +6,12 @@ itself. Step 1: hold the robot in its zero pose (every joint at 0 rad: standing 
 feet flat and parallel, arms hanging at the sides) and zero_ticks are read from the present
 positions. Step 2: move each joint by hand the way the prompt says; the direction of the
 tick change confirms or flips its sign. Step 3 (``--limits``): move each joint to both ends
-of its free range; min_rad/max_rad are recorded inside the servo's own limits. The output
-keeps the input's comments and layout and is validated before it is written.
+of its free range; min_rad/max_rad are recorded inside the servo's own limits. A joint that
+does not move is asked again at once. Limits the servo cannot reach from its new zero are
+narrowed (said per joint). The output keeps the input's comments and layout and is
+validated before it is written; a bundled robot's name becomes the output's file name.
+Exit 1 when a joint's sign or limits were asked for and not measured (the measured joints
+are written all the same).
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from robot.bus.base import Bus
+from robot.commands.calibrate_report import report
 from robot.commands.common import (
     HARDWARE_BUSES,
     add_bus_args,
@@ -26,6 +31,7 @@ from robot.commands.common import (
     output_file,
     robot_from,
 )
+from robot.config.bundled import robot_names
 from robot.config.robot import JointConfig, RobotConfig
 from robot.config.toml_edit import same_path, write_validated
 from robot.errors import ConfigError
@@ -36,13 +42,17 @@ from robot.setup.calibration import (
     direction_words,
     limits_from_ends,
     probe_direction,
+    wrapped_delta,
     zero_ticks,
 )
+from robot.setup.calibration_result import settle
 from robot.setup.motor_setup import answered
 
 Ask = Callable[[str], str]
-#: Prompts per joint in step 2 before its sign is kept as it was.
+#: Prompts per joint in step 2 before its sign is left unmeasured (kept as it was).
 SIGN_TRIES = 3
+#: Tries per joint in step 3 before its limits are left unmeasured (kept as they were).
+LIMIT_TRIES = 3
 #: The servo's own position-limit registers, per bus kind.
 LIMIT_REGISTERS = {"dynamixel": ("min_position_limit", "max_position_limit"),
                    "dynamixel1": ("cw_angle_limit", "ccw_angle_limit"),
@@ -70,7 +80,7 @@ def _position(bus: Bus, joint: JointConfig) -> int:
 
 
 def _signs(bus: Bus, robot: RobotConfig, ask: Ask) -> dict[str, int]:
-    """Step 2: ``{joint: sign}`` from one hand move per joint."""
+    """Step 2: ``{joint: sign}`` from one hand move per joint, for the joints that moved."""
     res, per_rad = robot.bus.servo.resolution, robot.bus.servo.ticks_per_rad
     out: dict[str, int] = {}
     print(f"step 2: move each joint by hand, about 20-30 degrees, the way it says "
@@ -90,34 +100,53 @@ def _signs(bus: Bus, robot: RobotConfig, ask: Ask) -> dict[str, int]:
                 break
             print(f"  {j.name}: moved only {reading.delta:+d} ticks; again, further")
         else:
-            print(f"  {j.name}: no move seen; sign kept at {j.sign:+d}")
-            out[j.name] = j.sign
+            print(f"  {j.name}: no move seen in {SIGN_TRIES} tries; sign NOT measured (the "
+                  f"file keeps {j.sign:+d})")
         ask(f"put {j.name} back to its zero pose and press Enter ")
     return out
 
 
+def _servo_limits(bus: Bus, j: JointConfig, kind: str) -> tuple[int, int] | None:
+    """The joint's servo position-limit registers (lo, hi) [ticks]; None where they span
+    nothing (lo >= hi) or the bus has no registers."""
+    read = getattr(bus, "read_register", None)
+    if read is None:
+        return None
+    lo, hi = (int(read(j.servo_id, r)) for r in LIMIT_REGISTERS[kind])
+    return (lo, hi) if lo < hi else None
+
+
 def _limits(bus: Bus, robot: RobotConfig, zeros: dict[str, int], signs: dict[str, int],
             kind: str, ask: Ask) -> dict[str, tuple[float, float]]:
-    """Step 3: ``{joint: (min_rad, max_rad)}`` from the two ends of each joint's free range."""
-    res, per_rad = robot.bus.servo.resolution, robot.bus.servo.ticks_per_rad
-    read = getattr(bus, "read_register", None)
+    """Step 3: ``{joint: (min_rad, max_rad)}`` from the two ends of each joint's free range,
+    for the joints whose ends were at least MOVE_THRESHOLD_RAD apart (asked again at once,
+    LIMIT_TRIES times, when they were not)."""
     out: dict[str, tuple[float, float]] = {}
     print("step 3: move each joint by hand to both ends of its free range (where it touches "
           "the frame or a cable pulls), gently")
     for j in robot.joints:
-        ends = []
-        for which in ("one end", "the other end"):
-            ask(f"{j.name} (id {j.servo_id}): hold it at {which} of its free range and "
-                "press Enter ")
-            ends.append(_position(bus, j))
-        servo_limits = None
-        if read is not None:
-            lo, hi = (int(read(j.servo_id, r)) for r in LIMIT_REGISTERS[kind])
-            servo_limits = (lo, hi) if lo < hi else None
-        out[j.name] = limits_from_ends(*ends, zero=zeros[j.name], sign=signs[j.name],
-                                       resolution=res, servo_limits=servo_limits,
-                                       ticks_per_rad=per_rad)
-        print(f"  {j.name}: [{out[j.name][0]:+.3f}, {out[j.name][1]:+.3f}] rad")
+        servo = robot.servo(j)
+        res, per_rad = servo.resolution, servo.ticks_per_rad
+        sign, servo_limits = signs.get(j.name, j.sign), _servo_limits(bus, j, kind)
+        for _ in range(LIMIT_TRIES):
+            ends = []
+            for which in ("one end", "the other end"):
+                ask(f"{j.name} (id {j.servo_id}): hold it at {which} of its free range and "
+                    "press Enter ")
+                ends.append(_position(bus, j))
+            span = abs(wrapped_delta(ends[0], ends[1], res)) / per_rad
+            lo, hi = limits_from_ends(ends[0], ends[1], zero=zeros[j.name], sign=sign,
+                                      resolution=res, servo_limits=servo_limits,
+                                      ticks_per_rad=per_rad)
+            if span >= MOVE_THRESHOLD_RAD and lo < hi:
+                out[j.name] = (lo, hi)
+                print(f"  {j.name}: [{lo:+.3f}, {hi:+.3f}] rad")
+                break
+            print(f"  {j.name}: the two ends are only {span:.2f} rad apart (at least "
+                  f"{MOVE_THRESHOLD_RAD} rad); again, to the very ends")
+        else:
+            print(f"  {j.name}: limits NOT measured in {LIMIT_TRIES} tries (the file keeps "
+                  f"[{j.min_rad:+.3f}, {j.max_rad:+.3f}])")
         ask(f"put {j.name} back to its zero pose and press Enter ")
     return out
 
@@ -143,32 +172,22 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
             ask("step 1: hold the robot in its zero pose (standing straight, feet flat and "
                 "parallel, arms hanging at the sides) and press Enter ")
         zeros = zero_ticks(bus.read_positions(robot.ids), robot)
-        signs = {j.name: j.sign for j in robot.joints}
-        limits: dict[str, tuple[float, float]] = {}
+        signs: dict[str, int] | None = None
+        limits: dict[str, tuple[float, float]] | None = None
         if not args.zero:
             signs = _signs(bus, robot, ask)
             if args.limits:
                 limits = _limits(bus, robot, zeros, signs, kind, ask)
-    changes: dict[str, dict[str, int | float]] = {}
-    for j in robot.joints:
-        changes[j.name] = {"zero_ticks": zeros[j.name], "sign": signs[j.name]}
-        if j.name in limits:
-            changes[j.name].update(min_rad=limits[j.name][0], max_rad=limits[j.name][1])
+    # A bundled robot's name would stay on the user's robot: it takes the file's name.
+    name = out.stem if robot.name in robot_names() and out.stem != robot.name else None
+    result = settle(robot, zeros, signs=signs, limits=limits, name=name)
     try:
-        write_validated(source, out, changes)
+        write_validated(source, out, result.changes(), name=name,
+                        rest={jn: new for jn, (_, new) in result.rest.items()})
     except OSError as e:
         raise ConfigError(f"--out {out}: cannot write it: {e.strerror or e}; nothing was "
                           "written (free some space or choose another path)") from e
-    _report(robot, changes, out)
-    return 0
-
-
-def _report(robot: RobotConfig, changes: dict[str, dict[str, int | float]], out: Path) -> None:
-    print(f"{'joint':<18} {'zero_ticks':>15} {'sign':>9}  limits [rad]")
-    for j in robot.joints:
-        c = changes[j.name]
-        lim = (f"[{c['min_rad']:+.3f}, {c['max_rad']:+.3f}]" if "min_rad" in c
-               else f"[{j.min_rad:+.3f}, {j.max_rad:+.3f}] (kept)")
-        print(f"{j.name:<18} {j.zero_ticks:>6} -> {c['zero_ticks']:<5} "
-              f"{j.sign:+d} -> {c['sign']:+d}  {lim}")
-    print(f"wrote {out}; check it with `biped monitor --robot {out}` by moving joints by hand")
+    check = " ".join(["biped monitor", "--robot", str(out), "--bus", kind, "--port",
+                      args.port or robot.bus.port,
+                      *(["--baud", str(args.baud)] if args.baud else [])])
+    return report(robot, result, out, check=check)

@@ -94,5 +94,5 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
                   f"({done})")
     if not args.joint:
         print(f"done: connect the chain and check with `biped scan --robot {args.robot} "
-              f"--port {bus.port_name}`")
+              f"--bus {robot.bus.kind} --port {bus.port_name}`")
     return 0

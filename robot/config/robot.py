@@ -91,10 +91,11 @@ class Geometry:
 
 @dataclass(frozen=True)
 class Masses:
-    """Link masses including the servos they carry [kg]."""
+    """Link masses including the servos they carry [kg]. ``hip_yaw_link`` only with hip
+    yaw joints (0: 5-DoF legs, the hip roll servo sits on the torso)."""
 
     torso: float = field(metadata=spec(MASS))
-    hip_yaw_link: float = field(metadata=spec(MASS))
+    hip_yaw_link: float = field(default=0.0, kw_only=True, metadata=spec(MASS))
     hip_roll_link: float = field(metadata=spec(MASS))
     thigh: float = field(metadata=spec(MASS))
     shin: float = field(metadata=spec(MASS))

@@ -13,7 +13,7 @@ from robot.config.bundled import DEFAULT_ROBOT, resolve_robot_path
 from robot.config.checks import check_bus, check_joint_extras, check_joint_set, check_ticks
 from robot.config.gains_file import check_fits, parse_gains, split_gains
 from robot.config.imu_file import parse_imu
-from robot.config.joint_names import ARM_NAMES, JOINT_NAMES
+from robot.config.joint_names import ARM_NAMES, HIP_YAW_NAMES, JOINT_NAMES
 from robot.config.params import BALANCE, SPECS, canonical_name, check_value
 from robot.config.robot import ANGLE, BusConfig, Geometry, JointConfig, Masses, RobotConfig
 from robot.config.toml_io import Range, TomlValue, build, number, read_toml, show, table
@@ -51,6 +51,9 @@ def parse_robot(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> R
 
     jtab = table(src, "joints", data["joints"])
     check_joint_set(src, jtab)
+    if any(n in jtab for n in HIP_YAW_NAMES) and mass.hip_yaw_link == 0.0:
+        raise ConfigError(f"{src}: mass.hip_yaw_link: missing (the robot has hip yaw joints; "
+                          "only 5-DoF legs leave it out)")
     if any(n in jtab for n in ARM_NAMES):
         for sect, obj in (("geometry", geometry), ("mass", mass)):
             for f in ("shoulder_width", "upper_arm", "forearm"):

@@ -1,8 +1,9 @@
 """Change a few joint values of a robot TOML file, keeping its comments and layout (tomlkit).
 
-``edit_joints(text, {joint: {field: value}})`` returns the new text; the caller validates it
-with ``robot.config.robot_file.parse_robot`` before writing. ``write_validated`` does both: nothing is
-written unless the result loads.
+``edit_joints(text, {joint: {field: value}})`` returns the new text (optionally also the
+robot's ``name`` and ``[rest]`` angles); the caller validates it with
+``robot.config.robot_file.parse_robot`` before writing. ``write_validated`` does both:
+nothing is written unless the result loads.
 """
 
 from __future__ import annotations
@@ -20,12 +21,14 @@ from robot.config.robot import RobotConfig
 from robot.config.robot_file import parse_robot
 from robot.errors import ConfigError
 
-EDITABLE = ("sign", "zero_ticks", "min_rad", "max_rad")
+EDITABLE = ("sign", "zero_ticks", "min_rad", "max_rad", "fixed_rad")
 
 
 def edit_joints(text: str, changes: Mapping[str, Mapping[str, int | float]], *,
-                source: str = "<robot>") -> str:
-    """``text`` with ``joints.<joint>.<field>`` set for every entry of ``changes``."""
+                source: str = "<robot>", name: str | None = None,
+                rest: Mapping[str, float] | None = None) -> str:
+    """``text`` with ``joints.<joint>.<field>`` set for every entry of ``changes``, and
+    ``name`` and ``rest.<joint>`` [rad] when given."""
     try:
         doc = tomlkit.parse(text)
     except TOMLKitError as e:
@@ -36,10 +39,14 @@ def edit_joints(text: str, changes: Mapping[str, Mapping[str, int | float]], *,
         if table is None:
             raise ConfigError(f"{source}: joints.{joint}: missing; cannot set "
                               f"{', '.join(fields)}")
-        for name, value in fields.items():
-            if name not in EDITABLE:
-                raise ValueError(f"edit_joints: {name!r} is not one of {EDITABLE}")
-            table[name] = value
+        for key, value in fields.items():
+            if key not in EDITABLE:
+                raise ValueError(f"edit_joints: {key!r} is not one of {EDITABLE}")
+            table[key] = value
+    if name is not None:
+        doc["name"] = name
+    for joint, q in (rest or {}).items():
+        doc["rest"][joint] = q
     return tomlkit.dumps(doc)
 
 
@@ -52,10 +59,14 @@ def same_path(a: str | Path, b: str | Path) -> bool:
 
 
 def write_validated(source: Path, out: Path,
-                    changes: Mapping[str, Mapping[str, int | float]]) -> RobotConfig:
-    """Write ``source`` with ``changes`` to ``out`` (atomically) if the result is a valid
-    robot file; ConfigError naming ``out``, its field and the fix otherwise (nothing written)."""
-    text = edit_joints(source.read_text(encoding="utf-8"), changes, source=str(source))
+                    changes: Mapping[str, Mapping[str, int | float]], *,
+                    name: str | None = None,
+                    rest: Mapping[str, float] | None = None) -> RobotConfig:
+    """Write ``source`` with ``changes`` (and ``name``, ``rest``: see ``edit_joints``) to
+    ``out`` (atomically) if the result is a valid robot file; ConfigError naming ``out``,
+    its field and the fix otherwise (nothing written)."""
+    text = edit_joints(source.read_text(encoding="utf-8"), changes, source=str(source),
+                       name=name, rest=rest)
     robot = parse_robot(tomllib.loads(text), source=str(out))
     fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", dir=out.parent)
     try:

@@ -119,3 +119,16 @@ def limits_from_ends(a: int, b: int, *, zero: int, sign: int, resolution: int,
     lo, hi = max(lo + LIMIT_MARGIN_RAD, hw_lo), min(hi - LIMIT_MARGIN_RAD, hw_hi)
     k = 10 ** LIMIT_DIGITS
     return math.ceil(lo * k) / k, math.floor(hi * k) / k
+
+
+def fit_limits(min_rad: float, max_rad: float, *, zero: int, sign: int, resolution: int,
+               servo_limits: tuple[int, int] | None = None,
+               ticks_per_rad: float | None = None) -> tuple[float, float] | None:
+    """[min_rad, max_rad] cut to ``hardware_range`` (what the servo reaches from ``zero`` and
+    ``sign``), the cut ends rounded inward to LIMIT_DIGITS; the limits themselves when they
+    fit. None when the servo reaches none of it (or under a thousandth of a radian)."""
+    hw_lo, hw_hi = hardware_range(zero, sign, resolution, servo_limits, ticks_per_rad)
+    k = 10 ** LIMIT_DIGITS
+    lo = min_rad if min_rad >= hw_lo else math.ceil(hw_lo * k) / k
+    hi = max_rad if max_rad <= hw_hi else math.floor(hw_hi * k) / k
+    return (lo, hi) if lo < hi else None

@@ -5,11 +5,13 @@ Only one servo may be on the bus. ``find_servo`` looks for it in two passes, che
 1. the factory id 1 at every standard baud of the family, and the robot's own ids at the
    robot's baud (a servo set up earlier and left on the chain), most likely bauds first;
 2. if nothing answered: every id 0..252 at each baud (one broadcast ping per baud where the
-   SDK has it, Dynamixel; else one ping per id), stopping at the first baud that answers.
+   protocol has it: Dynamixel Protocol 2.0, and LX's broadcast id read; else one ping per
+   id: Dynamixel Protocol 1.0, Feetech), stopping at the first baud that answers.
 
 More than one servo, or a garbled reply (two servos sharing an id answer at once), refuses
-before anything is written. ``assign`` then writes, torque off first (EEPROM): return delay
-0, the id, the baud rate; re-opens at the new baud and checks the id and model answer.
+before anything is written; no answer at all says "no servo answered". ``assign`` then
+writes, torque off first (EEPROM): return delay 0, the id, the baud rate; re-opens at the
+new baud and checks the id and model answer.
 """
 
 from __future__ import annotations
@@ -84,16 +86,18 @@ def _ping_all(bus: SetupBus, ids: Iterable[int]) -> list[Found]:
     return found
 
 
-def _sweep(bus: SetupBus) -> list[Found]:
-    """Every servo at the current baud: a broadcast ping, else one ping per id."""
+def _sweep(bus: SetupBus, progress: Callable[[str], None]) -> list[Found]:
+    """Every servo at the current baud: a broadcast ping, else (the protocol has none) one
+    ping per id."""
     try:
         answered = bus.broadcast_ping()
-    except BusError as e:
-        raise SetupRefused(f"garbled replies to a broadcast ping at {bus.baud} baud on "
-                           f"{bus.port_name}: servos sharing an id are connected; connect "
-                           "only the servo to set up") from e
+    except BusError as e:   # its message says why (garbled replies, a port error) and the fix
+        raise SetupRefused(f"{e}; nothing was written") from e
     if answered is None:
+        progress(f"scanning every id at {bus.baud} baud (one ping per id: this protocol has "
+                 "no broadcast ping)")
         return _ping_all(bus, ALL_IDS)
+    progress(f"scanning every id at {bus.baud} baud (one broadcast ping)")
     return _ping_all(bus, sorted(answered))  # one by one: duplicates collapse in the reply
 
 
@@ -129,15 +133,16 @@ def find_servo(bus: SetupBus, robot: RobotConfig, *,
         if not found:
             for baud in bauds:
                 bus.set_baud(baud)
-                progress(f"scanning every id at {baud} baud")
-                found = _sweep(bus)
+                found = _sweep(bus, progress)
                 if found:
                     break
     finally:
         bus.set_baud(original)
     if not found:
-        raise SetupRefused(f"no servo answers on {bus.port_name} at any id or {family} baud "
-                           "rate; check its power (the LED flashes at power-up) and cable")
+        rates = ", ".join(map(str, bauds))
+        raise SetupRefused(f"no servo answered on {bus.port_name} at any id "
+                           f"({ALL_IDS.start}-{ALL_IDS.stop - 1}) and baud ({rates}); check "
+                           "its power (the LED flashes at power-up), its cable and --port")
     if len(found) > 1:
         who = ", ".join(f"id {f.id} at {f.baud} baud" for f in found)
         raise SetupRefused(f"{len(found)} servos answer on {bus.port_name} ({who}); nothing "

@@ -160,9 +160,10 @@ def add_worldbody(root: ET.Element, robot: RobotConfig) -> None:
         leg = f"{side}_leg"
         b = _body(torso, f"{side}_hip_yaw_link", (0, y * g.hip_width / 2, 0),
                   f"{side}_hip_yaw", robot)
-        _inertial(b, m.hip_yaw_link, (0, 0, 0.5 * s), (s, s, s))
-        _sub(b, "geom", class_="visual", type="box", pos=fmt(0, 0, 0.5 * s), size=servo_box,
-             material="servo")
+        if m.hip_yaw_link:                  # 5-DoF legs: no hip yaw servo, a massless frame
+            _inertial(b, m.hip_yaw_link, (0, 0, 0.5 * s), (s, s, s))
+            _sub(b, "geom", class_="visual", type="box", pos=fmt(0, 0, 0.5 * s),
+                 size=servo_box, material="servo")
         b = _body(b, f"{side}_hip_roll_link", (0, 0, 0), f"{side}_hip_roll", robot)
         _inertial(b, m.hip_roll_link, (0, 0, 0), (s, s, s))
         _sub(b, "geom", class_="visual", type="box", size=servo_box, material="servo")

@@ -87,9 +87,6 @@ class GaitEngine:
             raise ValueError("robot joints must be in canonical order")
         self.robot = robot
         self._leg_yaw = robot.has_hip_yaw
-        if not self._leg_yaw and params.turn != 0.0:
-            log.warning("%s has no hip yaw (5-DoF legs): turn = %g is ignored", robot.name,
-                        params.turn)
         self._params = params
         self._target = within_steering_budget(params)
         self._live = self._target
@@ -98,6 +95,10 @@ class GaitEngine:
         self._ramp = 0.0          # linear ramp variable in [0, 1]
         self._running = False
         self.unreachable_ticks = 0
+        #: The heading change [rad] the gait's ``turn`` asked for so far: ``turn`` per step,
+        #: two steps per cycle of the phase, times the envelope (a feedback loop's trim
+        #: not included: it corrects, it does not ask).
+        self.asked_yaw = 0.0
         #: Posture change relative to the feet, set by a feedback loop (robot.balance).
         self.trim = NO_TRIM
         #: Lift of the right and left foot [m] at the last ``pose`` (> 0: swinging).
@@ -252,7 +253,10 @@ class GaitEngine:
         else:
             self._ramp = max(0.0, self._ramp - step)
         if self._ramp > 0.0:
+            theta = self.phase.theta
             self.phase = gait.advance(self.phase, p, dt * (1.0 + self.trim.tempo))
+            if p.turn != 0.0:
+                self.asked_yaw += self.amplitude * p.turn * (self.phase.theta - theta) / math.pi
         else:
             # Fully ramped out: at zero amplitude the pose does not depend on the phase, so
             # resetting it is invisible and the next start begins a fresh stride.

@@ -9,7 +9,8 @@ The paper animates a Maya rig (Y up, Z forward, rig units). Here, once:
 - foot heights below the ground are stance: clamped at the ground;
 - lateral sway of the pelvis in step with the stride (weight over the stance foot);
 - steering: ``speed`` scales the stride, ``turn`` yaws the feet (hip yaw) about the
-  body's vertical axis (orientation and position) and
+  body's vertical axis (orientation and position), or on 5-DoF legs (no hip yaw) makes
+  one stride longer than the other (``stride_turn``), and
   ``side_step`` moves them sideways, both in step with the stride;
 - eq 14/15: the up-leg translations move the pelvis: their mean shifts it forward, their
   difference yaws it, ``UpLeg_tY`` sets the hip height;
@@ -86,25 +87,20 @@ NO_TRIM = BodyTrim()
 TURN_RANGE = (SPECS["turn"].lo, SPECS["turn"].hi)
 
 
-#: 5-DoF legs (no hip yaw) steer by step length: for ``turn`` [rad/step] the right stride
-#: grows and the left one shrinks by STRIDE_TURN x turn x the half gap of the feet [m], a
-#: differential drive's share (1: the stride difference that turns a wheeled robot of that
-#: track by ``turn`` per step), at most STRIDE_TURN_MAX x the stride.
-STRIDE_TURN = float(__import__("os").environ.get("ST", "1.0"))
-STRIDE_TURN_MAX = float(__import__("os").environ.get("STM", "0.5"))
-#: ... and by hip roll: the sway turns round this much earlier over the outer foot [rad
-#: of sway phase per rad/step of turn].
-TURN_SWAY = float(__import__("os").environ.get("TS", "0.0"))
-
-
-PY0 = float(__import__("os").environ.get("PY0", "0.0"))
-PYS = float(__import__("os").environ.get("PYS", "0.0"))
+#: 5-DoF legs (no hip yaw) steer by step length, as a differential drive does: for
+#: ``turn`` [rad/step] each foot's stride is shifted by ``turn`` x the half gap of the feet
+#: [m] (the right one forward and the left one back in step with the stride, so the right
+#: stride grows and the left one shrinks by that much: over the two stances of a cycle the
+#: right side of the body moves 4 x turn x half gap farther than the left, which turns a
+#: body of that track by ``turn`` per step), at most STRIDE_TURN_MAX x the stride
+#: amplitude (Slgt, not the speed: turning on the spot still steps).
+STRIDE_TURN_MAX = 0.5
 
 
 def stride_turn(turn: Num, half_w: Num, stride: Num) -> Num:
-    """The stride change [m] of 5-DoF steering for ``turn`` [rad/step], feet ``half_w``
-    [m] either side of the pelvis, a stride amplitude ``stride`` [m]."""
-    d = STRIDE_TURN * turn * half_w
+    """The stride shift [m] of 5-DoF steering for ``turn`` [rad/step], the feet ``half_w``
+    [m] either side of the pelvis, a stride amplitude ``stride`` [m] (>= 0)."""
+    d = turn * half_w
     lim = STRIDE_TURN_MAX * stride
     return lim if d > lim else -lim if d < -lim else d
 
@@ -120,7 +116,8 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
     """Map the paper's channels (robot.gait.channels at ``amplitude``) to body targets.
 
     leg_yaw: False for 5-DoF legs (no hip yaw): no foot yaws relative to the pelvis, so
-    ``turn`` and the pelvis yaw of eq 14/15 are left out and the IK's hip yaw is 0.
+    the pelvis yaw of eq 14/15 is left out, the IK's hip yaw is 0, and ``turn`` steers
+    by step length instead (``stride_turn``).
     trim: a feedback loop's change of posture (robot.balance), see ``BodyTrim``.
     """
     s = scale(g, p)
@@ -133,12 +130,7 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
     yaw = s * (ch["RightUpLeg_tZ"] - ch["LeftUpLeg_tZ"]) / g.hip_width if leg_yaw else 0.0
     turn = (p.turn if trim.turn == 0.0
             else min(max(p.turn + trim.turn, TURN_RANGE[0]), TURN_RANGE[1]))
-    if leg_yaw or turn == 0.0:
-        py = p.sway * (sin_t * xm.cos(p.sway_phase) - tz * xm.sin(p.sway_phase))
-    else:   # 5-DoF steering, hip roll: the sway's turn-around earlier over one foot
-        sway_phase = p.sway_phase + TURN_SWAY * turn * sin_t
-        py = p.sway * (sin_t * xm.cos(sway_phase) - tz * xm.sin(sway_phase))
-        py = py + PY0 * turn + PYS * turn * sin_t
+    py = p.sway * (sin_t * xm.cos(p.sway_phase) - tz * xm.sin(p.sway_phase))
     pitch = p.torso_lean + trim.pitch + p.spine_gain * (ch["StZ_ik"] - ch["CtZ"])
     pelvis_rot = xm.rz_ry(yaw, pitch)
     if trim.roll != 0.0:
@@ -166,9 +158,9 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
     r_rot = xm.rz_ry(yaw_r, -p.toe_gain * ch["RightToe_tY"] * w_r)
     l_rot = xm.rz_ry(yaw_l, -p.toe_gain * ch["LeftToe_tY"] * w_l)
     if not leg_yaw and turn != 0.0:
-        # 5-DoF steering, step length: the right stride longer by ``dx`` and the left
-        # shorter for a left turn (both feet x - tz * dx).
-        dx = stride_turn(turn, half_w, s * 0.5 * (p.Slgt_R + p.Slgt_L)) * tz
+        # 5-DoF steering by step length (STRIDE_TURN_MAX): both feet x - tz * dx, so for
+        # a left turn the right stride (-tz * Slgt_R) grows and the left (+tz) shrinks.
+        dx = stride_turn(turn, half_w, s * 0.5 * (abs(p.Slgt_R) + abs(p.Slgt_L))) * tz
         r_pos = (r_pos[0] - dx, r_pos[1], r_pos[2])
         l_pos = (l_pos[0] - dx, l_pos[1], l_pos[2])
     if yaw_turn != 0.0:

@@ -23,7 +23,10 @@ from robot.config.robot import RobotConfig
 from robot.gait import xmath as xm
 from robot.gait.expressions import FTAU_ALPHA, FTAU_DIVISOR, J_ERROR_STZ_IK, Phase
 from robot.gait.ik import REACH_TOL, SIDE_SIGN
-from robot.gait.targets import ARM_HANG, HAND_OUT, TURN_RANGE, BodyTrim
+from robot.gait.targets import ARM_HANG, HAND_OUT, TURN_RANGE, BodyTrim, stride_turn
+from robot.gait.tick_math import rz_ry as _rz_ry
+from robot.gait.tick_math import t_apply as _apply_t
+from robot.gait.tick_math import t_matmul as _t_matmul
 from robot.gait.xmath import Rot
 
 
@@ -166,13 +169,17 @@ class TickKernel:
                          -hip_h + lift_l * down)
         w_r = (0.0 if ty < 0.0 else 1.0 if ty > 1.0 else ty) * down
         w_l = (0.0 if ty_l < 0.0 else 1.0 if ty_l > 1.0 else ty_l) * down
-        turn = (0.0 if not self._leg_yaw else p.turn if trim.turn == 0.0
+        turn = (p.turn if trim.turn == 0.0
                 else min(max(p.turn + trim.turn, TURN_RANGE[0]), TURN_RANGE[1]))
-        yaw_r = -0.5 * turn * tz
-        yaw_l = 0.5 * turn * tz
+        yaw_turn = turn if self._leg_yaw else 0.0
+        yaw_r = -0.5 * yaw_turn * tz
+        yaw_l = 0.5 * yaw_turn * tz
         r_rot = _rz_ry(yaw_r, d.neg_toe * ftau * w_r)
         l_rot = _rz_ry(yaw_l, d.neg_toe * -ftau * w_l)
-        if turn != 0.0:  # targets._yawed, with cos and sin of the yaw from the rotations
+        if not self._leg_yaw and turn != 0.0:   # 5-DoF steering by step length
+            dx = stride_turn(turn, half_w, s * 0.5 * (abs(p.Slgt_R) + abs(p.Slgt_L))) * tz
+            rx_, lx_ = rx_ - dx, lx_ - dx
+        if yaw_turn != 0.0:  # targets._yawed, with cos and sin of the yaw from the rotations
             c, sn = r_rot[4], -r_rot[1]
             rx_, ry_ = c * rx_ - sn * ry_, sn * rx_ + c * ry_
             c, sn = l_rot[4], -l_rot[1]
@@ -205,30 +212,6 @@ class TickKernel:
         if layout is not None:   # 5-DoF legs, extra joints held at fixed angles
             q = [q[i] if i >= 0 else fixed for i, fixed in layout]
         return q, lift_r, lift_l, ok
-
-
-def _rz_ry(yaw: float, pitch: float) -> Rot:
-    """xmath.rz_ry on floats (a zero angle is common: cos(+-0) = 1, sin(+-0) = +-0)."""
-    cz, sz = (1.0, yaw) if yaw == 0.0 else (cos(yaw), sin(yaw))
-    cy, sy = (1.0, pitch) if pitch == 0.0 else (cos(pitch), sin(pitch))
-    return (cz * cy, -sz, cz * sy, sz * cy, cz, sz * sy, -sy, 0.0, cy)
-
-
-def _apply_t(r: Rot, x: float, y: float, z: float) -> tuple[float, float, float]:
-    """xmath.apply_t: r.T @ (x, y, z)."""
-    return (r[0] * x + r[3] * y + r[6] * z, r[1] * x + r[4] * y + r[7] * z,
-            r[2] * x + r[5] * y + r[8] * z)
-
-
-def _t_matmul(a: Rot, b: Rot) -> Rot:
-    """xmath.matmul(xmath.transpose(a), b)."""
-    a0, a3, a6, a1, a4, a7, a2, a5, a8 = a
-    b0, b1, b2, b3, b4, b5, b6, b7, b8 = b
-    return (
-        a0 * b0 + a1 * b3 + a2 * b6, a0 * b1 + a1 * b4 + a2 * b7, a0 * b2 + a1 * b5 + a2 * b8,
-        a3 * b0 + a4 * b3 + a5 * b6, a3 * b1 + a4 * b4 + a5 * b7, a3 * b2 + a4 * b5 + a5 * b8,
-        a6 * b0 + a7 * b3 + a8 * b6, a6 * b1 + a7 * b4 + a8 * b7, a6 * b2 + a7 * b5 + a8 * b8,
-    )
 
 
 def _leg_ik(k: _Leg, sole: tuple[float, float, float], f: Rot) -> tuple[list[float], bool]:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import math
 from typing import Any
 
 from robot.bus.base import Bus
@@ -75,10 +76,24 @@ def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
                    recorder=recorder)
 
 
+#: A walk whose heading changes by more than this [deg per minute of the run] beyond what
+#: its ``turn`` asked for is flagged in its summary (``heading_drifts``).
+HEADING_DRIFT_DEG_MIN = 10.0
+
+
 def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *,
                  gait: str) -> dict[str, Any]:
     """The JSON object of `biped walk --json`: robot, gait, bus, seconds, balance, then
-    the result (RunResult.as_dict)."""
-    return {"robot": spec.robot.name, "gait": gait, "bus": spec.bus.kind,
-            "seconds": spec.options.seconds, "balance": spec.imu is not None,
-            **result.as_dict()}
+    the result (RunResult.as_dict) and, where the bus measured the heading (simulation),
+    the heading the gait asked for, the drift beyond it per minute and whether that is
+    more than ``HEADING_DRIFT_DEG_MIN``."""
+    out = {"robot": spec.robot.name, "gait": gait, "bus": spec.bus.kind,
+           "seconds": spec.options.seconds, "balance": spec.imu is not None,
+           **result.as_dict()}
+    ran_min = result.stats.ticks / result.stats.rate_hz / 60.0 if result.stats.rate_hz else 0.0
+    if "heading_change_deg" in out and ran_min > 0.0:
+        asked = math.degrees(spec.source.asked_yaw)
+        drift = (float(out["heading_change_deg"]) - asked) / ran_min
+        out.update({"heading_asked_deg": asked, "heading_drift_deg_min": drift,
+                    "heading_drifts": abs(drift) > HEADING_DRIFT_DEG_MIN})
+    return out

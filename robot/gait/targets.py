@@ -93,7 +93,11 @@ TURN_RANGE = (SPECS["turn"].lo, SPECS["turn"].hi)
 #: stride grows and the left one shrinks by that much: over the two stances of a cycle the
 #: right side of the body moves 4 x turn x half gap farther than the left, which turns a
 #: body of that track by ``turn`` per step), at most STRIDE_TURN_MAX x the stride
-#: amplitude (Slgt, not the speed: turning on the spot still steps).
+#: amplitude (Slgt, not the speed: turning on the spot still steps). In physics the body
+#: can only yaw by its feet slipping, so which way it turns depends on the robot: in
+#: MuJoCo the 5-DoF Dynamixel legs-only robot turns against the stride law, the AX-12
+#: one with it (docs/gait.md). A heading loop's turn trim is therefore not steered this
+#: way (a wrong sign would run away: the 5-DoF Feetech robot fell): only the asked turn.
 STRIDE_TURN_MAX = 0.5
 
 
@@ -157,10 +161,11 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
     yaw_l = 0.5 * yaw_turn * tz
     r_rot = xm.rz_ry(yaw_r, -p.toe_gain * ch["RightToe_tY"] * w_r)
     l_rot = xm.rz_ry(yaw_l, -p.toe_gain * ch["LeftToe_tY"] * w_l)
-    if not leg_yaw and turn != 0.0:
+    if not leg_yaw and p.turn != 0.0:
         # 5-DoF steering by step length (STRIDE_TURN_MAX): both feet x - tz * dx, so for
         # a left turn the right stride (-tz * Slgt_R) grows and the left (+tz) shrinks.
-        dx = stride_turn(turn, half_w, s * 0.5 * (abs(p.Slgt_R) + abs(p.Slgt_L))) * tz
+        # The asked turn only, not a feedback loop's trim (see STRIDE_TURN_MAX).
+        dx = stride_turn(p.turn, half_w, s * 0.5 * (abs(p.Slgt_R) + abs(p.Slgt_L))) * tz
         r_pos = (r_pos[0] - dx, r_pos[1], r_pos[2])
         l_pos = (l_pos[0] - dx, l_pos[1], l_pos[2])
     if yaw_turn != 0.0:

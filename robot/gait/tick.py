@@ -176,8 +176,8 @@ class TickKernel:
         yaw_l = 0.5 * yaw_turn * tz
         r_rot = _rz_ry(yaw_r, d.neg_toe * ftau * w_r)
         l_rot = _rz_ry(yaw_l, d.neg_toe * -ftau * w_l)
-        if not self._leg_yaw and turn != 0.0:   # 5-DoF steering by step length
-            dx = stride_turn(turn, half_w, s * 0.5 * (abs(p.Slgt_R) + abs(p.Slgt_L))) * tz
+        if not self._leg_yaw and p.turn != 0.0:   # 5-DoF: by step length, asked turn only
+            dx = stride_turn(p.turn, half_w, s * 0.5 * (abs(p.Slgt_R) + abs(p.Slgt_L))) * tz
             rx_, lx_ = rx_ - dx, lx_ - dx
         if yaw_turn != 0.0:  # targets._yawed, with cos and sin of the yaw from the rotations
             c, sn = r_rot[4], -r_rot[1]

@@ -120,6 +120,8 @@ def format_summary(r: dict[str, Any]) -> str:
             f"  fell          {fell} (lowest torso {r['min_torso_height_m']:.3f} m,"
             f" max tilt {r['max_tilt_deg']:.1f} deg)",
         ]
+        if r.get("clamped_joints_s") or r.get("ik_unreachable_s"):
+            lines.append(f"  joint limits  {clamp_words(r)}")
         world = describe_world(r.get("world"))
         if world:
             lines.append(f"  world         {world}")
@@ -146,6 +148,16 @@ def heading_words(r: dict[str, Any]) -> str:
     flag = (f": DRIFTS more than {HEADING_DRIFT_DEG_MIN:g} deg/min unasked"
             if r["heading_drifts"] else "")
     return f" ({asked}drift {r['heading_drift_deg_min']:+.1f} deg/min{flag})"
+
+
+def clamp_words(r: dict[str, Any]) -> str:
+    """Which joints the gait held at a limit and for how long, and how long a target was
+    out of the IK's reach."""
+    held = ", ".join(f"{name} {t:.2f} s" for name, t in r["clamped_joints_s"].items())
+    words = [f"held at a limit: {held}"] if held else []
+    if r["ik_unreachable_s"]:
+        words.append(f"target out of reach {r['ik_unreachable_s']:.2f} s")
+    return "; ".join(words)
 
 
 def servo_words(torque: str) -> str:

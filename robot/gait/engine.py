@@ -2,8 +2,9 @@
 
 Pure (no I/O). ``tick(dt)`` serves the control loop on floats (the engine is a motion
 source, robot.loop.source); ``curves(times)`` serves previs on numpy arrays. Joint angles
-come out in ``robot.joints`` order, clamped to the joint limits; unreachable targets are
-clamped by the IK and counted, never NaN.
+come out in ``robot.joints`` order, clamped to the joint limits (each joint's clamped
+poses counted: ``clamp_ticks``); unreachable targets are clamped by the IK and counted,
+never NaN.
 """
 
 from __future__ import annotations
@@ -106,6 +107,10 @@ class GaitEngine:
         self._lo = [j.min_rad for j in robot.joints]
         self._hi = [j.max_rad for j in robot.joints]
         self._limits = list(zip(self._lo, self._hi, strict=True))
+        #: Poses in which each joint (robot order) was held at its limit, and the joints
+        #: (indices) held there in the last pose.
+        self.clamp_ticks = [0] * len(robot.joints)
+        self.clamped: tuple[int, ...] = ()
         self._kernel = TickKernel(robot)
         self._plain_p: GaitParams | None = None   # the last parameters found _plain
         self._plain_trim: BodyTrim | None = None  # the last trim found _plain
@@ -217,8 +222,16 @@ class GaitEngine:
                 log.warning("gait target out of reach (%d ticks so far): clamped to the "
                             "nearest reachable pose; reduce stride, foot height or crouch",
                             self.unreachable_ticks)
-        return [lo if v < lo else hi if v > hi else v
-                for v, (lo, hi) in zip(q, self._limits, strict=True)]
+        out = [lo if v < lo else hi if v > hi else v
+               for v, (lo, hi) in zip(q, self._limits, strict=True)]
+        if out != q:       # a joint held at its limit: counted per joint (clamp_ticks)
+            self.clamped = tuple(i for i, (a, b) in enumerate(zip(out, q, strict=True))
+                                 if a != b)
+            for i in self.clamped:
+                self.clamp_ticks[i] += 1
+        elif self.clamped:
+            self.clamped = ()
+        return out
 
     def _plain_inputs(self, p: GaitParams, ph: gait.Phase, a: float, trim: BodyTrim) -> bool:
         """Every input a Python float or int, so the kernel's arithmetic is exactly the

@@ -22,11 +22,12 @@ from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.gait import xmath as xm
 from robot.gait.expressions import FTAU_ALPHA, FTAU_DIVISOR, J_ERROR_STZ_IK, Phase
-from robot.gait.ik import REACH_TOL, SIDE_SIGN
+from robot.gait.ik import REACH_TOL, SIDE_SIGN, Reach
 from robot.gait.targets import ARM_HANG, HAND_OUT, TURN_RANGE, BodyTrim, stride_turn
 from robot.gait.tick_math import rz_ry as _rz_ry
 from robot.gait.tick_math import t_apply as _apply_t
 from robot.gait.tick_math import t_matmul as _t_matmul
+from robot.gait.vectorised import spans
 from robot.gait.xmath import Rot
 
 
@@ -42,8 +43,10 @@ class _Leg(NamedTuple):
     far: float     # a + b
     near: float    # |a - b|
     span: float    # 4 a b
-    lo: float      # |a - b| - REACH_TOL
-    hi: float      # a + b + REACH_TOL
+    lo: float      # c_lo - REACH_TOL
+    hi: float      # c_hi + REACH_TOL
+    c_lo: float    # the hip to ankle distances the knee limits allow (ik.leg_reach)
+    c_hi: float
 
 
 class _Arm(NamedTuple):
@@ -51,8 +54,10 @@ class _Arm(NamedTuple):
 
     py: float
     py2: float     # py * py
-    lo: float      # |u - f|
-    hi: float      # u + f
+    lo: float      # the distances the elbow limits allow (ik.arm_reach)
+    hi: float
+    far: float     # u + f
+    near: float    # |u - f|
     far_s: float   # (far - |py|) (far + |py|) of ik.spans
     s_near: float  # (|py| - near) (|py| + near) of ik.spans
     span: float    # 4 u f
@@ -84,26 +89,29 @@ class TickKernel:
         g = robot.geometry
         self._g = g
         self._leg_yaw = robot.has_hip_yaw
-        self._arms = robot.has_arms
         self._layout = robot.layout
-        self._legs = tuple(self._leg(side) for side in ("r", "l"))
-        self._hands = tuple(self._arm(py) for py in (-HAND_OUT, HAND_OUT))
+        r_leg, l_leg, r_arm, l_arm = spans(robot)
+        self._legs = (self._leg("r", r_leg), self._leg("l", l_leg))
+        self._hands: tuple[_Arm, _Arm] | None = (
+            (self._arm(-HAND_OUT, r_arm), self._arm(HAND_OUT, l_arm))
+            if r_arm is not None and l_arm is not None else None)
         self._hang = -ARM_HANG * (g.upper_arm + g.forearm)
         self._p: GaitParams | None = None
         self._derived: _Derived | None = None
 
-    def _leg(self, side: str) -> _Leg:
+    def _leg(self, side: str, span: Reach) -> _Leg:
         g = self._g
         a, b = g.thigh, g.shin
         return _Leg(0.0, SIDE_SIGN[side] * g.hip_width / 2, 0.0, a, b, g.ankle_height, a + b,
-                    abs(a - b), 4.0 * a * b, abs(a - b) - REACH_TOL, a + b + REACH_TOL)
+                    abs(a - b), 4.0 * a * b, span.lo - REACH_TOL, span.hi + REACH_TOL,
+                    span.lo, span.hi)
 
-    def _arm(self, py: float) -> _Arm:
+    def _arm(self, py: float, span: Reach) -> _Arm:
         u, f = self._g.upper_arm, self._g.forearm
-        lo, hi, s = abs(u - f), u + f, abs(py)
-        far, near = hi, lo
-        return _Arm(py, py * py, lo, hi, (far - s) * (far + s), (s - near) * (s + near),
-                    4.0 * u * f, 2.0 * u, f - u, lo - REACH_TOL, hi + REACH_TOL)
+        far, near, s = u + f, abs(u - f), abs(py)
+        return _Arm(py, py * py, span.lo, span.hi, far, near, (far - s) * (far + s),
+                    (s - near) * (s + near), 4.0 * u * f, 2.0 * u, f - u,
+                    span.lo - REACH_TOL, span.hi + REACH_TOL)
 
     def _derive(self, p: GaitParams) -> _Derived:
         g = self._g
@@ -192,7 +200,7 @@ class TickKernel:
                             _t_matmul(pelvis, l_rot))
         q += q_l
         ok = ok & ok_l
-        if self._arms:
+        if self._hands is not None:
             # -- hands relative to the shoulders, then the arms' IK ------------------------
             s_ar, s_al = sin(ph.arm_R), sin(ph.arm_L)
             if a != 1.0:
@@ -216,7 +224,7 @@ class TickKernel:
 
 def _leg_ik(k: _Leg, sole: tuple[float, float, float], f: Rot) -> tuple[list[float], bool]:
     """ik.leg_ik on floats: the six leg angles [rad] and the reachable flag."""
-    hx, hy, hz, a, b, ah, far, near, span, lo, hi = k
+    hx, hy, hz, a, b, ah, far, near, span, lo, hi, c_lo, c_hi = k
     f0, f1, f2, f3, f4, f5, f6, f7, f8 = f
     x = hx - (sole[0] + f2 * ah)   # ankle → hip
     y = hy - (sole[1] + f5 * ah)
@@ -226,6 +234,7 @@ def _leg_ik(k: _Leg, sole: tuple[float, float, float], f: Rot) -> tuple[list[flo
     rz = f2 * x + f5 * y + f8 * z
     c = sqrt(rx * rx + ry * ry + rz * rz)
     reachable = (c >= lo) & (c <= hi)
+    c = c_lo if c < c_lo else c_hi if c > c_hi else c
     s = abs(c)                       # ik.spans and ik.bend with t = 0
     out = (far - s) * (far + s) - 0.0
     out = 0.0 if out < 0.0 else span if out > span else out
@@ -254,18 +263,24 @@ def _leg_ik(k: _Leg, sole: tuple[float, float, float], f: Rot) -> tuple[list[flo
 def _arm_ik(k: _Arm, px: float, pz: float) -> tuple[list[float], bool]:
     """ik.arm_ik on floats for the hand at (px, k.py, pz) [m]: three arm angles [rad] and
     the reachable flag."""
-    py, py2, lo, hi, far_s, s_near, span, two_u, f_u, lo_tol, hi_tol = k
+    py, py2, lo, hi, far, near, far_s, s_near, span, two_u, f_u, lo_tol, hi_tol = k
     rho2 = px * px + pz * pz
     d = sqrt(rho2 + py2)
     dc = lo if d < lo else hi if d > hi else d
     kk = dc / (d if d > 1e-300 else 1e-300)
     y = py * kk
     y = -dc if y < -dc else dc if y > dc else y
-    t = sqrt(rho2)                   # ik.spans(u, f, py, t)
-    t2 = t * t
-    out = far_s - t2
+    t = sqrt(rho2)                   # ik.spans(u, f, py * kk, t * kk)
+    if kk == 1.0:                    # inside the reach: py's terms precomputed
+        t2 = t * t
+        out = far_s - t2
+        inn = s_near + t2
+    else:
+        sk, tk = abs(py * kk), t * kk
+        t2 = tk * tk
+        out = (far - sk) * (far + sk) - t2
+        inn = (sk - near) * (sk + near) + t2
     out = 0.0 if out < 0.0 else span if out > span else out
-    inn = s_near + t2
     inn = 0.0 if inn < 0.0 else span if inn > span else inn
     elbow = -2.0 * atan2(sqrt(out), sqrt(inn))
     vx = sqrt(out * inn) / two_u

@@ -10,15 +10,22 @@ form) for where the clamped chain really puts the hand and the foot.
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 import pytest
 
+from robot.cli import main
+from robot.commands.walk import format_summary
 from robot.config.bundled import ROBOTS_DIR
+from robot.config.gait_file import load_gait
 from robot.config.robot_file import load_robot
+from robot.gait import expressions as gait
+from robot.gait.engine import GaitEngine
 from robot.gait.ik import arm_fk_local, arm_ik, arm_reach, leg_fk_full, leg_ik, leg_reach
-from robot.gait.vectorised import spans
+from robot.gait.targets import body_targets
+from robot.gait.vectorised import solve, spans
 
 DXL = load_robot(ROBOTS_DIR / "biped18-dynamixel.toml")
 
@@ -82,3 +89,40 @@ def test_a_foot_target_inside_the_knee_limit_is_met_on_its_line() -> None:
     assert np.linalg.norm(ankle - hip) == pytest.approx(span.lo, abs=1e-9)
     assert (ankle - hip) / np.linalg.norm(ankle - hip) == pytest.approx(line, abs=1e-9)
     assert np.asarray(rot) == pytest.approx(np.eye(3).ravel(), abs=1e-9)  # foot still level
+
+
+HIGH_ARMS = {"Ahgt_R": 2.0, "Ahgt_L": 2.0}      # hands raised beyond the shoulders' reach
+
+
+def test_the_engine_counts_each_joint_held_at_its_limit() -> None:
+    """Counted against the general functions' unclamped angles and the limits by hand."""
+    params = load_gait("walk").params.replace(HIGH_ARMS)
+    engine = GaitEngine(DXL, params)
+    engine.start()
+    want = [0] * len(DXL.joints)
+    for _ in range(400):
+        q = engine.tick(0.005)
+        ch = gait.channels(engine.phase, engine.live_params, amplitude=engine.amplitude)
+        raw, _ = solve(body_targets(ch, engine.live_params, DXL.geometry,
+                                    amplitude=engine.amplitude), DXL)
+        for i, (v, j) in enumerate(zip(raw, DXL.joints, strict=True)):
+            want[i] += not j.min_rad <= float(v) <= j.max_rad
+        assert all(j.min_rad <= v <= j.max_rad for v, j in zip(q, DXL.joints, strict=True))
+    assert engine.clamp_ticks == want
+    held = {DXL.joint_names[i] for i, n in enumerate(want) if n}
+    assert held & {"r_shoulder_pitch", "l_shoulder_pitch"}
+
+
+def test_a_walk_says_which_joints_it_held_at_a_limit(capsys: pytest.CaptureFixture[str]) -> None:
+    sets = [a for k, v in HIGH_ARMS.items() for a in ("--set", f"{k}={v}")]
+    assert main(["walk", "--json", "--seconds", "2", "--no-balance", *sets]) == 0
+    r = json.loads(capsys.readouterr().out)
+    ran = r["ticks"] / r["rate_hz"]
+    assert set(r["clamped_joints_s"]) & {"r_shoulder_pitch", "l_shoulder_pitch"}
+    assert all(0.0 < t <= ran for t in r["clamped_joints_s"].values())
+    assert 0.0 < r["ik_unreachable_s"] <= ran
+    assert "joint limits  held at a limit: " in format_summary(r)
+    assert main(["walk", "--json", "--seconds", "2", "--no-balance"]) == 0
+    plain = json.loads(capsys.readouterr().out)
+    assert plain["clamped_joints_s"] == {} and plain["ik_unreachable_s"] == 0.0
+    assert "joint limits" not in format_summary(plain)

@@ -22,6 +22,7 @@ from robot.config.gait_file import load_gait
 from robot.config.params import GaitParams
 from robot.gait import expressions as gait
 from robot.gait.engine import GaitEngine
+from robot.gait.ik import leg_fk_full
 from robot.gait.targets import body_targets
 from robot.run.walk import HEADING_DRIFT_DEG_MIN
 
@@ -106,3 +107,26 @@ def test_an_asked_turn_is_not_drift(capsys: pytest.CaptureFixture[str]) -> None:
     minutes = r["ticks"] / r["rate_hz"] / 60.0
     assert r["heading_drift_deg_min"] == pytest.approx(
         (r["heading_change_deg"] - r["heading_asked_deg"]) / minutes)
+
+
+def test_a_live_turn_lengthens_the_right_stride_of_a_five_dof_robot() -> None:
+    """What the panel's turn slider does (GaitEngine.set_params while walking): the right
+    sole's fore-aft travel, from the joint angles through the forward kinematics, grows by
+    2 x turn x the half gap."""
+    def right_travel(turn: float) -> float:
+        engine = GaitEngine(ROBOT, LEVEL)
+        engine.start()
+        for _ in range(400):
+            engine.tick(0.005)
+        engine.set_params({"turn": turn})
+        for _ in range(400):                                    # ramped in, turn followed
+            engine.tick(0.005)
+        xs = []
+        for _ in range(round(LEVEL.cycle_s / 0.005) + 1):
+            q = dict(zip(ROBOT.joint_names, engine.tick(0.005), strict=True))
+            leg = (0.0, *(q[f"r_{j}"] for j in ("hip_roll", "hip_pitch", "knee",
+                                                 "ankle_pitch", "ankle_roll")))
+            xs.append(leg_fk_full(ROBOT.geometry, "r", leg)[0][0])
+        return max(xs) - min(xs)
+    half_gap = ROBOT.geometry.hip_width / 2 + LEVEL.foot_spread
+    assert right_travel(0.2) - right_travel(0.0) == pytest.approx(2 * 0.2 * half_gap, abs=1e-4)

@@ -41,10 +41,10 @@ def test_byte_ranges_by_rfc_9110() -> None:
 def test_the_page_plays_the_take_s_audio_in_step(tmp_path: Path, browser: Browser) -> None:
     write_show(tmp_path, seconds=8.0)
     with served_panel(studio_dir=tmp_path) as (controller, base):
-        errors, span = measure(controller, base, browser, seconds=6.0)
-        assert span >= 5.5 and len(errors) >= 10, (span, len(errors))
-        held = np.abs(errors[5:])
-        assert float(np.median(held)) < 100.0, errors
+        got = measure(controller, base, browser, seconds=6.0)
+        assert got.span >= 5.5 and len(got.audio) >= 10, (got.span, len(got.audio))
+        held = np.abs(got.audio[5:])
+        assert float(np.median(held)) < 100.0, got.audio
         assert wait_for(lambda: not controller.running, timeout=15.0)
 
 

@@ -33,6 +33,16 @@
   }
 
   let wasRecording = null;
+  function prepare(now) {   // a new show: load its audio
+    if (show && show.take === now.take) return;
+    show = now; cue = 0;
+    const audio = $("show-audio");
+    if (now.audio) {
+      audio.src = now.audio + (TOKEN ? "&token=" + encodeURIComponent(TOKEN) : "");
+      audio.load();
+    }
+  }
+
   P.listeners.push((s) => {
     if (!s.studio) return;
     status(s.studio);
@@ -60,58 +70,67 @@
 })();
 
 // A show take with a soundtrack: the browser plays the sound (the robot's computer needs no
-// audio stack). Every live frame carries the show's time on the robot (the engine's, 0 at
-// its first tick after the ramp in) and the server's wall time when it was read. The page
-// dates each frame by that wall time, less the smallest delivery delay seen (so a frame that
-// arrives late does not shift the clock), and the audio element follows: started at the
-// audio's offset, steered by its playback rate (within +-10 %), re-seeked for a large drift.
+// audio stack). Every live frame carries the show's time t on the robot (the engine's, 0 at
+// its first tick after the ramp in), the robot's wall time `at` of that very tick, and the
+// rate at which show time runs (below 1 when the loop falls behind). The page maps the
+// robot's wall clock onto its own by the smallest (arrival - at) seen, so a frame that
+// arrives late, or was read from a cache, still says what the show time was when; the show
+// time now is t + rate * (now - at). The audio element follows: started at the audio's
+// offset, steered by its playback rate, re-seeked only for a large drift. The steering is
+// proportional, with the show's rate fed forward: rate = show rate - drift / TAU, so the
+// drift decays as exp(-t / TAU) and never overshoots (no integral term to wind up); a
+// playback rate is set only when it changes by more than RATE_STEP (each change costs the
+// audio renderer a re-buffer).
 (() => {
   const P = window.panel;
   const $ = (id) => document.getElementById(id);
   const TOKEN = new URLSearchParams(location.search).get("token");
   const SEEK_S = 0.15;      // drift [s] beyond which it seeks
-  const GAIN = 1.5, INTEGRAL = 0.6;   // rate change per s of drift, per s*s of it held
+  const TAU = 0.5;          // [s] time constant of the steering
+  const MAX_DEV = 0.1;      // largest playback-rate change from the show's rate
+  const RATE_STEP = 0.005;  // smallest playback-rate change made
   let show = null;          // the playing show's fields, or null
-  let heard = null;         // {t, at}: show time t [s] at performance.now() at [ms]
-  let delay = Infinity;     // smallest (arrival - server wall time) seen [ms]: clock offset
+  let heard = null;         // {t, at, rate}: show time t [s] at page time at [ms]
+  let offset = Infinity;    // smallest (arrival - robot wall time) seen [ms]: the clocks' offset
   let lead = 0.05;          // a seek lands this late [s] (learnt from the last one)
   let seeked = false;       // the last step was a seek: the next drift says how late
-  let held = 0, last = null;   // integral of the drift [s*s], when it was last updated
   let cue = 0;
+  let seeks = 0;            // seeks made (for the tests: a seek is a jump in the sound)
   let wasPlaying = null;    // the take playing at the last frame
 
-  function showTime() {     // the robot's show time now [s], by the page's clock
-    return heard ? heard.t + (performance.now() - heard.at) / 1000 : null;
+  const pageNow = () => performance.timeOrigin + performance.now();   // [ms]
+
+  function showTime(at) {   // the robot's show time [s] at page time at [ms]
+    return heard ? heard.t + heard.rate * (at - heard.at) / 1000 : null;
   }
 
-  function hear(t, wall) {  // a frame: show time t [s] read at server wall time [s]
-    const now = performance.now();
-    const arrival = performance.timeOrigin + now;
-    delay = Math.min(delay, arrival - 1000 * wall);
-    heard = { t, at: now - (arrival - 1000 * wall - delay) };   // when it was read, here
+  function hear(now) {      // a frame: show time now.t [s] at robot wall time now.at [s]
+    if (now.at === null || now.at === undefined) return;
+    offset = Math.min(offset, pageNow() - 1000 * now.at);
+    heard = { t: now.t, at: 1000 * now.at + offset, rate: now.rate || 1 };
   }
 
   function follow() {
     const audio = $("show-audio");
     if (!show || !show.audio || heard === null) return;
-    const want = showTime() - show.audio_offset_s;    // where the audio should be [s]
+    const at = pageNow();
+    const want = showTime(at) - show.audio_offset_s;   // where the audio should be [s]
     if (want < 0) return;
     if (audio.paused) {
       audio.currentTime = want + lead;
-      seeked = true;
+      seeked = true; seeks++;
       audio.play().catch((e) => P.say("audio: " + e.message + " (tap the page once)", true));
       return;
     }
     const drift = audio.currentTime - want;
     if (seeked) { lead = Math.min(0.3, Math.max(0, lead - drift)); seeked = false; }
-    const now = performance.now();
-    held = Math.min(0.05, Math.max(-0.05, held + drift * (last ? (now - last) / 1000 : 0)));
-    last = now;
     if (Math.abs(drift) > SEEK_S) {
-      audio.currentTime = want + lead; audio.playbackRate = 1; seeked = true; held = 0;
-    } else {
-      audio.playbackRate = Math.min(1.1, Math.max(0.9, 1 - GAIN * drift - INTEGRAL * held));
+      audio.currentTime = want + lead; audio.playbackRate = heard.rate; seeked = true;
+      seeks++;
+      return;
     }
+    const rate = heard.rate * Math.min(1 + MAX_DEV, Math.max(1 - MAX_DEV, 1 - drift / TAU));
+    if (Math.abs(rate - audio.playbackRate) > RATE_STEP) audio.playbackRate = rate;
   }
 
   function stop(why) {
@@ -120,7 +139,17 @@
     audio.removeAttribute("src");
     $("show-line").hidden = true;
     if (why) P.say(why);
-    show = null; heard = null; cue = 0; delay = Infinity; held = 0; last = null;
+    show = null; heard = null; cue = 0; offset = Infinity;
+  }
+
+  function prepare(now) {   // a new show: load its audio
+    if (show && show.take === now.take) return;
+    show = now; cue = 0;
+    const audio = $("show-audio");
+    if (now.audio) {
+      audio.src = now.audio + (TOKEN ? "&token=" + encodeURIComponent(TOKEN) : "");
+      audio.load();
+    }
   }
 
   P.listeners.push((s) => {
@@ -132,19 +161,17 @@
     const playing = s.studio ? s.studio.playing : null;
     if (wasPlaying && playing !== wasPlaying) P.say("take " + wasPlaying + " finished");
     wasPlaying = playing;
-    if (!now || s.state !== "walking") {
+    if (!now || !s.running) {
       if (show) stop(null);
       return;
     }
-    if (!show || show.take !== now.take) {
-      show = now; cue = 0;
-      const audio = $("show-audio");
-      if (now.audio) {
-        audio.src = now.audio + (TOKEN ? "&token=" + encodeURIComponent(TOKEN) : "");
-        audio.load();
-      }
+    if (!now.playing) {
+      if (heard) stop(null);                 // played to its end: ramping out
+      else if (now.at === null) prepare(now);   // ramping in: the audio loads
+      return;
     }
-    hear(now.t, s.wall_time);
+    prepare(now);
+    hear(now);
     while (cue < now.cues.length && now.cues[cue].t <= now.t) {
       const line = $("show-line");
       line.hidden = false;
@@ -154,7 +181,12 @@
     follow();
   });
   setInterval(follow, 50);
-  // For the tests and the curious: the audio's clock and the show time it follows [s].
-  window.showClock = () => ({ audio: $("show-audio").currentTime, playing: !$("show-audio").paused,
-                              show: showTime(), offset: show ? show.audio_offset_s : null });
+  // For the tests and the curious: the audio's clock [s] and the page's wall time of that
+  // read [ms], and the show time the page follows then [s].
+  window.showClock = () => {
+    const audio = $("show-audio"), at = pageNow();
+    return { audio: audio.currentTime, at, playing: !audio.paused, show: showTime(at),
+             offset: show ? show.audio_offset_s : null, clockOffset: offset, seeks,
+             rate: audio.playbackRate };
+  };
 })();

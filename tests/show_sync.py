@@ -1,8 +1,9 @@
 """Measuring a show's audio sync in the panel (headless Chromium): a show take with a
 soundtrack (an arm show imported from a BVH, a tone), the panel serving it, and reads of
 the page's <audio> clock against the take's time at the same instant (the loop process
-stamps each tick's take time with its wall clock; the page says when it read). Used by tests/test_panel_show.py (a short run, a
-loose bound that catches a broken follower) and docs/show_sync.py (the 30 s measurement)."""
+stamps each tick's take time with its wall clock; the page says when it read). Used by
+tests/test_panel_show.py (a short run, a loose bound that catches a broken follower)
+and docs/show_sync.py (the 30 s measurement)."""
 
 from __future__ import annotations
 

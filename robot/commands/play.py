@@ -6,8 +6,8 @@ balance feedback if it was on), so in the simulation it reproduces the recorded 
 stream. A show take (`biped import`) streams its joints as authored, and where its timeline
 has the gait walk, the gait walks the legs (robot/motion/show_walk.py; ``--no-root-travel``:
 the authored legs everywhere). A keyframe sequence plays on its own: the joints it names
-follow it, the others hold the standing pose. Either way: ramp in from the present pose, clamp, slew, then ramp
-to rest and torque off (``--hold``: stay on). Ctrl-C / SIGTERM as for `biped walk`.
+follow it, the others hold the standing pose. Either way: ramp in from the present pose,
+clamp, slew, then ramp to rest and torque off (``--hold``: stay on). Ctrl-C / SIGTERM as for `biped walk`.
 """
 
 from __future__ import annotations

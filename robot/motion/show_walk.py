@@ -32,6 +32,7 @@ from robot.gait.engine import GaitEngine
 from robot.motion.keyframes import Sequence
 from robot.motion.takes import Take
 
+
 @dataclass(frozen=True)
 class Travel:
     """walks: (start, stop) [s of show time], in order, not overlapping; changes: (t [s],

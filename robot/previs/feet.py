@@ -59,7 +59,7 @@ def rig_motion(rig: Rig, c: Array, scale: float) -> RigMotion:
     """The feet, root and heading of ``rig`` seen through ``c`` (robot from file axes,
     ``Rig.orient``), lengths times ``scale`` [m per file unit]."""
     rot, _, ends = _world(rig)
-    t = np.arange(rig.frames) * rig.frame_s
+    t: Array = np.arange(rig.frames, dtype=np.float64) * rig.frame_s
     root = rig.root @ c.T * scale
     fwd = np.einsum("ij,njk,k->ni", c, rot[:, 0], c[0])     # the root's forward, robot axes
     heading = np.unwrap(np.arctan2(fwd[:, 1], fwd[:, 0]))

@@ -6,7 +6,8 @@ Per step (from one swing's lift-off to the next; the last to the walk's end) the
 mean velocity over that step, in the heading frame of the root: forward v [m/s], left u
 [m/s], yaw rate w [rad/s]. Step by step, so the steps' travel adds up to the root's (a
 longer window, a stride, would average a limp but not add up at the walk's ends). The
-gait's parameters follow from what one unit of each makes the robot travel (robot/gait/targets.py, docs/gait.md), with n = 2 / cycle steps per second:
+gait's parameters follow from what one unit of each makes the robot travel
+(robot/gait/targets.py, docs/gait.md), with n = 2 / cycle steps per second:
 
 - ``speed`` scales the stride: the stance foot moves 2 A relative to the pelvis per step
   (A = the stride amplitude, ``Slgt`` x leg / ``rig_leg`` [m]), so the no-slip speed is

@@ -26,7 +26,10 @@ and side step in their parameter ranges; each clamp is reported.
 
 The gait starts half its ramp-in time (``ramp_cycles`` x cycle) before the walk's first
 lift-off and is told to stop half its ramp-out time before the last touch-down, so its
-amplitude's integral, the distance it walks, is the walk's length at full amplitude.
+amplitude's integral, the distance it walks, is the walk's length at full amplitude; for
+that the ramp out keeps the speed of the step it starts in (steps that begin after the
+gait's stop are not written). The legs are the gait's from the walk's first lift-off to its
+last touch-down and blend over the half ramps outside it (robot/motion/show_walk.py).
 """
 
 from __future__ import annotations
@@ -127,6 +130,8 @@ def plan_walk(walk: Walk, m: RigMotion, robot: RobotConfig, params: GaitParams,
         t0, t1 = bounds[i], bounds[i + 1]
         v, u, w = _velocity(m, t0, t1)
         when = start if i == 0 else t0
+        if i and when >= stop:
+            break       # the ramp out keeps the last speed: its distance is the ramp in's
         speed = _clamp("speed", v / fwd if fwd else 0.0, *SPEED_RANGE, when, clamped)
         yaw = w / turn if turn and robot.has_hip_yaw else 0.0
         yaw = _clamp("turn", yaw, SPECS["turn"].lo, SPECS["turn"].hi, when, clamped)

@@ -34,10 +34,14 @@ def main() -> int:
           f"second left out): worst {held.max():.1f} ms, p90 {np.percentile(held, 90):.1f} "
           f"ms, median {np.median(held):.1f} ms, within 50 ms: {np.mean(held < 50):.0%}; "
           f"the page's estimate of the take's time: worst {guess.max():.1f} ms, median "
-          f"{np.median(guess):.1f} ms; {got.seeks} seeks; load average "
+          f"{np.median(guess):.1f} ms; {got.seeks[-1] if got.seeks else 0} seeks; load average "
           f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     worst = int(np.argmax(held))
     print("worst reads (t from the first [s], audio error, estimate error [ms]): " + ", ".join(
         f"{got.at[5 + k] - got.at[0]:.1f} {got.audio[5 + k]:+.0f} {got.estimate[5 + k]:+.0f}"
         for k in sorted(np.argsort(-held)[:5])))
     return 0 if held[worst] < 50.0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -53,25 +53,30 @@ class Sync:
     """Per read while the audio plays [ms]: ``audio`` the audio's clock less the take's
     time at the instant of the read; ``estimate`` the page's own estimate of the take's
     time less the take's time (what the follower steers to); the reads' page wall times
-    [s]; ``span`` [s] of take time covered; ``seeks`` the page made."""
+    [s]; the audio's playback rate and the seeks the page had made by then; ``span`` [s]
+    of take time covered."""
 
     audio: list[float]
     estimate: list[float]
     at: list[float]
+    rate: list[float]
+    seeks: list[int]
     span: float
-    seeks: int
 
 
 def measure(controller: PanelController, base: str, browser: Browser, seconds: float,
-            wait: float = 20.0) -> Sync:
+            wait: float = 20.0, tune: dict[str, float] | None = None) -> Sync:
     """Play the show from the page and compare, read by read, the page's <audio> clock
     with the take's time at the same instant: the page says when (its wall clock) it read
     the audio; the loop process stamps each tick's take time with its wall clock (the same
     machine's clock); the take's time at the read is interpolated between the stamped
-    ticks fetched just before and just after the read. Leaves the page open until the
-    take ends."""
+    ticks fetched just before and just after the read. ``tune``: the page's follower
+    settings to change (robot/panel/static/studio.js ``showTune``). Leaves the page open
+    until the take ends."""
     page = browser.new_page()
     page.goto(base)
+    if tune:
+        page.evaluate("(t) => Object.assign(window.showTune, t)", tune)
     page.wait_for_selector("#takes option[value=show]", state="attached")
     page.select_option("#takes", "show")
     page.click("#play")
@@ -90,7 +95,8 @@ def measure(controller: PanelController, base: str, browser: Browser, seconds: f
     audio: list[float] = []
     estimate: list[float] = []
     at: list[float] = []
-    clock = {"seeks": 0}
+    rate: list[float] = []
+    seeks: list[int] = []
     while (a := stamped()) is not None and a[0] < first[0] + seconds:
         clock = page.evaluate("showClock()")
         b = stamped()
@@ -102,8 +108,9 @@ def measure(controller: PanelController, base: str, browser: Browser, seconds: f
             audio.append(1000 * (clock["audio"] + OFFSET - take))
             estimate.append(1000 * (clock["show"] - take))
             at.append(w)
+            rate.append(float(clock["rate"]))
+            seeks.append(int(clock["seeks"]))
         time.sleep(0.1)
     span = (stamped() or (first[0] + seconds, 0.0))[0] - first[0]
-    seeks = int(clock["seeks"])
     page.close()
-    return Sync(audio, estimate, at, span, seeks)
+    return Sync(audio, estimate, at, rate, seeks, span)

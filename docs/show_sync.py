@@ -3,11 +3,14 @@ soundtrack played from the panel in Debian's headless Chromium, the page's <audi
 five times a second against the take's time on the robot (tests/show_sync.py). Prints the
 worst, 90th percentile and median difference and the machine's load.
 
-Run: ``MUJOCO_GL=egl .venv/bin/python docs/show_sync.py``
+Run: ``MUJOCO_GL=egl .venv/bin/python docs/show_sync.py ['{"tau": 0.5}']`` (the optional JSON
+object changes the page's follower settings, ``window.showTune`` in
+robot/panel/static/studio.js)
 """
 
 from __future__ import annotations
 
+import json
 import os
 import sys
 import tempfile
@@ -26,7 +29,8 @@ def main() -> int:
     write_show(folder, seconds=33.0)
     with served_panel(studio_dir=folder) as (controller, base), sync_playwright() as p:
         browser = p.chromium.launch(executable_path=CHROMIUM, args=[*ARGS, AUTOPLAY])
-        got = measure(controller, base, browser, seconds=30.0)
+        got = measure(controller, base, browser, seconds=30.0,
+                      tune=json.loads(sys.argv[1]) if len(sys.argv) > 1 else None)
         browser.close()
     held = np.abs(got.audio[5:])
     guess = np.abs(got.estimate[5:])

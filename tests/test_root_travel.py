@@ -17,7 +17,10 @@ from walk_anim import RIG_LEG, WalkShape, write_walk_bvh
 import robot.cli as cli
 from robot.config.joint_names import LEG_NAMES
 from robot.config.robot_file import load_robot
+from robot.motion.show import stream_sequence
+from robot.motion.show_walk import ShowEngine, Travel
 from robot.motion.takes import Take, read_take
+from robot.panel.runs import ShowTake, build
 from robot.previs.travel import Efficiency
 
 #: The speed, turn and side step asked of the gait match the root's within this share.
@@ -121,3 +124,19 @@ def test_the_show_walks_the_root_s_distance_in_the_sim(tmp_path: Path,
     middle = (t > shape.stand_s + 1.0) & (t < shape.stand_s + shape.walk_s - 1.0)
     assert np.abs(cmd[middle] - authored[middle]).max() > 0.05
     assert math.isfinite(result["walked"]["heading_change_deg"])
+
+
+def test_the_panel_plays_a_walking_show_with_the_gait(tmp_path: Path) -> None:
+    """The panel's show run (robot/panel/runs.py) walks the legs with the take's timeline:
+    the engine it builds from the take is the gait's where the character walks."""
+    take = _import(tmp_path, WalkShape(steps=4))
+    robot = load_robot(take.header.robot)
+    kind = ShowTake("walk", stream_sequence(take), Travel.of_take(take), take.header.params)
+    engine = build(kind, robot, take.header.params).engine
+    assert isinstance(engine, ShowEngine)
+    engine.start()
+    rate = take.header.rate_hz
+    walk_mid = (WalkShape().stand_s + 1.0) * rate
+    for _ in range(int(walk_mid)):
+        engine.tick(1.0 / rate)
+    assert engine.gait_share == 1.0 and engine.state == "walking"

@@ -22,9 +22,8 @@ from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.run.session import bus_session
 from robot.run.signals import shield
-from robot.servo.models import BUS_FAMILIES
+from robot.servo.models import factory_baud
 from robot.setup.motor_setup import (
-    FACTORY_BAUD,
     answered,
     assign,
     check_model,
@@ -60,8 +59,10 @@ def _bus(args: argparse.Namespace, robot: RobotConfig) -> SdkBus | LxBus:
                      check_health=False)
     cls: type[SdkBus] = {"dynamixel": DynamixelBus, "dynamixel1": Dynamixel1Bus}.get(
         kind, FeetechBus)
-    # No robot on the bus: a servo at id 1 is a new servo, not joint 1 (and no health check).
-    return cls(args.port or robot.bus.port, baud=FACTORY_BAUD[BUS_FAMILIES[kind]],
+    # No robot on the bus: a servo at id 1 is a new servo, not joint 1 (and no health check);
+    # the robot's servo model says which table (the XL-320's, an SCS's) and the first baud.
+    servo = robot.bus.servo
+    return cls(args.port or robot.bus.port, baud=factory_baud(servo), family=servo.family,
                retries=robot.bus.retries, timeout_ms=robot.bus.timeout_ms, check_health=False)
 
 
@@ -85,7 +86,9 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
                     print("stopped")
                     return 1
             found = find_servo(bus, robot, progress=lambda m: print(f"  {m}", flush=True))
-            check_model(found, robot, joint)
+            note = check_model(found, robot, joint)
+            if note:
+                print(f"  note: {note}")
             print(f"  found: {robot.bus.model} at id {found.id}, {found.baud} baud")
             with shield():           # id, baud, return delay: all of them or a signal waits
                 changes = assign(bus, found, joint, robot)

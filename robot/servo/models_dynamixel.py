@@ -118,8 +118,8 @@ MODELS: dict[str, ServoModel] = {m.name: m for m in (
     # AX-12A: 1.5 N m (12 V, 1.5 A), 59 rpm (12 V), 54.6 g; 0..300 deg in 1024 steps; 12.
     _m("AX-12A", 12, P1, 1024, 1.5, 59, 0.0546, 12.0, span_deg=300.0, gain_set=_AXS,
        factory_gains=_AX),
-    # AX-18A: 1.8 N m (12 V, 2.2 A), 97 rpm (12 V), 54.5 g; 18.
-    _m("AX-18A", 18, P1, 1024, 1.8, 97, 0.0545, 12.0, span_deg=300.0, gain_set=_AXS,
+    # AX-18A: 1.8 N m (12 V, 2.2 A), 97 rpm (12 V), 55.9 g (54.5 g is the older AX-18F); 18.
+    _m("AX-18A", 18, P1, 1024, 1.8, 97, 0.0559, 12.0, span_deg=300.0, gain_set=_AXS,
        factory_gains=_AX),
     # MX-28 (Protocol 1.0 firmware): 2.5 N m, 55 rpm at 12 V, 72 g; 4096 steps; 29; ships at
     # 57600 (Baud Rate(4) initial 34, unlike the AX's 1).

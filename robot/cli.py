@@ -43,6 +43,7 @@ COMMANDS: tuple[str, ...] = (
     "monitor",
     "robustness",
     "tune",
+    "identify",
 )
 
 

@@ -23,7 +23,9 @@ def test_energy_and_knee_load_are_the_hand_sums() -> None:
     knee_r, knee_l = model.actuator("r_knee").id, model.actuator("l_knee").id
     hip = model.actuator("r_hip_pitch").id
     dof = {n: model.jnt_dofadr[model.joint(n).id] for n in ("r_knee", "l_knee", "r_hip_pitch")}
-    stall = robot.servo(robot.joint("r_knee")).stall_torque
+    # the servo model's stall torque at the robot's supply: kt V max_duty / R
+    knee = robot.joint("r_knee")
+    stall = robot.servo_physics(knee).stall_torque(robot.voltage(knee))
     mon.update(0.0)                                   # start: no span yet
     data.actuator_force[[knee_r, knee_l, hip]] = (0.7, -0.35, 0.2)
     data.qvel[[dof["r_knee"], dof["l_knee"], dof["r_hip_pitch"]]] = (2.0, 1.0, -3.0)

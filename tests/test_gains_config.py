@@ -82,7 +82,9 @@ def test_gain_sets_name_the_manuals_registers_and_memory() -> None:
 
 
 def test_without_gain_tables_every_joint_gets_its_models_factory_values() -> None:
-    robot = parse_robot(robot_data("biped18-dynamixel"), source="r.toml")
+    data = robot_data("biped18-dynamixel")
+    data["bus"].pop("gains", None)      # the bundled file sets [bus.gains]: none here
+    robot = parse_robot(data, source="r.toml")
     for j in robot.joints:
         assert dict(robot.gains(j)) == MANUAL_FACTORY["XL430-W250"]
         assert robot.voltage(j) == 11.1     # XL430-W250 datasheet: 11.1 V nominal
@@ -104,6 +106,7 @@ def test_precedence_factory_then_bus_then_joint() -> None:
 
 def test_a_joint_with_its_own_model_gets_that_models_factory_values() -> None:
     data = robot_data("biped18-dynamixel")
+    data["bus"].pop("gains", None)      # the bundled file sets [bus.gains]: none here
     data["joints"]["r_knee"]["model"] = "XM430-W350"
     robot = parse_robot(data, source="r.toml")
     assert dict(robot.gains(robot.joint("r_knee"))) == MANUAL_FACTORY["XM430-W350"]

@@ -16,6 +16,7 @@ import copy
 import io
 import json
 import logging
+import re
 from collections.abc import Iterator
 from contextlib import redirect_stdout
 from pathlib import Path
@@ -49,9 +50,17 @@ ROBOT_FILE = {"dynamixel": "biped18-dynamixel", "dynamixel1": "biped18-ax12",
               "feetech": "biped18-feetech"}
 
 
+def bundled_text(protocol: str) -> str:
+    """The bundled robot file for ``protocol`` without its own [bus.gains] (the gains the
+    robot walks with, docs/servos.md): these tests start from the factory values."""
+    text = (ROBOTS_DIR / f"{ROBOT_FILE[protocol]}.toml").read_text()
+    return re.sub(r"\n\[bus\.gains\][^\[]*", "\n", text, count=1)
+
+
 def robot_with(protocol: str, *, bus: dict[str, int] | None = None,
                joints: dict[str, dict[str, Any]] | None = None) -> RobotConfig:
     data = copy.deepcopy(read_toml(ROBOTS_DIR / f"{ROBOT_FILE[protocol]}.toml"))
+    data["bus"].pop("gains", None)      # start from the factory values (bundled_text)
     data["bus"]["timeout_ms"] = TEST_TIMEOUT_MS
     if bus:
         data["bus"]["gains"] = bus
@@ -201,7 +210,7 @@ def test_a_read_back_mismatch_is_a_fault_naming_servo_register_and_values(
 
 def test_a_walk_with_a_gain_the_servo_refuses_ends_in_a_fault_with_torque_off(
         emulate: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    text = (ROBOTS_DIR / "biped18-dynamixel.toml").read_text()
+    text = bundled_text("dynamixel")
     text = text.replace("timeout_ms = 20.0", f"timeout_ms = {TEST_TIMEOUT_MS}")
     text = text.replace("[geometry]", "[bus.gains]\nposition_p_gain = 500\n\n[geometry]", 1)
     path = tmp_path / "robot.toml"
@@ -227,7 +236,7 @@ def test_a_walk_with_a_gain_the_servo_refuses_ends_in_a_fault_with_torque_off(
 def robot_file(tmp_path: Path, protocol: str, extra: str = "") -> Path:
     """The bundled robot for ``protocol`` with a test reply timeout and ``extra`` TOML put
     before its [geometry] table."""
-    text = (ROBOTS_DIR / f"{ROBOT_FILE[protocol]}.toml").read_text()
+    text = bundled_text(protocol)
     text = text.replace("timeout_ms = 20.0", f"timeout_ms = {TEST_TIMEOUT_MS}")
     path = tmp_path / "robot.toml"
     path.write_text(text.replace("[geometry]", f"{extra}\n[geometry]", 1))

@@ -18,6 +18,7 @@ from robot.config.joint_names import ARM_JOINTS, LEG_JOINTS  # noqa: E402
 from robot.config.robot import RobotConfig  # noqa: E402
 from robot.config.robot_file import load_robot  # noqa: E402
 from robot.gait import ik  # noqa: E402
+from robot.servo.firmware import stiffness  # noqa: E402
 from sim.mujoco.mjcf import build_mjcf, standing_qpos  # noqa: E402
 
 ROBOTS = sorted(p.name for p in ROBOTS_DIR.glob("*.toml"))
@@ -43,17 +44,21 @@ def test_model_matches_config(name: str) -> None:
     assert [m.actuator(i).name for i in range(m.nu)] == list(names)
     assert m.joint(0).name == "root" and m.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE
     assert [m.joint(i).name for i in range(1, m.njnt)] == list(names)
-    servo = robot.bus.servo
     for i, j in enumerate(robot.joints):
+        physics, volts = robot.servo_physics(j), robot.voltage(j)
         jid = _id(m, mujoco.mjtObj.mjOBJ_JOINT, j.name)
         assert m.jnt_range[jid].tolist() == [j.min_rad, j.max_rad]
         assert m.jnt_limited[jid]
         assert m.actuator_ctrlrange[i].tolist() == [j.min_rad, j.max_rad]
-        assert m.actuator_forcerange[i].tolist() == pytest.approx([-servo.stall_torque,
-                                                                   servo.stall_torque])
+        stall = physics.stall_torque(volts)
+        assert m.actuator_forcerange[i].tolist() == pytest.approx([-stall, stall], rel=1e-5)
         assert m.actuator_trnid[i, 0] == jid
-        assert m.actuator_gainprm[i, 0] == pytest.approx(servo.stall_torque / 0.05)
-        assert m.dof_armature[m.jnt_dofadr[jid]] > 0
+        assert m.actuator_gainprm[i, 0] == pytest.approx(
+            stiffness(robot.servo(j), physics, robot.gains(j), volts), rel=1e-5)
+        dof = m.jnt_dofadr[jid]
+        assert m.dof_armature[dof] == pytest.approx(physics.armature, rel=1e-5)
+        assert m.dof_damping[dof] == pytest.approx(   # torque on: back-EMF + gearbox
+            physics.back_emf_damping + physics.viscous, rel=1e-5)
     assert m.body_subtreemass[_id(m, mujoco.mjtObj.mjOBJ_BODY, "torso")] == pytest.approx(
         robot.mass.total)
     assert m.opt.timestep <= 0.002
@@ -161,7 +166,10 @@ def test_cli_writes_loadable_files(tmp_path, capsys) -> None:  # type: ignore[no
     alone = mujoco.MjModel.from_xml_path(str(out / "robot.xml"))
     assert scene.nu == alone.nu == 18
     assert scene.key("home").name == "home"
-    assert scene.actuator_forcerange[0, 1] == pytest.approx(1.91)
+    # the STS3215 as Rhoban/bam identified it at 7.4 V (kt 1.2116 N m/A, R 2.6762 ohm,
+    # PWM limit 0.97): stall = kt V d / R
+    assert scene.actuator_forcerange[0, 1] == pytest.approx(1.21164 * 7.4 * 0.97 / 2.67617,
+                                                            rel=1e-4)
 
 
 def test_cli_reports_an_unwritable_out_dir(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]

@@ -5,6 +5,12 @@ the time MuJoCo's own stepping takes (its timers) versus everything else in the 
 Each configuration runs ``repeats`` times; reported as the median and the spread of the
 realtime factor (sim seconds / wall seconds of the loop) and the physics share. Machines
 are shared: compare ratios measured in one run, never absolute numbers across machines.
+
+``presets``: every bundled gait preset walked for 60 s on the flat on every bundled robot
+(5 s with ``quick``), as `biped walk` runs it (balance on where the robot has an IMU):
+whether it fell, its speed and heading change. The simulated servos are the identified
+ones at the robot file's gains (docs/servos.md), so this is where a gain choice that
+makes a preset sag or fall shows.
 """
 
 from __future__ import annotations
@@ -16,6 +22,7 @@ from typing import Any
 from robot.balance.stage import Balance, attitude_reader
 from robot.bus.factory import make_bus
 from robot.bus.servo_map import ServoMap
+from robot.config.bundled import gait_names, robot_names
 from robot.config.gait_file import load_gait
 from robot.config.robot_file import load_robot
 from robot.gait.engine import GaitEngine
@@ -47,6 +54,41 @@ def _walk(robot_name: str, seconds: float, *, balance: bool) -> tuple[float, flo
     return stats.duration_s / wall, physics / wall
 
 
+def _preset(robot_name: str, gait_name: str, seconds: float) -> dict[str, Any]:
+    from robot.run.run import execute
+    from robot.run.spec import RunOptions
+    from robot.run.walk import walk_imu, walk_spec, walk_summary
+
+    robot = load_robot(robot_name)
+    gait = load_gait(gait_name)
+    bus: Any = make_bus("sim", robot=robot)
+    spec = walk_spec(robot, gait.for_robot(robot), bus, gait=gait_name,
+                     imu=walk_imu(robot, bus), options=RunOptions(seconds=seconds))
+    r = walk_summary(spec, execute(spec), gait=gait_name)
+    return {"fell": r["fell"], "fell_at_s": r["fell_at_s"],
+            "speed_m_s": round(r["speed_m_s"], 3),
+            "heading_change_deg": round(r["heading_change_deg"], 1)}
+
+
+#: Presets for previs only, not for a robot to walk (their files say so: "paper" is the
+#: paper's equations verbatim, with no weight shift): walked and reported, not counted.
+PREVIS_ONLY = frozenset({"paper"})
+
+
+def run_presets(*, quick: bool = False) -> dict[str, Any]:
+    """Every bundled preset on every bundled robot: 60 s on the flat (5 s quick);
+    ``all_walked``: no preset meant for a robot fell."""
+    seconds = 5.0 if quick else 60.0
+    out: dict[str, Any] = {"seconds": seconds}
+    walked = True
+    for robot in robot_names():
+        for gait in gait_names():
+            row = out[f"{robot} {gait}"] = _preset(robot, gait, seconds)
+            walked = walked and (gait in PREVIS_ONLY or not row["fell"])
+    out["all_walked"] = walked
+    return out
+
+
 def run_sim_bench(*, quick: bool = False) -> dict[str, Any]:
     seconds, repeats = (1.0, 1) if quick else (20.0, 5)
     out: dict[str, Any] = {"walk_seconds": seconds, "repeats": repeats}
@@ -59,4 +101,5 @@ def run_sim_bench(*, quick: bool = False) -> dict[str, Any]:
                 "realtime_factor_min_max": [round(factors[0], 2), round(factors[-1], 2)],
                 "mj_step_share_of_loop": round(statistics.median(r[1] for r in runs), 3),
             }
+    out["presets"] = run_presets(quick=quick)
     return out

@@ -13,9 +13,11 @@ from functools import cached_property
 
 from robot.config.imu_file import ImuConfig
 from robot.config.joint_names import ARM_NAMES, JOINT_NAMES, LEG_NAMES
+from robot.config.servo_file import physics_for
 from robot.config.toml_io import Range, spec
 from robot.errors import ConfigError
 from robot.servo.models import MODELS, ServoModel
+from robot.servo.physics import ServoPhysics
 
 # Valid ranges of the numeric fields (checked at load; see robot/config/toml_io.py).
 #: bus.retries: extra attempts per transaction; more than 10 only hides a broken bus.
@@ -52,6 +54,9 @@ class BusConfig:
     timeout_ms: float = field(default=20.0, metadata=spec(TIMEOUT_MS))
     voltage: float | None = field(default=None, metadata=spec(VOLTAGE))
     gains: Mapping[str, int] = field(default_factory=dict)
+    #: a fitted servo model file (robot/config/servo_file.py) for every joint on the bus,
+    #: relative to the robot file; None: the bundled model of ``model``
+    servo_file: str | None = None
 
     @property
     def servo(self) -> ServoModel:
@@ -135,6 +140,8 @@ class JointConfig:
     model: str | None = None
     fixed_rad: float | None = field(default=None, metadata=spec(ANGLE))
     gains: Mapping[str, int] = field(default_factory=dict)
+    #: a fitted servo model file for this joint (overrides ``bus.servo_file``)
+    servo_file: str | None = None
 
 
 @dataclass(frozen=True)
@@ -152,6 +159,9 @@ class RobotConfig:
     #: "balance feedback") for this robot; a gait preset that names a gain itself, and
     #: --set, take precedence.
     balance: Mapping[str, float] = field(default_factory=dict)
+    #: Servo physics read from the model files the robot file names, per joint name
+    #: (joints without one use their model's bundled physics: ``servo_physics``).
+    physics: Mapping[str, ServoPhysics] = field(default_factory=dict)
 
     def joint(self, name: str) -> JointConfig:
         for j in self.joints:
@@ -181,6 +191,12 @@ class RobotConfig:
         """The gain registers ``joint``'s servo gets [register values]: its model's factory
         values, overridden by ``[bus.gains]``, overridden by ``[joints.<name>.gains]``."""
         return {**self.servo(joint).factory_gains, **self.bus.gains, **joint.gains}
+
+    def servo_physics(self, joint: JointConfig) -> ServoPhysics:
+        """The physics ``joint``'s servo is simulated with: the model file the robot file
+        names for it, else its model's bundled physics (robot/config/servo_file.py)."""
+        named = self.physics.get(joint.name)
+        return named if named is not None else physics_for(self.servo(joint).name)
 
     def voltage(self, joint: JointConfig) -> float:
         """The supply voltage ``joint``'s servo sees [V]: ``bus.voltage``, else its model's

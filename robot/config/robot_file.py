@@ -16,6 +16,7 @@ from robot.config.imu_file import parse_imu
 from robot.config.joint_names import ARM_NAMES, HIP_YAW_NAMES, JOINT_NAMES
 from robot.config.params import BALANCE, SPECS, canonical_name, check_value
 from robot.config.robot import ANGLE, BusConfig, Geometry, JointConfig, Masses, RobotConfig
+from robot.config.servo_file import servo_files
 from robot.config.toml_io import Range, TomlValue, build, number, read_toml, show, table
 from robot.errors import ConfigError
 from robot.servo.models import MODELS
@@ -107,6 +108,8 @@ def parse_robot(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> R
                               f"gait preset); valid: {gains}")
         balance[canon] = check_value(canon, v, where=where)
     robot = RobotConfig(name=name, bus=bus, geometry=geometry, mass=mass, joints=tuple(joints),
-                        rest=rest, source=src, imu=imu, balance=balance)
+                        rest=rest, source=src, imu=imu, balance=balance,
+                        physics=servo_files(src, bus.servo_file, [
+                            (j.name, j.servo_file, j.model or bus.model) for j in joints]))
     check_ticks(robot)
     return robot

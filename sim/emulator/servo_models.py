@@ -70,6 +70,10 @@ MODELS: dict[str, ServoModel] = {
     # XC430-W240 70); RAM initial values Velocity I Gain 1,920, Position D 0, Position P 460.
     "XC430-W150": ServoModel("XC430-W150", 1070, "dynamixel_x", 4096, _rpm(70), initial={
         "velocity_i_gain": 1920, "position_d_gain": 0, "position_p_gain": 460}),
+    # ROBOTIS e-Manual XL330-M288-T: Model Number 1200; 4096 pulses/rev; 103 rev/min at 5 V;
+    # RAM initial values Position D Gain 0, Position P Gain 400.
+    "XL330-M288": ServoModel("XL330-M288", 1200, "dynamixel_x", 4096, _rpm(103), initial={
+        "position_d_gain": 0, "position_p_gain": 400}),
     # ROBOTIS e-Manual AX-12A: Model Number 12; 0..1023 over 0..300 deg (0.29 deg);
     # 59 rev/min at 12 V.
     "AX-12A": ServoModel("AX-12A", 12, "dynamixel_p1", 1024, _rpm(59), 300.0),
@@ -82,6 +86,9 @@ MODELS: dict[str, ServoModel] = {
     # Feetech STS3215 (7.4 V): memory table Model(3-4) reads 777 (= 3 * 256 + 9); 4096
     # steps/rev (12-bit magnetic encoder, 0.088 deg/step); no-load 0.222 s/60 deg.
     "STS3215": ServoModel("STS3215", 777, "feetech_sts", 4096, _per_60deg(0.222)),
+    # Feetech STS3250 (12 V) datasheet: 4096 steps/rev; no-load 0.133 s/60 deg. Model 2825
+    # (= 11 * 256 + 9) as lerobot's Feetech table lists it.
+    "STS3250": ServoModel("STS3250", 2825, "feetech_sts", 4096, _per_60deg(0.133)),
     # Feetech STS3032 (6 V): 4096 steps/rev; no-load 0.1 s/60 deg. Model 1288 (= 5 * 256 +
     # 8) is the value the driver lists; no Feetech page here prints it.
     "STS3032": ServoModel("STS3032", 1288, "feetech_sts", 4096, _per_60deg(0.1)),

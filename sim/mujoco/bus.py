@@ -1,8 +1,12 @@
 """The MuJoCo mock bus: the real buses' interface, speaking ticks, with simulated servos.
 
-The servo model (goal → setpoint slewed at ``max_speed_rad_s`` → position actuator with its
-force limited to the stall torque; torque, load, thermal model, overload flag) lives in
-``sim.mujoco.servos``; its docstring states the discretisation. Like real servos after
+The servo model: goal → setpoint slewed at ``max_speed_rad_s`` (or the firmware's own goal
+slew, if slower) → the firmware's position law through a DC motor at the supply voltage,
+with gearbox friction and armature (``sim.mujoco.servo_law``: MuJoCo's actuator, joint
+damping, frictionloss and armature carry it; once per control tick the load-dependent
+friction and, where the firmware has them, the dead band and I term are updated). Goals,
+torque, load, the thermal model and the overload flag live in ``sim.mujoco.servos``; its
+docstring states the discretisation. Like real servos after
 power-up, torque starts off; the robot starts in the ``home`` keyframe (or ``pose``) with
 its goals at the present positions.
 
@@ -30,6 +34,7 @@ from robot.errors import BusError
 from sim.mujoco.mjcf import FOOT_GEOMS, build_mjcf, standing_qpos
 from sim.mujoco.observation import BodyObservation
 from sim.mujoco.run_watch import SimRunWatch
+from sim.mujoco.servo_law import ChainLaw, robot_servos
 from sim.mujoco.servos import AMBIENT_C, SimServos
 from sim.mujoco.view import OffscreenRenderer, SimClock, WallPacer, check_display, launch_viewer
 from sim.mujoco.world import PUSH_WINDOW_S, TimedForces
@@ -100,17 +105,19 @@ class MujocoBus(BodyObservation, Bus):
         names = self.robot.joint_names
         self._qadr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names])
         self._act = np.array([model.actuator(n).id for n in names])
-        self._kp = model.actuator_gainprm[self._act, 0].copy()
-        self._kv = -model.actuator_biasprm[self._act, 2].copy()
-        stall = np.array([self.robot.servo(j).stall_torque for j in self.robot.joints])
+        dof = np.array([model.jnt_dofadr[model.joint(n).id] for n in names])
+        law = robot_servos(self.robot)
+        self._law = ChainLaw(model, data, law, self._act, dof, self._qadr)
         self._ground = np.flatnonzero((model.geom_bodyid == 0)
                                       & ((model.geom_contype | model.geom_conaffinity) != 0))
         self._feet = tuple(model.geom(n).id for n in FOOT_GEOMS)
         self._torso = model.body("torso").id
         self._dt = float(model.opt.timestep)
         self._opt = model.opt
-        self._servos = SimServos(self.servo_map, stall, data.qpos[self._qadr],
-                                 latency_s=world.latency_s if world is not None else 0.0)
+        self._servos = SimServos(self.servo_map, law.force, data.qpos[self._qadr],
+                                 latency_s=world.latency_s if world is not None else 0.0,
+                                 max_speed=np.minimum(self.servo_map.max_speed,
+                                                      law.max_velocity))
         self._forces = TimedForces()
         self._model, self._data = model, data
         self._apply_torque()
@@ -214,7 +221,7 @@ class MujocoBus(BodyObservation, Bus):
         load = servos.load_percent(force).tolist()
         temperature = servos.temperature.tolist()
         overloaded = servos.overloaded().tolist()
-        volts = self.robot.bus.servo.nominal_voltage
+        volts = self.robot.voltage(self.robot.joints[0])   # one supply for the bus
         sids = self.servo_map.ids
         return {sids[i]: ServoState(id=sids[i], position=ticks[i], load=load[i],
                                     temperature=temperature[i], voltage=volts,
@@ -230,11 +237,7 @@ class MujocoBus(BodyObservation, Bus):
         return np.rint(sm.zero + sm.sign * q * sm.ticks_per_rad).astype(np.int64)
 
     def _apply_torque(self) -> None:
-        m = self.model
-        on = self._servos.enabled.astype(float)
-        m.actuator_gainprm[self._act, 0] = self._kp * on
-        m.actuator_biasprm[self._act, 1] = -self._kp * on
-        m.actuator_biasprm[self._act, 2] = -self._kv * on
+        self._law.set_torque(self._servos.enabled)
 
     def advance(self, deadline: float) -> None:
         """Step the physics until data.time == deadline [s] exactly (a last partial step
@@ -244,6 +247,7 @@ class MujocoBus(BodyObservation, Bus):
         t0 = float(d.time)
         if deadline <= t0:
             return
+        self._law.tick(self._servos.setpoint, deadline - t0)
         while (event := self._next_event()) < deadline - _TIME_EPS:
             if event > d.time:
                 self._physics_to(event)
@@ -285,7 +289,7 @@ class MujocoBus(BodyObservation, Bus):
         m, d, opt, servos, dt = self.model, self.data, self._opt, self._servos, self._dt
         while (remaining := stop - d.time) > _TIME_EPS:
             if not servos.settled:
-                d.ctrl[self._act] = servos.slew(min(dt, remaining))
+                d.ctrl[self._act] = self._law.ctrl(servos.slew(min(dt, remaining)))
             if remaining < dt:
                 opt.timestep = remaining
                 try:

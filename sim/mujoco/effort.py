@@ -3,7 +3,8 @@
 ``EffortMonitor`` is fed once per control tick (a streamer observer, after the physics):
 it integrates the absolute mechanical power of every actuated joint, |tau * qdot|, over the
 tick (the state at the end of the tick held over it) and averages the knees' load (|tau| /
-stall torque). Actuators are named after their joints (sim/mujoco/mjcf_robot.py).
+the simulated servo's stall torque, its actuator's force limit). Actuators are named after
+their joints (sim/mujoco/mjcf_robot.py).
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ class EffortMonitor:
         self._dof = np.array([model.jnt_dofadr[model.joint(n).id] for n in names])
         knees = [names.index(k) for k in KNEES if k in names]
         self._knees = np.array(knees, dtype=int)
-        stall = np.array([robot.servo(j).stall_torque for j in robot.joints])
+        # the simulated servos' stall torque at the robot's supply (sim/mujoco/servo_law.py)
+        stall = model.actuator_forcerange[self._act, 1]
         self._knee_stall = stall[self._knees] if knees else np.ones(0)
         self.energy_j = 0.0
         self._knee_sum = 0.0

@@ -8,10 +8,11 @@ sites, and a ``home`` keyframe: the robot's rest pose standing with the lowest s
 at z = 0. scene.xml includes robot.xml and adds floor, light, skybox and the tracking
 camera ``track``.
 
-Servo model (see ``sim.mujoco.mjcf_robot.servo_dynamics``): position actuator, kp = stall torque /
-0.05 rad, force limited to the stall torque, armature = reflected rotor inertia (back-EMF
-damping stall torque / no-load speed, times a 30 ms motor time constant), kv critically
-damps the unloaded servo. The speed limit is the bus's (setpoint slew).
+Servo model (``sim.mujoco.servo_law``, written per joint by
+``sim.mujoco.mjcf_robot.servo_attributes``): each actuator is the firmware's position law at
+the robot's gains through the motor at the supply voltage (kp, kv, force range = stall
+torque), each joint carries the back-EMF and gearbox damping, the gearbox friction and the
+rotor's armature, as with the torque on.
 """
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""The robot's MJCF element tree: defaults (servo model + joint groups), bodies, actuators.
+"""The robot's MJCF element tree: defaults (servo model + joint groups), bodies, actuators
+(each joint and actuator carries its own servo's parameters: ``servo_attributes``).
 
 Kinematic chain exactly as ``robot.config.robot.Geometry`` documents it; every body frame is
 parallel to the pelvis frame at zero pose, so every joint axis is +x, +y or +z of the
@@ -9,12 +10,11 @@ pelvis frame (right-hand rule). Link masses come from ``Masses`` as explicit
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from typing import NamedTuple
 
 from robot.config.extra_joints import UNIT, extra_axis, extra_layout, link_length
 from robot.config.joint_names import JOINT_NAMES
 from robot.config.robot import RobotConfig
-from robot.servo.models import ServoModel
+from sim.mujoco.servo_law import robot_servos
 
 AXES = {"hip_yaw": "0 0 1", "hip_roll": "1 0 0", "hip_pitch": "0 1 0", "knee": "0 1 0",
         "ankle_pitch": "0 1 0", "ankle_roll": "1 0 0", "shoulder_pitch": "0 1 0",
@@ -26,36 +26,22 @@ EXTRA_MASS_KG = 0.02
 #: Collision bits: floor/world 1, right leg 2, left leg 4. Legs collide with the floor and
 #: the other leg; torso and arms only with the floor (never parent-child, never same leg).
 CONTACT = {"r_leg": ("2", "5"), "l_leg": ("4", "3"), "body": ("0", "1")}
-#: Mechanical time constant of a small iron-core servo motor [s] (armature = b * tau).
-MOTOR_TAU_S = 0.03
 SERVO_DENSITY = 1500.0  # [kg/m^3], a servo's average density (sets link thickness)
 
 
-class ServoDynamics(NamedTuple):
-    """Position-actuator parameters for one servo model.
-
-    kp [N m/rad]; kv: velocity gain that critically damps the unloaded servo (its D term
-    plus back-EMF) [N m s/rad]; forcerange: stall torque [N m]; armature: reflected rotor
-    inertia (back-EMF damping stall_torque / no_load_speed times MOTOR_TAU_S) [kg m^2];
-    damping: gearbox viscous loss [N m s/rad]; frictionloss: gearbox friction [N m].
-    """
-
-    kp: float
-    kv: float
-    forcerange: float
-    armature: float
-    damping: float
-    frictionloss: float
-
-
-def servo_dynamics(servo: ServoModel) -> ServoDynamics:
-    """A hobby servo: stiff but compliant (stall torque at 0.05 rad error)."""
-    b = servo.stall_torque / servo.no_load_speed
-    kp = servo.stall_torque / 0.05
-    armature = b * MOTOR_TAU_S
-    return ServoDynamics(kp=kp, kv=2.0 * (kp * armature) ** 0.5, forcerange=servo.stall_torque,
-                         armature=armature, damping=0.05 * b,
-                         frictionloss=0.01 * servo.stall_torque)
+def servo_attributes(robot: RobotConfig) -> dict[str, tuple[dict[str, str], dict[str, str]]]:
+    """Per joint name: (joint attributes, actuator attributes) of its servo with the torque
+    on (``sim.mujoco.servo_law``: the firmware law at the robot's gains and voltage, the
+    motor's back-EMF and the gearbox as damping, frictionloss and armature)."""
+    a = robot_servos(robot)
+    out = {}
+    for i, j in enumerate(robot.joints):
+        joint = {"armature": num(a.armature[i]), "damping": num(a.viscous[i] + a.back_emf[i]),
+                 "frictionloss": num(a.coulomb[i] + a.stribeck[i])}
+        act = {"kp": num(a.kp[i]), "kv": num(a.kv[i]),
+               "forcerange": num(-a.force[i], a.force[i])}
+        out[j.name] = (joint, act)
+    return out
 
 
 def fmt(*values: float) -> str:
@@ -95,12 +81,7 @@ def add_defaults(root: ET.Element, robot: RobotConfig) -> None:
     for j in robot.joints:
         servo = robot.servo(j)
         if servo.name not in models:
-            dyn = servo_dynamics(servo)
-            model = models[servo.name] = _sub(top, "default", class_=servo.name)
-            _sub(model, "joint", armature=num(dyn.armature), damping=num(dyn.damping),
-                 frictionloss=num(dyn.frictionloss))
-            _sub(model, "position", kp=num(dyn.kp), kv=num(dyn.kv),
-                 forcerange=num(-dyn.forcerange, dyn.forcerange))
+            models[servo.name] = _sub(top, "default", class_=servo.name)
         cls = joint_class(robot, j.name)
         if cls in done:
             continue
@@ -238,9 +219,16 @@ def add_extra_joints(torso: ET.Element, robot: RobotConfig, s: float) -> None:
 
 
 def add_actuators_and_sensors(root: ET.Element, robot: RobotConfig) -> None:
+    """Position actuators named after their joints, with each servo's law; each joint gets
+    its servo's damping, frictionloss and armature (``servo_attributes``)."""
     act = _sub(root, "actuator")
+    servo = servo_attributes(robot)
+    for joint in root.iter("joint"):
+        if joint.get("name") in servo:   # the bodies' joints, not the defaults' templates
+            joint.attrib.update(servo[joint.attrib["name"]][0])
     for j in robot.joints:
-        _sub(act, "position", name=j.name, joint=j.name, class_=joint_class(robot, j.name))
+        _sub(act, "position", name=j.name, joint=j.name, class_=joint_class(robot, j.name),
+             **servo[j.name][1])
     sensors = _sub(root, "sensor")
     _sub(sensors, "gyro", name="imu_gyro", site="imu")
     _sub(sensors, "accelerometer", name="imu_accelerometer", site="imu")

@@ -49,15 +49,17 @@ class SimServos:
     """Servo state for one simulated chain (see the module docstring).
 
     servo_map: the robot's tick conversion and limits; stall: stall torque per joint
-    [N m]; q0: start position per joint [rad]; latency_s: goal latency [s].
+    [N m]; q0: start position per joint [rad]; latency_s: goal latency [s]; max_speed: the
+    setpoint slew per joint [rad/s] (default: the map's max_speed_rad_s).
     """
 
     def __init__(self, servo_map: ServoMap, stall: Floats, q0: Floats, *,
-                 latency_s: float = 0.0) -> None:
+                 latency_s: float = 0.0, max_speed: Floats | None = None) -> None:
         n = len(servo_map.ids)
         self.map = servo_map
         self.stall = np.asarray(stall, float)
         self.latency_s = latency_s
+        self.max_speed = servo_map.max_speed if max_speed is None else max_speed
         self.goal = np.array(q0, float)  # [rad]
         self.setpoint = self.goal.copy()  # [rad]
         self.enabled = np.zeros(n, dtype=bool)
@@ -126,7 +128,7 @@ class SimServos:
         """Move each setpoint toward its goal by at most max_speed * ``dt`` [s]; update
         ``settled``; return the setpoints [rad]."""
         if dt != self._vmax_dt:
-            self._vmax_dt, self._vmax = dt, self.map.max_speed * dt
+            self._vmax_dt, self._vmax = dt, self.max_speed * dt
         vmax = self._vmax
         error = self.goal - self.setpoint
         within = np.abs(error) <= vmax

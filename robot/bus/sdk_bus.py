@@ -175,7 +175,8 @@ class SdkBus(SdkRegisters, Bus):
             # firmware and return delay at its own table's addresses.
             table = TABLES[servo.family] if servo is not None else self.table
             found.append(ServoInfo(
-                id=sid, model=number, model_name=servo.name if servo else f"unknown({number})",
+                id=sid, model=servo.number if servo else number,
+                model_name=servo.name if servo else f"unknown({number})",
                 firmware=self.read_register(sid, self.firmware_register, table=table),
                 return_delay_us=self.read_register(sid, "return_delay_time",
                                                    table=table) * unit_us,

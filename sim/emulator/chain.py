@@ -57,10 +57,10 @@ from types import TracebackType
 from typing import Any
 
 from robot.config.robot import RobotConfig
-from sim.emulator.chain_specs import FACTORY_BAUD, FACTORY_ID, factory_servos, plan_chain
+from sim.emulator.chain_specs import FACTORY_BAUD, FACTORY_ID, factory_baud, factory_servos, plan_chain
 from sim.emulator.control_tables import BAUD_CODES, TABLES
 from sim.emulator.records import ChainSpec, EmulatorError, Packet
-from sim.emulator.servo_models import MODELS, PROTOCOL_FAMILY
+from sim.emulator.servo_models import MODELS
 from sim.emulator.servo_status import ERROR_BITS
 
 __all__ = ["ChainSpec", "Emulator", "EmulatorError", "Packet"]
@@ -80,7 +80,7 @@ class Emulator:
                  baud: int | None = None) -> None:
         choice = plan_chain(protocol, robot, ids=ids, model=model, baud=baud)
         self.protocol = protocol
-        self.family = PROTOCOL_FAMILY[protocol]
+        self.family = MODELS[choice.model].family     # the chain's table family
         self.model, self.baud, self.ids = choice.model, choice.baud, choice.ids
         self.spec = ChainSpec(protocol, choice.servos, seed)
         self._proc: subprocess.Popen[bytes] | None = None
@@ -101,7 +101,7 @@ class Emulator:
         if count < 1:
             raise EmulatorError(f"count: expected at least 1 servo, got {count}")
         emu = cls(protocol, ids=[FACTORY_ID] * count, model=model,
-                  baud=FACTORY_BAUD[protocol])
+                  baud=factory_baud(protocol, model))
         emu.spec = replace(emu.spec, plugged=(), servos=factory_servos(protocol, emu.spec.servos))
         return emu
 

@@ -11,11 +11,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from robot.config.robot import RobotConfig
-from sim.emulator.control_tables import BAUD_CODES
+from sim.emulator.control_tables import BAUD_CODES, TABLES
 from sim.emulator.lx_commands import BAUD as LX_BAUD
 from sim.emulator.records import EmulatorError
 from sim.emulator.servo import ServoSpec
-from sim.emulator.servo_models import MODELS, PROTOCOL_FAMILY
+from sim.emulator.servo_models import MODELS, PROTOCOL_FAMILIES, PROTOCOL_FAMILY
 
 DEFAULT_MODEL = {"dynamixel": "XL430-W250", "dynamixel1": "AX-12A", "feetech": "STS3215",
                  "lx": "LX-16A"}
@@ -65,14 +65,14 @@ def plan_chain(protocol: str, robot: RobotConfig | None, *, ids: Sequence[int] |
     if protocol not in PROTOCOL_FAMILY:
         raise EmulatorError(f"protocol: expected one of {', '.join(PROTOCOL_FAMILY)}, "
                             f"got {protocol!r}")
-    family = PROTOCOL_FAMILY[protocol]
     same_kind = robot is not None and robot.bus.kind == protocol
     model = model or (robot.bus.model if robot is not None and same_kind
                       else DEFAULT_MODEL[protocol])
-    if model not in MODELS or MODELS[model].family != family:
-        valid = [m for m, s in MODELS.items() if s.family == family]
+    if model not in MODELS or MODELS[model].family not in PROTOCOL_FAMILIES[protocol]:
+        valid = [m for m, s in MODELS.items() if s.family in PROTOCOL_FAMILIES[protocol]]
         raise EmulatorError(f"model: {model!r} is not a {protocol} servo; valid: "
                             f"{', '.join(valid)}")
+    family = MODELS[model].family              # one table family a chain (as the driver's bus)
     if ids is None:
         if robot is None:
             raise EmulatorError("Emulator needs a robot config or ids=[...]")
@@ -91,6 +91,20 @@ def plan_chain(protocol: str, robot: RobotConfig | None, *, ids: Sequence[int] |
 
 
 def factory_servos(protocol: str, servos: Sequence[ServoSpec]) -> tuple[ServoSpec, ...]:
-    """The same servos with the factory return delay (new out of the box)."""
-    delay = FACTORY_RETURN_DELAY[protocol]
-    return tuple(replace(s, return_delay=delay) for s in servos)
+    """The same servos with the factory return delay (new out of the box): the manual's
+    initial Return Delay Time of each one's table (LX: none)."""
+    def delay(model: str) -> int:
+        entry = TABLES.get(MODELS[model].layout, {}).get("return_delay_time")
+        return entry.initial or 0 if entry is not None else FACTORY_RETURN_DELAY[protocol]
+    return tuple(replace(s, return_delay=delay(s.model)) for s in servos)
+
+
+def factory_baud(protocol: str, model: str | None) -> int:
+    """The rate a new ``model`` servo (default: the protocol's) listens at [bit/s]: its
+    table's initial Baud Rate (an MX-28 on Protocol 1.0 ships at 57600 where an AX-12A
+    ships at 1 Mbps; the XL-320 at 1 Mbps where the X series ships at 57600)."""
+    m = MODELS[model or DEFAULT_MODEL[protocol]]
+    entry = TABLES.get(m.layout, {}).get("baud_rate")
+    if entry is None or entry.initial is None:
+        return FACTORY_BAUD[protocol]
+    return BAUD_CODES[m.family][entry.initial]

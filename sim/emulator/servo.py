@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from sim.emulator import servo_frame, servo_indirect, servo_motion, servo_write
 from sim.emulator.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, UNPRINTED, Entry
 from sim.emulator.servo_models import MODELS
-from sim.emulator.servo_state import WriteError
+from sim.emulator.servo_state import PROTOCOL_2, WriteError, byteorder
 from sim.emulator.servo_status import BUS_WATCHDOG, ERROR_BITS, RETURN_DELAY_UNIT_S
 
 #: The registers that hold a family's position limits (low, high).
@@ -28,6 +28,8 @@ POSITION_LIMITS: dict[str, tuple[str, str]] = {
     "dynamixel_x": ("min_position_limit", "max_position_limit"),
     "dynamixel_p1": ("cw_angle_limit", "ccw_angle_limit"),
     "feetech_sts": ("min_angle_limit", "max_angle_limit"),
+    "dynamixel_xl320": ("cw_angle_limit", "ccw_angle_limit"),
+    "feetech_scs": ("min_angle_limit", "max_angle_limit"),
 }
 
 
@@ -56,6 +58,7 @@ class EmulatedServo:
         self.spec = spec
         self.model = MODELS[spec.model]
         self.family = self.model.family
+        self.byteorder = byteorder(self.family)
         layout = self.model.layout                      # its control table's key
         self.table: dict[str, Entry] = TABLES[layout]
         self.mem = bytearray(max(r.address + r.size for r in self.table.values()))
@@ -93,19 +96,19 @@ class EmulatedServo:
         self._saved = bytes(self.mem[:self.eeprom_end])   # EEPROM as kept over power-off
         self._ram_at_power_on = bytes(self.mem[self.eeprom_end:])
         self.pending: tuple[int, bytes] | None = None     # a Reg Write waiting for Action
-        self._registered = {"dynamixel_x": "registered_instruction",
-                            "dynamixel_p1": "registered"}.get(self.family, "async_write_flag")
+        self._registered = {"dynamixel_x": "registered_instruction", "dynamixel_p1": "registered",
+                            "dynamixel_xl320": "registered"}.get(self.family, "async_write_flag")
         self._indirect = servo_indirect.indirect_map(self.table)   # X only
 
     def get(self, name: str) -> int:
         """Value of a register by name (signed where the Dynamixel table says so)."""
         start, end, signed, _ = self._slots[name]
-        return int.from_bytes(self.mem[start:end], "little", signed=signed)
+        return int.from_bytes(self.mem[start:end], self.byteorder, signed=signed)
 
     def set_raw(self, name: str, value: int) -> None:
         """Store a register by name, leaving the position model alone."""
         start, end, _, modulus = self._slots[name]
-        self.mem[start:end] = (value % modulus).to_bytes(end - start, "little")
+        self.mem[start:end] = (value % modulus).to_bytes(end - start, self.byteorder)
 
     def set(self, name: str, value: int) -> None:
         """Store a register by name without any check (the emulator's back door).
@@ -143,7 +146,7 @@ class EmulatedServo:
 
     @property
     def error_register(self) -> str:
-        return "hardware_error_status" if self.family == "dynamixel_x" else "status"
+        return "hardware_error_status" if "hardware_error_status" in self.table else "status"
 
     # ------------------------------------------------------------------ behaviour
     def hear(self, now: float) -> None:
@@ -191,8 +194,8 @@ class EmulatedServo:
         value = 0
         for name in self.conditions:
             value |= 1 << bits[name]
-        if self.family == "dynamixel_x":
-            # X series latch hardware errors until reboot and drop torque (shutdown).
+        if self.family in PROTOCOL_2:
+            # X series (and the XL-320) latch hardware errors until reboot and drop torque.
             value |= self.get("hardware_error_status")
             if value:
                 self.set("torque_enable", 0)
@@ -276,7 +279,7 @@ class EmulatedServo:
     def _keeps_eeprom(self) -> bool:
         """Whether an EEPROM write survives power-off: always on Dynamixel X; on Feetech
         STS only with the Lock flag (55) at 0 (1 = changes not saved, the factory value)."""
-        return self.family == "dynamixel_x" or self.get("lock") == 0
+        return self.family in PROTOCOL_2 or self.get("lock") == 0
 
     def power_off(self, now: float) -> None:
         """Unplugged: the horn stops where it is and torque is gone."""

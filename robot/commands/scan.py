@@ -50,7 +50,8 @@ def _row(info: ServoInfo, robot: RobotConfig,
     joint = robot.joint_by_id(info.id)
     return {"id": info.id, "model": info.model, "model_name": info.model_name,
             "firmware": info.firmware, "return_delay_us": info.return_delay_us,
-            "baud": info.baud, "joint": joint.name if joint else None, "gains": gains}
+            "baud": info.baud, "joint": joint.name if joint else None, "gains": gains,
+            "case": joint.case if joint else None}
 
 
 def run(args: argparse.Namespace) -> int:
@@ -90,6 +91,8 @@ def _print_table(rows: list[dict[str, object]], robot: RobotConfig, *, bus_name:
         model = f"{r['model_name']} ({r['model']})"
         delay = f"{r['return_delay_us']:.0f} µs" if r["return_delay_us"] is not None else "?"
         joint = r["joint"] or "(not in robot config)"
+        if r["case"]:
+            joint = f"{joint} (axis of dual case {r['case']})"
         print(f"{r['id']:>4}  {model:<18} {r['firmware'] or '?':>4} {delay:>8}  {joint}")
     print("\n".join(gains_text))
     seen = {r["id"] for r in rows}

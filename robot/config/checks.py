@@ -137,6 +137,29 @@ def check_joint_set(src: str, jtab: Mapping[str, TomlValue]) -> None:
                           f"{', '.join(ARM_NAMES)}, or none)")
 
 
+def check_cases(src: str, joints: list[JointConfig], bus: BusConfig) -> None:
+    """Dual-axis servos: every joint on one has a ``case``, each case holds exactly two
+    joints, both on a dual-axis model; no other joint names a case."""
+    members: dict[str, list[str]] = {}
+    for j in joints:
+        dual = MODELS[j.model or bus.model].axes == 2
+        jp = f"joints.{j.name}.case"
+        if dual and j.case is None:
+            raise ConfigError(f"{src}: {jp}: missing ({j.model or bus.model} is a dual-axis "
+                              "servo: name its case, the same word on the joint of its other "
+                              "axis)")
+        if j.case is not None and not dual:
+            raise ConfigError(f"{src}: {jp}: {j.model or bus.model} has one axis; case is for "
+                              "the dual-axis 2XL430-W250 / 2XC430-W250")
+        if j.case is not None:
+            members.setdefault(j.case, []).append(j.name)
+    for case, names in members.items():
+        if len(names) != 2:
+            raise ConfigError(f"{src}: joints.{names[0]}.case: case {case!r} holds "
+                              f"{len(names)} joint(s) ({', '.join(names)}); a dual-axis case "
+                              "has two axes: name it on exactly two joints")
+
+
 def check_joint_extras(src: str, jp: str, j: JointConfig, bus: BusConfig, *,
                        extra: bool) -> None:
     """``model`` is a servo of the bus's family; ``fixed_rad`` only on extra joints and

@@ -114,19 +114,29 @@ def find_servo(bus: SetupBus, robot: RobotConfig, *,
                progress: Callable[[str], None] = log.info) -> Found:
     """The one servo on ``bus`` (open; left at its original baud). SetupRefused when none,
     or more than one, answers."""
+    return find_servos(bus, robot, 1, progress=progress)[0]
+
+
+def find_servos(bus: SetupBus, robot: RobotConfig, count: int, *,
+                progress: Callable[[str], None] = log.info) -> list[Found]:
+    """The ``count`` servos on ``bus`` (one case: 1, or 2 for a dual-axis servo, which ships
+    at ids 1 and 2); left at its original baud. SetupRefused when none, or another number,
+    answers."""
     family = robot.bus.servo.family
     original = bus.baud
     try:
         bauds = [b for b in baud_order(family, robot.bus.baud) if _try_baud(bus, b)]
         skipped = sorted(set(BAUD_CODES.get(family, {}).values()) - set(bauds))
-        progress(f"looking for id {FACTORY_ID} at {', '.join(map(str, bauds))} baud"
+        factory_ids = list(range(FACTORY_ID, FACTORY_ID + count))
+        progress(f"looking for id {', '.join(map(str, factory_ids))} at "
+                 f"{', '.join(map(str, bauds))} baud"
                  + (f" ({', '.join(map(str, skipped))}: the SDK cannot set it)" if skipped
                     else ""))
         found: list[Found] = []
         for baud in bauds:
             bus.set_baud(baud)
-            ids = [FACTORY_ID] + ([i for i in robot.ids if i != FACTORY_ID]
-                                  if baud == robot.bus.baud else [])
+            ids = factory_ids + ([i for i in robot.ids if i not in factory_ids]
+                                 if baud == robot.bus.baud else [])
             found += _ping_all(bus, ids)
         if not found:
             for baud in bauds:
@@ -141,11 +151,15 @@ def find_servo(bus: SetupBus, robot: RobotConfig, *,
         raise SetupRefused(f"no servo answered on {bus.port_name} at any id "
                            f"({ALL_IDS.start}-{ALL_IDS.stop - 1}) and baud ({rates}); check "
                            "its power (the LED flashes at power-up), its cable and --port")
-    if len(found) > 1:
-        who = ", ".join(f"id {f.id} at {f.baud} baud" for f in found)
+    who = ", ".join(f"id {f.id} at {f.baud} baud" for f in found)
+    if count == 1 and len(found) > 1:
         raise SetupRefused(f"{len(found)} servos answer on {bus.port_name} ({who}); nothing "
                            "was written: connect only the servo to set up")
-    return found[0]
+    if count > 1 and (len(found) != count or len({(f.baud, f.model) for f in found}) != 1):
+        raise SetupRefused(f"{len(found)} servo(s) answer on {bus.port_name} ({who}); a "
+                           f"dual-axis case answers at {count} ids of one model and baud; "
+                           "nothing was written: connect only the case to set up")
+    return found
 
 
 def check_model(found: Found, robot: RobotConfig, joint: JointConfig) -> str | None:

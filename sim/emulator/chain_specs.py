@@ -82,17 +82,24 @@ def plan_chain(protocol: str, robot: RobotConfig | None, *, ids: Sequence[int] |
     if baud not in RATES[family]:
         raise EmulatorError(f"baud: {baud} is not a {protocol} rate; valid: {RATES[family]}")
     specs = []
+    cases: dict[str, int] = {}          # a dual-axis case's name -> its number (1, 2, ...)
     for sid in ids:
         joint = robot.joint_by_id(sid) if robot is not None and same_kind else None
         own = joint.model if joint is not None and joint.model else model  # mixed models
         zero, lo, hi = _limits(robot, sid, own)
-        specs.append(ServoSpec(sid, own, zero, lo, hi, baud))
+        case = cases.setdefault(joint.case, len(cases) + 1) if joint and joint.case else 0
+        specs.append(ServoSpec(sid, own, zero, lo, hi, baud, case=case))
     return ChainChoice(model, baud, tuple(ids), tuple(specs))
 
 
 def factory_servos(protocol: str, servos: Sequence[ServoSpec]) -> tuple[ServoSpec, ...]:
     """The same servos with the factory return delay (new out of the box): the manual's
-    initial Return Delay Time of each one's table (LX: none)."""
+    initial Return Delay Time of each one's table (LX: none). A dual-axis model
+    (2XL430-W250) is a case of two axes, at ids 1 and 2."""
+    servos = [replace(s, servo_id=s.servo_id + axis, case=n + 1) if MODELS[s.model].axes == 2
+              else s for n, s in enumerate(servos)
+              for axis in range(MODELS[s.model].axes)]
+
     def delay(model: str) -> int:
         entry = TABLES.get(MODELS[model].layout, {}).get("return_delay_time")
         return entry.initial or 0 if entry is not None else FACTORY_RETURN_DELAY[protocol]

@@ -49,6 +49,8 @@ class ServoSpec:
     max_ticks: int
     baud: int
     return_delay: int = 0
+    #: a dual-axis servo's case (its two axes share one number; 0: a one-axis servo)
+    case: int = 0
 
 
 class EmulatedServo:
@@ -99,6 +101,7 @@ class EmulatedServo:
         self._registered = {"dynamixel_x": "registered_instruction", "dynamixel_p1": "registered",
                             "dynamixel_xl320": "registered"}.get(self.family, "async_write_flag")
         self._indirect = servo_indirect.indirect_map(self.table)   # X only
+        self.partner: EmulatedServo | None = None   # the other axis of a dual-axis case
 
     def get(self, name: str) -> int:
         """Value of a register by name (signed where the Dynamixel table says so)."""
@@ -285,6 +288,13 @@ class EmulatedServo:
         """Unplugged: the horn stops where it is and torque is gone."""
         self.update(now)
         self.set("torque_enable", 0)
+
+    def follow(self, name: str, value: int) -> None:
+        """The other axis of this case was given ``name`` = ``value`` (a setting the case
+        shares): take it, in EEPROM too."""
+        self.set(name, value)
+        if self.table[name].address < self.eeprom_end and self._keeps_eeprom():
+            self._saved = bytes(self.mem[:self.eeprom_end])
 
     def power_on(self, now: float) -> None:
         """Plugged in again: EEPROM as saved, RAM at its power-on values, horn unmoved."""

@@ -14,7 +14,8 @@ class ServoModel:
     codes, error bits, watchdog); resolution: positions (0..resolution-1); span_deg: angle
     they cover [deg]; no_load_speed: at the nominal voltage [rad/s]; table: its control
     table's key in ``control_tables.TABLES`` when not the family's own; initial: the
-    model's own initial values where its manual differs from the family's table."""
+    model's own initial values where its manual differs from the family's table; axes: ids
+    one case answers at."""
 
     name: str
     number: int
@@ -24,6 +25,8 @@ class ServoModel:
     span_deg: float = 360.0
     table: str = ""
     initial: Mapping[str, int] = field(default_factory=dict)
+    #: motors (ids) in one case: 2 for the 2XL430-W250 / 2XC430-W250 (sim/emulator/dual_axis.py)
+    axes: int = 1
 
     @property
     def layout(self) -> str:

@@ -57,10 +57,10 @@ _MX106_1 = {"max_voltage_limit": 160}
 
 
 def _m(name: str, number: int, family: str, resolution: int, speed: float, *,
-       span: float = 360.0, table: str = "", initial: Mapping[str, int] | None = None
-       ) -> ServoModel:
+       span: float = 360.0, table: str = "", initial: Mapping[str, int] | None = None,
+       axes: int = 1) -> ServoModel:
     return ServoModel(name, number, family, resolution, speed, span, table,
-                      dict(initial or {}))
+                      dict(initial or {}), axes)
 
 
 MORE: dict[str, ServoModel] = {m.name: m for m in (
@@ -77,8 +77,9 @@ MORE: dict[str, ServoModel] = {m.name: m for m in (
                         ("XH430-W210", 1010, 50), ("XH430-V350", 1040, 31),
                         ("XH430-V210", 1050, 52), ("XM540-W270", 1120, 30),
                         ("XM540-W150", 1130, 53))),
-    _m("2XL430-W250", 1090, X, 4096, rpm(57), table="dynamixel_2xl", initial=_2XL),
-    _m("2XC430-W250", 1160, X, 4096, rpm(64), table="dynamixel_2xl", initial=_2XL),
+    # Two axes a case (2xl430-w250 page: "Each motor on 2XL430 has its own control table").
+    _m("2XL430-W250", 1090, X, 4096, rpm(57), table="dynamixel_2xl", initial=_2XL, axes=2),
+    _m("2XC430-W250", 1160, X, 4096, rpm(64), table="dynamixel_2xl", initial=_2XL, axes=2),
     _m("MX-28(2.0)", 30, X, 4096, rpm(55), table="dynamixel_mx2", initial=_MX28_2),
     _m("MX-64(2.0)", 311, X, 4096, rpm(63), table="dynamixel_xm", initial=_MX64_2),
     _m("MX-106(2.0)", 321, X, 4096, rpm(45), table="dynamixel_xm", initial=_MX64_2),

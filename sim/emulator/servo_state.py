@@ -59,6 +59,13 @@ class ServoState(Protocol):
 
     def hold(self) -> None: ...
 
+    @property
+    def partner(self) -> ServoState | None:
+        """The other axis of a dual-axis case (2XL430-W250), else None."""
+
+    def follow(self, name: str, value: int) -> None:
+        """Take a setting the other axis of the case was given (kept in EEPROM)."""
+
 
 #: Where a family has no rule of its own it behaves as its kin: the XL-320 as the AX
 #: (CW/CCW Angle Limits, Moving Speed in 0.111 rev/min, bit-10 directions), the Feetech SCS

@@ -61,6 +61,8 @@ STS_ENERGISING: dict[str, frozenset[Mode]] = {
     "goal_speed": frozenset({Mode.VELOCITY}), "goal_time": frozenset({Mode.PWM}),
 }
 STS_STEP_SIGN_BIT = 15
+#: A dual-axis case's settings both axes hold as one (sim/emulator/dual_axis.py).
+CASE_SHARED = frozenset({"baud_rate", "protocol_type"})
 
 
 def plan(servo: ServoState, address: int, data: bytes) -> tuple[WriteError, dict[str, int]]:
@@ -116,6 +118,9 @@ def check(servo: ServoState, name: str, value: int) -> WriteError:
     wd = servo.watchdog
     if wd is not None and name == wd.register and not wd.accepts(value):
         return WriteError.RANGE
+    partner = servo.partner
+    if name == "id" and partner is not None and value == partner.get("id"):
+        return WriteError.LIMIT     # 2XL430: both axes one id is a Data Limit Error
     if servo.watchdog_tripped and name in ("goal_position", "goal_velocity", "goal_pwm"):
         return WriteError.RANGE     # goals are read-only until the watchdog is cleared
     if servo.family == "dynamixel_x":
@@ -156,6 +161,8 @@ def apply(servo: ServoState, values: dict[str, int]) -> None:
             servo.hold()
             continue
         servo.set(name, v)
+        if name in CASE_SHARED and servo.partner is not None:
+            servo.partner.follow(name, v)     # one communication module: both axes
     mode = servo_modes.mode(servo)
     if mode is not mode_before:
         if mode is Mode.POSITION:

@@ -235,8 +235,9 @@ class SdkBus(SdkRegisters, Bus):
 
     def read_gains(self, servo_id: int, *, model: int | None = None) -> dict[str, int] | None:
         joint = self.robot.joint_by_id(servo_id) if self.robot else None
-        servo = (self.robot.servo(joint) if self.robot and joint else
-                 None if model is None else lookup((self.family, *self.families), model))
+        servo = self.robot.servo(joint) if self.robot and joint else None
+        if model is not None and (servo is None or servo.number != model):
+            servo = self.identify(servo_id, model)   # the servo found is not the file's
         return None if servo is None else gain_writer.read(self, servo_id, servo.gain_set)
 
     def write_goals(self, goals: Mapping[int, int]) -> None:

@@ -12,7 +12,7 @@ from robot.bus import health
 from robot.bus.base import ServoInfo
 from robot.bus.sdk_bus import SdkBus
 from robot.commands.common import HARDWARE_BUSES, add_bus_args, bus_from, id_list, one_line_errors
-from robot.config.bundled import DEFAULT_ROBOT, ROBOTS_DIR
+from robot.config.bundled import DEFAULT_ROBOT, ROBOTS_DIR, robot_names
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from robot.errors import BusError
@@ -42,6 +42,10 @@ def _robot(args: argparse.Namespace) -> RobotConfig:
         bundled = ROBOTS_DIR / f"biped18-{args.bus}.toml"
         if bundled.exists():
             return load_robot(bundled)
+        for name in robot_names():       # a bundled robot on that bus (dynamixel1: the AX's)
+            robot = load_robot(ROBOTS_DIR / f"{name}.toml")
+            if robot.bus.kind == args.bus:
+                return robot
     return load_robot(DEFAULT_ROBOT)
 
 

@@ -180,3 +180,13 @@ def test_factory_baud_is_each_models_table() -> None:
         assert driver_models.factory_baud(driver_models.MODELS[name]) == baud, name
         assert factory_baud(driver_models.kind_of(driver_models.MODELS[name].family),
                             name) == baud, name
+
+
+def test_docs_robots_md_lists_every_servo_once() -> None:
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "robots.md").read_text()
+    table = text.split("## Supported servos", 1)[1].split("\n\n", 3)[2]
+    names = [row.split("|")[1].strip() for row in table.splitlines()
+             if row.startswith("| ") and not row.startswith("| servo")]
+    assert sorted(names) == sorted(driver_models.MODELS)

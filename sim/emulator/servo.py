@@ -15,13 +15,14 @@ sync/bulk packet); :meth:`update` trips it (goal := present where the gap ran ou
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from sim.emulator import servo_frame, servo_indirect, servo_motion, servo_write
 from sim.emulator.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, UNPRINTED, Entry
 from sim.emulator.servo_models import MODELS
+from sim.emulator.servo_spec import ServoSpec
 from sim.emulator.servo_state import PROTOCOL_2, WriteError, byteorder
 from sim.emulator.servo_status import BUS_WATCHDOG, ERROR_BITS, RETURN_DELAY_UNIT_S
+
+__all__ = ["EmulatedServo", "ServoSpec"]
 
 #: The registers that hold a family's position limits (low, high).
 POSITION_LIMITS: dict[str, tuple[str, str]] = {
@@ -31,26 +32,6 @@ POSITION_LIMITS: dict[str, tuple[str, str]] = {
     "dynamixel_xl320": ("cw_angle_limit", "ccw_angle_limit"),
     "feetech_scs": ("min_angle_limit", "max_angle_limit"),
 }
-
-
-@dataclass(frozen=True)
-class ServoSpec:
-    """What the emulator needs to build one servo.
-
-    servo_id: bus id; model: key of ``servo_models.MODELS``; zero_ticks: initial present
-    position [ticks]; min_ticks/max_ticks: position limits [ticks]; baud: [bit/s];
-    return_delay: Return Delay Time register [raw steps] (0: a chain already set up).
-    """
-
-    servo_id: int
-    model: str
-    zero_ticks: int
-    min_ticks: int
-    max_ticks: int
-    baud: int
-    return_delay: int = 0
-    #: a dual-axis servo's case (its two axes share one number; 0: a one-axis servo)
-    case: int = 0
 
 
 class EmulatedServo:

@@ -31,7 +31,7 @@ from robot.loop.telemetry import Telemetry  # noqa: E402
 from robot.motion.layered import LayeredEngine  # noqa: E402
 from robot.motion.show import stream_sequence  # noqa: E402
 from robot.motion.takes import read_take  # noqa: E402
-from robot.panel.controller import LoopOptions, make_controller  # noqa: E402
+from robot.panel.controller import BusSpec, LoopOptions, make_controller  # noqa: E402
 from robot.panel.server import build_server, serve_in_thread  # noqa: E402
 from robot.panel.studio import Studio  # noqa: E402
 from robot.previs.bvh import write_bvh  # noqa: E402
@@ -83,7 +83,7 @@ def film(robot_path: Path, take_path: Path, out: Path) -> None:
 
 def panel(robot_path: Path, takes: Path, out: Path) -> None:
     robot = load_robot(str(robot_path))
-    controller = make_controller(robot, MujocoBus(robot, realtime=True),
+    controller = make_controller(robot, BusSpec("sim", options={"realtime": True}),
                                  load_gait("walk").params,
                                  options=LoopOptions(rate_hz=100.0, read_every=5),
                                  preset="walk")

@@ -17,10 +17,9 @@ from playwright.sync_api import sync_playwright
 from robot.config.bundled import DEFAULT_ROBOT
 from robot.config.gait_file import load_gait
 from robot.config.robot_file import load_robot
-from robot.panel.controller import LoopOptions, make_controller
+from robot.panel.controller import BusSpec, LoopOptions, make_controller
 from robot.panel.server import build_server, serve_in_thread
 from robot.panel.studio import Studio
-from sim.mujoco.bus import MujocoBus
 
 CHROMIUM = "/usr/bin/chromium"
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu"]
@@ -28,7 +27,7 @@ ARGS = ["--headless", "--no-sandbox", "--disable-gpu"]
 
 def main(out: Path) -> None:
     robot = load_robot(DEFAULT_ROBOT)
-    controller = make_controller(robot, MujocoBus(robot, realtime=True),
+    controller = make_controller(robot, BusSpec("sim", options={"realtime": True}),
                                  load_gait("walk").params,
                                  options=LoopOptions(rate_hz=100.0), preset="walk")
     tmp = Path(tempfile.mkdtemp())

@@ -19,10 +19,9 @@ from playwright.sync_api import Browser, sync_playwright
 from robot.config.bundled import DEFAULT_ROBOT
 from robot.config.gait_file import load_gait
 from robot.config.robot_file import load_robot
-from robot.panel.controller import LoopOptions, PanelController, make_controller
+from robot.panel.controller import BusSpec, LoopOptions, PanelController, make_controller
 from robot.panel.server import build_server, serve_in_thread
 from robot.panel.studio import Studio
-from sim.mujoco.bus import MujocoBus
 
 CHROMIUM = "/usr/bin/chromium"
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -40,7 +39,7 @@ def served_panel(*, studio_dir: Path | None = None) -> Iterator[tuple[PanelContr
     on a free port: (controller, base URL); emergency stop and shutdown at the end.
     studio_dir: also serve the studio (takes and keyframes under it)."""
     robot = load_robot(DEFAULT_ROBOT)
-    controller = make_controller(robot, MujocoBus(robot, realtime=True),
+    controller = make_controller(robot, BusSpec("sim", options={"realtime": True}),
                                  load_gait("walk").params,
                                  options=LoopOptions(rate_hz=100.0, read_every=5),
                                  preset="walk")

@@ -1,7 +1,7 @@
 """Measuring a show's audio sync in the panel (headless Chromium): a show take with a
 soundtrack (an arm show imported from a BVH, a tone), the panel serving it, and reads of
-the page's <audio> clock against the take's time (the engine's, read in this process just
-before and after each read of the page). Used by tests/test_panel_show.py (a short run, a
+the page's <audio> clock against the take's time (the engine's, asked of the panel's loop
+process just before and after each read of the page). Used by tests/test_panel_show.py (a short run, a
 loose bound that catches a broken follower) and docs/show_sync.py (the 30 s measurement)."""
 
 from __future__ import annotations
@@ -57,8 +57,8 @@ def measure(controller: PanelController, base: str, browser: Browser, seconds: f
     page.click("#play")
 
     def take_time() -> float | None:
-        streamer = controller.streamer
-        return streamer.engine.time if controller.running and streamer else None
+        s = controller.loop_state(max_age=0.0)      # asked of the loop process now
+        return s.get("engine_t") if s["running"] else None
     end = time.monotonic() + wait
     while not page.evaluate("showClock().playing") and time.monotonic() < end:
         time.sleep(0.05)
@@ -70,9 +70,11 @@ def measure(controller: PanelController, base: str, browser: Browser, seconds: f
         t1 = take_time()
         if t0 is None or t1 is None:
             break
-        if clock["playing"] and t1 - t0 <= 0.011:        # a read within a tick or two
+        # A read within a few ticks: the take's time is asked of the loop process (a
+        # round trip each), so the bracket is wider than a tick on a busy machine.
+        if clock["playing"] and t1 - t0 <= 0.03:
             errors.append(1000 * (clock["audio"] + OFFSET - (t0 + t1) / 2))
-        time.sleep(0.2)
+        time.sleep(0.1)
     span = (take_time() or first + seconds) - first
     page.close()
     return errors, span

@@ -248,13 +248,12 @@ def test_capture_by_hand_on_the_emulator(emu: Emulator, robot: RobotConfig, robo
 def test_panel_capture_on_the_emulator(emu: Emulator, robot: RobotConfig, robot_toml: Path,
                                        tmp_path: Path) -> None:
     """The panel's studio: release the right arm, the hand moves it, capture, save."""
-    from robot.bus.factory import make_bus
-    from robot.panel.controller import LoopOptions, make_controller
+    from robot.panel.controller import BusSpec, LoopOptions, make_controller
     from robot.panel.studio import Studio
 
     robot = load_robot(robot_toml)
-    bus = make_bus(emu.protocol, robot=robot, port=emu.port)
-    controller = make_controller(robot, bus, load_gait("walk").params,
+    controller = make_controller(robot, BusSpec(emu.protocol, port=emu.port),
+                                 load_gait("walk").params,
                                  options=LoopOptions(rate_hz=50.0))
     studio = Studio(controller, takes_dir=tmp_path / "t", keys_dir=tmp_path / "k")
     arm = ("r_shoulder_pitch", "r_shoulder_roll", "r_elbow")

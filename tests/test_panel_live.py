@@ -19,18 +19,17 @@ from websockets.sync.client import ClientConnection, connect
 from robot.config.bundled import DEFAULT_ROBOT
 from robot.config.gait_file import load_gait
 from robot.config.robot_file import load_robot
-from robot.panel.controller import LoopOptions, PanelController, make_controller
+from robot.panel.controller import BusSpec, LoopOptions, PanelController, make_controller
 from robot.panel.live import RATE_HZ, LiveHub
 from robot.panel.server import build_server, serve_in_thread
 from robot.panel.studio import Studio
-from sim.mujoco.bus import MujocoBus
 
 
 @pytest.fixture(scope="module")
 def served(tmp_path_factory: pytest.TempPathFactory
            ) -> Iterator[tuple[PanelController, int, LiveHub]]:
     robot = load_robot(DEFAULT_ROBOT)
-    controller = make_controller(robot, MujocoBus(robot, realtime=True),
+    controller = make_controller(robot, BusSpec("sim", options={"realtime": True}),
                                  load_gait("walk").params,
                                  options=LoopOptions(rate_hz=100.0, read_every=5))
     tmp = tmp_path_factory.mktemp("studio")

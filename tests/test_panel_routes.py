@@ -15,14 +15,13 @@ import pytest
 from robot.config.bundled import DEFAULT_ROBOT
 from robot.config.gait_file import load_gait
 from robot.config.robot_file import load_robot
-from robot.panel.controller import PanelController
+from robot.panel.controller import BusSpec, PanelController
 from robot.panel.guard import MAX_BODY, Guard
 from robot.panel.live import LiveHub
 from robot.panel.presets import PresetStore
 from robot.panel.routes import Handler, Request, Response, route_table
 from robot.panel.server import PanelServer, build_server, serve_in_thread
 from robot.panel.studio import Studio
-from sim.mujoco.bus import MujocoBus
 
 TOKEN = "r0ute-tok"
 EVIL = "http://evil.example"
@@ -60,7 +59,7 @@ def send(port: int, method: str, path: str, *, host: str | None = None, origin: 
 @pytest.fixture(scope="module")
 def controller(tmp_path_factory: pytest.TempPathFactory) -> Iterator[PanelController]:
     robot = load_robot(DEFAULT_ROBOT)
-    c = PanelController(robot, MujocoBus(robot), load_gait("walk").params,
+    c = PanelController(robot, BusSpec("sim"), load_gait("walk").params,
                         presets=PresetStore(tmp_path_factory.mktemp("presets")))
     yield c
     c.shutdown(timeout=2.0)

@@ -18,11 +18,10 @@ import pytest
 from robot.config.bundled import DEFAULT_ROBOT, GAITS_DIR
 from robot.config.gait_file import load_gait
 from robot.config.robot_file import load_robot
-from robot.panel.controller import LoopOptions, PanelController, make_controller
+from robot.panel.controller import BusSpec, LoopOptions, PanelController, make_controller
 from robot.panel.guard import MAX_BODY
 from robot.panel.presets import PresetStore
 from robot.panel.server import build_server, panel_url, serve_in_thread
-from sim.mujoco.bus import MujocoBus
 
 EVIL = "http://evil.example"
 READ_TIMEOUT_S = 1.5  # the served panel's; a stalled body must be answered after it
@@ -77,7 +76,7 @@ def served(tmp_path_factory: pytest.TempPathFactory
            ) -> Iterator[tuple[PanelController, int]]:
     """A panel on 127.0.0.1 whose loop is NOT running (so a start would show)."""
     robot = load_robot(DEFAULT_ROBOT)
-    controller = make_controller(robot, MujocoBus(robot, realtime=True),
+    controller = make_controller(robot, BusSpec("sim", options={"realtime": True}),
                                  load_gait("walk").params,
                                  options=LoopOptions(rate_hz=100.0, read_every=5),
                                  presets=PresetStore(tmp_path_factory.mktemp("presets")),
@@ -252,7 +251,7 @@ def test_other_methods_and_bad_request_lines_get_json(served: tuple[PanelControl
 def token_panel() -> Iterator[tuple[PanelController, int]]:
     """On every address, with a token, as for a phone."""
     robot = load_robot(DEFAULT_ROBOT)
-    controller = PanelController(robot, MujocoBus(robot), load_gait("walk").params)
+    controller = PanelController(robot, BusSpec("sim"), load_gait("walk").params)
     server = build_server(controller, host="0.0.0.0", port=0, token="s3cret-tok")
     serve_in_thread(server)
     yield controller, int(server.server_address[1])
@@ -289,3 +288,27 @@ def test_token_panel_answers_to_its_lan_url(token_panel: tuple[PanelController, 
     hostname = socket.gethostname()
     assert get(port, "/api/state", host=f"{hostname}:{port}", extra=auth).status == 200
     assert get(port, "/api/state", host=f"evil.example:{port}", extra=auth).status == 421
+
+
+def test_bearer_scheme_is_case_insensitive(token_panel: tuple[PanelController, int]) -> None:
+    """RFC 7235: the auth scheme is case-insensitive; the token itself is not."""
+    _, port = token_panel
+    for scheme in ("bearer", "BEARER", "BeArEr"):
+        assert get(port, "/api/state", extra=f"Authorization: {scheme} s3cret-tok\n"
+                   ).status == 200, scheme
+    assert get(port, "/api/state", extra="Authorization: bearer S3CRET-TOK\n").status == 401
+    assert get(port, "/api/state", extra="Authorization: Basic s3cret-tok\n").status == 401
+
+
+def test_number_with_thousands_of_digits_is_one_line_400(served: tuple[PanelController, int],
+                                                          capfd: pytest.CaptureFixture[str]
+                                                          ) -> None:
+    controller, port = served
+    before = controller.params
+    for body in (b'{"vM": ' + b"9" * 5000 + b"}", b'{"vM": ' + b"9" * 1000 + b"}",
+                 b'{"vM": 1e999}', b'{"vM": NaN}', b"[" * 60000):
+        r = post(port, "/api/params", body)
+        assert r.status == 400 and "\n" not in r.body["error"], (r.status, r.body)
+        assert "sys." not in r.body["error"]
+    assert controller.params == before
+    assert "Traceback" not in capfd.readouterr().err

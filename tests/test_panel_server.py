@@ -18,17 +18,15 @@ from typing import Any
 
 import pytest
 
-from robot.bus.factory import make_bus
 from robot.config.bundled import DEFAULT_ROBOT, GAITS_DIR, ROBOTS_DIR
 from robot.config.gait_file import load_gait
 from robot.config.params import GROUPS, SPECS
 from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
-from robot.panel.controller import LoopOptions, PanelController, make_controller
+from robot.panel.controller import BusSpec, LoopOptions, PanelController, make_controller
 from robot.panel.presets import PresetStore
 from robot.panel.server import build_server, serve_in_thread
 from sim.emulator.chain import Emulator
-from sim.mujoco.bus import MujocoBus
 
 Call = Callable[..., tuple[int, Any]]
 
@@ -50,7 +48,7 @@ def http(base: str, method: str, path: str, body: Any = None, *, raw: bytes | No
 def panel(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[PanelController, Call]]:
     robot = load_robot(DEFAULT_ROBOT)
     presets = PresetStore(tmp_path_factory.mktemp("presets"))
-    controller = make_controller(robot, MujocoBus(robot, realtime=True),
+    controller = make_controller(robot, BusSpec("sim", options={"realtime": True}),
                                  load_gait("walk").params,
                                  options=LoopOptions(rate_hz=100.0, read_every=5),
                                  presets=presets, preset="walk")
@@ -104,9 +102,7 @@ def test_post_params_reaches_the_running_loop(panel: tuple[PanelController, Call
     assert wait_for(lambda: controller.state()["state"] == "walking")
     status, d = call("POST", "/api/params", {"Slgt_R": 0.9, "turn": 0.1})
     assert status == 200 and d["params"]["Slgt_R"] == 0.9 and d["params"]["turn"] == 0.1
-    streamer = controller.streamer
-    assert streamer is not None
-    assert wait_for(lambda: streamer.engine.params.Slgt_R == 0.9, 1.0)
+    assert wait_for(lambda: controller.live_params().Slgt_R == 0.9, 1.0)
     assert call("GET", "/api/params")[1]["params"]["Slgt_R"] == 0.9
     call("POST", "/api/params", {"turn": 0.0})
 
@@ -123,16 +119,15 @@ def test_post_params_reaches_the_running_loop(panel: tuple[PanelController, Call
 def test_bad_values_refused_and_nothing_changes(panel: tuple[PanelController, Call],
                                                 body: dict[str, Any], needle: str) -> None:
     controller, call = panel
-    streamer = controller.streamer
-    assert streamer is not None and wait_for(lambda: streamer.engine.params == controller.params)
+    assert wait_for(lambda: controller.live_params() == controller.params)
     before = call("GET", "/api/params")[1]["params"]
-    engine_before = streamer.engine.params
+    engine_before = controller.live_params()
     status, d = call("POST", "/api/params", body)
     assert status == 400 and needle in d["error"]
     assert call("GET", "/api/params")[1]["params"] == before
     tick = controller.state()["tick"]
     assert wait_for(lambda: controller.state()["tick"] >= tick + 5)  # a few ticks later,
-    assert streamer.engine.params == engine_before                   # nothing pending landed
+    assert controller.live_params() == engine_before                   # nothing pending landed
 
 
 @pytest.mark.parametrize("raw", [b"not json", b"[1, 2]", b"\xff\xfe"])
@@ -212,15 +207,14 @@ def test_start_stop_estop_reset(panel: tuple[PanelController, Call]) -> None:
                     not controller.running)
     assert "ramp_out" in seen or "rest" in seen
     assert call("GET", "/api/state")[1]["state"] == "stopped"
-    assert call("POST", "/api/stop")[0] == 409
+    assert call("POST", "/api/stop") == (200, {"ok": True, "state": "stopped"})  # idempotent
     assert call("POST", "/api/start")[0] == 200
     assert wait_for(lambda: call("GET", "/api/state")[1]["state"] == "walking")
-    bus = controller.bus
-    assert isinstance(bus, MujocoBus) and (bus.model.actuator_gainprm[:, 0] > 0).all()
+    assert all(controller.state()["torque"])  # what the wire was told: torque on
     assert call("POST", "/api/estop")[0] == 200
     assert controller.wait(1.0)
     assert call("GET", "/api/state")[1]["state"] == "estop"
-    assert (bus.model.actuator_gainprm[:, 0] == 0).all()
+    assert not any(controller.state()["torque"])
     assert call("POST", "/api/estop")[0] == 200  # idle: still torque off, still 200
     assert call("POST", "/api/reset")[0] == 200
     assert call("POST", "/api/start")[0] == 200
@@ -228,7 +222,7 @@ def test_start_stop_estop_reset(panel: tuple[PanelController, Call]) -> None:
 
 def test_token_required_beyond_loopback() -> None:
     robot = load_robot(DEFAULT_ROBOT)
-    controller = PanelController(robot, MujocoBus(robot), load_gait("walk").params)
+    controller = PanelController(robot, BusSpec("sim"), load_gait("walk").params)
     with pytest.raises(ConfigError, match="token"):
         build_server(controller, host="0.0.0.0", port=0)
     server = build_server(controller, host="0.0.0.0", port=0, token="s3cret")
@@ -294,21 +288,20 @@ def test_idle_figure_shows_the_read_back_pose_without_writing(protocol: str,
     robot = load_robot(ROBOTS_DIR / f"biped18-{protocol}.toml")
     with Emulator(protocol, robot, seed=1) as emu:
         emu.set_register(4, "present_position", 2048 + 600)  # r_knee, sign +1, zero 2048
-        bus = make_bus(protocol, robot=robot, port=emu.port, timeout_ms=50.0)
-        controller = make_controller(robot, bus, load_gait("walk").params,
-                                     presets=PresetStore(tmp_path))
+        controller = make_controller(robot, BusSpec(protocol, port=emu.port,
+                                                    options={"timeout_ms": 50.0}),
+                                     load_gait("walk").params, presets=PresetStore(tmp_path))
         server = build_server(controller, port=0)
         _, base = serve_in_thread(server)
         try:
-            s = http(base, "GET", "/api/state")[1]
-            assert s["figure"]["present"] is None and emu.log() == []  # bus closed: no read
-            bus.open()
-            emu.log(clear=True)
+            emu.log(clear=True)                                # the bus is open: from here
             t0 = time.monotonic()
             states = [http(base, "GET", "/api/state")[1] for _ in range(30)]
             knee = robot.joint_names.index("r_knee")
-            s = states[-1]
-            assert not s["running"] and s["state"] == "idle"
+            assert wait_for(lambda: http(base, "GET", "/api/state")[1]["q_present"]
+                            is not None)
+            s = http(base, "GET", "/api/state")[1]
+            assert not s["running"] and s["state"] == "idle" and not states[-1]["running"]
             assert s["q_present"][knee] == pytest.approx(600 * 2 * 3.141592653589793 / 4096)
             assert s["figure"]["cmd"] is None
             assert set(s["figure"]["present"]["side"]) >= {"r_leg", "l_leg", "torso"}
@@ -325,3 +318,17 @@ def test_idle_figure_shows_the_read_back_pose_without_writing(protocol: str,
             server.shutdown()
             server.server_close()
             controller.shutdown()
+
+
+def test_a_start_may_be_the_first_thing_asked() -> None:
+    """No I/O in the constructor: the first request (here a start) starts the loop
+    process and the bus."""
+    robot = load_robot(DEFAULT_ROBOT)
+    controller = PanelController(robot, BusSpec("sim"), load_gait("walk").params)
+    assert controller.pid is None
+    try:
+        controller.start()
+        assert controller.pid is not None and controller.running
+    finally:
+        controller.emergency_stop()
+        assert controller.shutdown(timeout=5)["holding"] is False

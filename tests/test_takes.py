@@ -23,11 +23,10 @@ from robot.config.gait_file import load_gait
 from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.motion.takes import read_take
-from robot.panel.controller import LoopOptions, make_controller
+from robot.panel.controller import BusSpec, LoopOptions, make_controller
 from robot.panel.studio import Studio
 from robot.servo.models import MODELS
 from sim.emulator.chain import Emulator
-from sim.mujoco.bus import MujocoBus
 
 pytest_plugins = ("bus_harness",)
 TOL = 1e-6  # [rad]
@@ -56,7 +55,7 @@ def test_walk_record_then_play_reproduces_the_stream(tmp_path: Path,
 
 def test_panel_take_with_live_changes_replays_exactly(tmp_path: Path) -> None:
     robot = load_robot(DEFAULT_ROBOT)
-    controller = make_controller(robot, MujocoBus(robot), load_gait("walk").params,
+    controller = make_controller(robot, BusSpec("sim"), load_gait("walk").params,
                                  options=LoopOptions(rate_hz=100.0, read_every=5),
                                  preset="walk")
     studio = Studio(controller, takes_dir=tmp_path / "takes", keys_dir=tmp_path / "keys")
@@ -100,7 +99,7 @@ def test_panel_plays_a_take_and_refuses_the_sliders_meanwhile(tmp_path: Path) ->
     takes.mkdir()
     assert biped("walk", "--seconds", "1", "--rate", "100", "--set", "turn=0.1",
                  "--record", str(takes / "t1.take.jsonl")) == 0
-    controller = make_controller(robot, MujocoBus(robot, realtime=True),
+    controller = make_controller(robot, BusSpec("sim", options={"realtime": True}),
                                  load_gait("walk").params,
                                  options=LoopOptions(rate_hz=100.0, read_every=10))
     studio = Studio(controller, takes_dir=takes, keys_dir=tmp_path / "keys")
@@ -108,11 +107,10 @@ def test_panel_plays_a_take_and_refuses_the_sliders_meanwhile(tmp_path: Path) ->
         assert studio.takes() == ["t1"]
         studio.play("t1")
         assert studio.playing == "t1"
+        assert controller.live_params().turn == 0.1  # the take's own parameters
         with pytest.raises(Exception, match="take t1 is playing"):
             controller.set_params({"turn": 0.3})
         assert controller.wait(30) and studio.playing is None
-        streamer = controller.streamer
-        assert streamer is not None and streamer.engine.params.turn == 0.1
         with pytest.raises(Exception, match="not found; valid: t1"):
             studio.play("nope")
     finally:

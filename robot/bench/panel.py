@@ -3,8 +3,9 @@
 The panel walks the robot on the pty emulator (18 Dynamixels, the real SDK, wall clock)
 at 200 Hz, and N clients in another process watch it, either as the old page did
 (polling ``/api/state`` every 100 ms after each answer) or as the page does now (one
-WebSocket each on ``/api/live``). Reported per (mode, N): loop overruns in the window,
-period-error percentiles, and how many state snapshots the server made; never asserted.
+WebSocket each on ``/api/live``). Reported per (mode, N): the loop's overruns in the
+window (its own count), the gaps between goal packets at the wire (the emulator's log:
+the period the servos see), and how many state snapshots the server made; never asserted.
 
 ``python -m robot.bench.panel [--seconds S] [--clients 0,20,50]`` prints JSON; `biped bench
 --only panel` runs it too.
@@ -25,16 +26,15 @@ from typing import Any
 
 import numpy as np
 
-from robot.bus.factory import make_bus
 from robot.config.bundled import ROBOTS_DIR
 from robot.config.gait_file import load_gait
 from robot.config.robot_file import load_robot
-from robot.loop.streamer import Telemetry
-from robot.panel.controller import LoopOptions, make_controller
+from robot.panel.controller import BusSpec, LoopOptions, make_controller
 from robot.panel.server import build_server, serve_in_thread
 from robot.panel.studio import Studio
 
 POLL_S = 0.1  # the old page: the next poll 100 ms after each answer
+GOAL_ADDRESS = 116  # Dynamixel X Goal Position (e-Manual)
 
 
 def _client_main(mode: str, n: int, base: str, seconds: float) -> None:
@@ -72,24 +72,16 @@ def _window(mode: str, n: int, seconds: float) -> dict[str, Any]:
     from sim.emulator.chain import Emulator
 
     robot = load_robot(ROBOTS_DIR / "biped18-dynamixel.toml")
-    lateness: list[float] = []
-    overruns: list[int] = []
-    recording = threading.Event()
-
-    def observe(tel: Telemetry) -> None:
-        if recording.is_set():
-            lateness.append(tel.period_error_ms)
-            overruns.append(tel.overruns)
     with Emulator("dynamixel", robot) as emu, tempfile.TemporaryDirectory() as tmp:
-        bus = make_bus("dynamixel", robot=robot, port=emu.port, timeout_ms=50.0)
-        controller = make_controller(robot, bus, load_gait("walk").params,
-                                     options=LoopOptions(rate_hz=200.0, read_every=10))
+        controller = make_controller(
+            robot, BusSpec("dynamixel", port=emu.port, options={"timeout_ms": 50.0}),
+            load_gait("walk").params, options=LoopOptions(rate_hz=200.0, read_every=10))
         server = build_server(controller, port=0, studio=Studio(
             controller, takes_dir=Path(tmp) / "t", keys_dir=Path(tmp) / "k"))
         _, base = serve_in_thread(server)
         hub = server.hub
         try:
-            controller.start(observer=observe)
+            controller.start()
             end = time.monotonic() + 20
             while controller.state()["state"] != "walking" and time.monotonic() < end:
                 time.sleep(0.05)
@@ -99,10 +91,13 @@ def _window(mode: str, n: int, seconds: float) -> dict[str, Any]:
                     [sys.executable, "-m", "robot.bench.panel", "--client", mode, str(n),
                      base, str(seconds + 1.0)], stdout=subprocess.PIPE, text=True)
                 time.sleep(1.0)  # let them connect
-            frames0 = hub.frames
-            recording.set()
+            frames0, before = hub.frames, controller.loop_state(max_age=0.0)
+            t0 = time.monotonic()
+            emu.log(clear=True)
             time.sleep(seconds)
-            recording.clear()
+            after = controller.loop_state(max_age=0.0)
+            goals = [p.t for p in emu.log() if p.instruction == "sync_write"
+                     and p.address == GOAL_ADDRESS and p.t >= t0]
             frames = hub.frames - frames0
             received = 0
             if client is not None:
@@ -110,18 +105,15 @@ def _window(mode: str, n: int, seconds: float) -> dict[str, Any]:
                 received = json.loads(out.strip().splitlines()[-1])["received"]
             running = controller.running
         finally:
-            if controller.running:
-                controller.stop()
-                controller.wait(20)
             server.shutdown()
             server.server_close()
             controller.shutdown(timeout=10)
-    lat = np.asarray(lateness) if lateness else np.zeros(1)
-    return {"mode": mode, "clients": n, "seconds": seconds, "ticks": len(lateness),
-            "overruns": (overruns[-1] - overruns[0]) if overruns else 0,
-            "period_error_p50_ms": round(float(np.percentile(lat, 50)), 3),
-            "period_error_p99_ms": round(float(np.percentile(lat, 99)), 3),
-            "period_error_max_ms": round(float(lat.max()), 3),
+    gaps = np.diff(goals) * 1e3 if len(goals) > 1 else np.zeros(1)
+    return {"mode": mode, "clients": n, "seconds": seconds, "goals": len(goals),
+            "overruns": after["tel"].get("overruns", 0) - before["tel"].get("overruns", 0),
+            "goal_gap_p50_ms": round(float(np.percentile(gaps, 50)), 3),
+            "goal_gap_p99_ms": round(float(np.percentile(gaps, 99)), 3),
+            "goal_gap_max_ms": round(float(gaps.max()), 3),
             "received_by_clients": received, "live_snapshots": frames,
             "loop_still_running": running}
 

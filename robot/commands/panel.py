@@ -1,29 +1,32 @@
 """`biped panel`: the live puppeteering web panel (same options as `biped walk`).
 
-Starts the gait loop (on the sim bus paced to the wall clock) and serves the page and its
-JSON API. The first SIGINT/SIGTERM starts a safe stop (ramp out, rest, then torque off, or
-hold with ``--hold``); a second one stops at once with torque off. Either way the bus is
-closed before the process exits: 130 after SIGINT, 143 after SIGTERM, 2 for bad options.
+Starts the control loop in a process of its own (on the sim bus paced to the wall clock,
+or the servos) and serves the page and its JSON API from this one. The first
+SIGINT/SIGTERM starts a safe stop (ramp out, rest, then torque off, or hold with
+``--hold``); a second one stops at once with torque off; any later one is ignored. Either
+way the bus is closed before the process exits: 130 after SIGINT, 143 after SIGTERM
+(never killed by the signal), 2 for bad options, 1 when torque could not be confirmed
+off at the end (the last line says which servos).
 """
 
 from __future__ import annotations
 
 import argparse
 import logging
+import os
 import secrets
 import time
 from pathlib import Path
 from typing import Any
 
-from robot.commands.balance_args import feedback_factory, imu_for
 from robot.commands.common import add_set_arg, bus_from, params_from, robot_from
 from robot.commands.walk import add_walk_args
 from robot.errors import ConfigError
-from robot.panel.controller import LoopOptions, make_controller
+from robot.panel.controller import BusSpec, LoopOptions, PanelController
 from robot.panel.presets import PresetStore, user_presets_dir
 from robot.panel.server import build_server, is_loopback, panel_url, serve_in_thread
 from robot.panel.studio import Studio, user_data_dir
-from robot.run.signals import SignalLatch, stop_on_signals
+from robot.run.signals import stop_on_signals
 
 log = logging.getLogger(__name__)
 
@@ -61,8 +64,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
 
 
 class _Deferred:
-    """Signal target that only records: the main thread acts on it, because a handler
-    must not use the bus the main thread may be in the middle of using."""
+    """Signal target that only records: the main thread acts on it (a handler must not
+    wait on the loop process the main thread may be waiting on)."""
 
     def __init__(self) -> None:
         self.stop = False
@@ -73,6 +76,36 @@ class _Deferred:
 
     def emergency_stop(self, reason: str = "") -> None:
         self.stop = self.abort = True
+
+
+#: How much lower this process's CPU priority is than the loop process's (nice units).
+WEB_NICE = 5
+
+
+def _give_way() -> None:
+    """Lower this process's CPU priority below the loop process's (started already, it
+    keeps its own): on a busy machine the scheduler prefers the loop to the web side."""
+    try:
+        os.nice(WEB_NICE)
+    except OSError as e:
+        log.debug("could not lower the web side's priority: %s", e)
+
+
+def _farewell(report: dict[str, Any], *, aborted: bool) -> tuple[str, bool]:
+    """The last line, from what the loop told the wire; and whether torque is safe."""
+    failed = list(report.get("failed", []))
+    torque = report.get("torque", {})
+    on = sorted(i for i, v in torque.items() if v)
+    if not report:
+        return "torque untouched (the bus was never opened)", True
+    if report.get("holding") and not aborted and not failed:
+        return "torque left ON (holding)", True
+    if failed or on:
+        unsure = on or sorted(torque) or ["all"]
+        why = failed[0] if failed else "the bus did not confirm it"
+        return (f"torque NOT confirmed off on servos {', '.join(map(str, unsure))}: {why}; "
+                "a servo with a bus watchdog stops where it is, check the others", False)
+    return "torque off", True
 
 
 def run(args: argparse.Namespace) -> int:
@@ -86,25 +119,28 @@ def run(args: argparse.Namespace) -> int:
         token = secrets.token_urlsafe(18)
     presets = PresetStore(Path(args.presets_dir)) if args.presets_dir else PresetStore()
     options: dict[str, Any] = {"realtime": True, "view": args.view} if kind == "sim" else {}
-    bus = bus_from(args, robot, kind=kind, **options)
-    imu = imu_for(args, robot, bus)
-    controller = make_controller(
-        robot, bus, params,
+    bus_from(args, robot, kind=kind, **options)     # --bus / --baud refused here, one line
+    controller = PanelController(
+        robot, BusSpec(kind, port=args.port, baud=args.baud, options=options), params,
         options=LoopOptions(rate_hz=args.rate, read_every=args.read_every, hold=args.hold,
-                            feedback=feedback_factory(imu)),
+                            balance=not args.no_balance, imu_noise=args.imu_noise),
         presets=presets, preset=gait.name)
-    try:
-        studio_dir = Path(args.studio_dir) if args.studio_dir else user_data_dir()
-        studio = Studio(controller, takes_dir=studio_dir / "takes",
-                        keys_dir=studio_dir / "keyframes")
-        server = build_server(controller, host=args.host, port=args.http_port, token=token,
-                              studio=studio)
-    except OSError as e:
-        raise ConfigError(f"--http-port {args.http_port}: cannot serve on {args.host}: "
-                          f"{e.strerror or e}") from e
-    signals, latch = _Deferred(), SignalLatch()
-    with stop_on_signals(signals, latch):
+    studio_dir = Path(args.studio_dir) if args.studio_dir else user_data_dir()
+    studio = Studio(controller, takes_dir=studio_dir / "takes",
+                    keys_dir=studio_dir / "keyframes")
+    signals = _Deferred()
+    server = None
+    report: dict[str, Any] = {}
+    with stop_on_signals(signals) as latch:   # to the end: a signal is never an exception
         try:
+            controller.open()             # the loop process, the bus open: or one line
+            _give_way()
+            try:
+                server = build_server(controller, host=args.host, port=args.http_port,
+                                      token=token, studio=studio)
+            except OSError as e:
+                raise ConfigError(f"--http-port {args.http_port}: cannot serve on "
+                                  f"{args.host}: {e.strerror or e}") from e
             _, local = serve_in_thread(server)
             query = f"?token={token}" if token else ""
             url = panel_url(args.host, int(server.server_address[1]))
@@ -113,19 +149,20 @@ def run(args: argparse.Namespace) -> int:
                   f"{url}{query}{also}", flush=True)
             if token and not args.token:
                 print(f"biped panel: access token {token}", flush=True)
-            if not args.no_start:
+            if not args.no_start and not signals.stop:
                 controller.start()
-            while not signals.stop:
+            while not signals.stop and controller.loop.gone is None:
                 time.sleep(0.1)
+            if controller.loop.gone is not None:
+                log.error("%s", controller.loop.gone)
             end = "hold" if args.hold else "torque off"
             print(f"biped panel: stopping (ramp out, rest, {end}; again: torque off now)",
                   flush=True)
         finally:
-            controller.shutdown(abort=lambda: signals.abort)
-            server.shutdown()
-            server.server_close()
-            if imu is not None:
-                imu.close()
-    print("biped panel: stopped; torque " + ("left ON (holding)" if controller.holding and
-                                             not signals.abort else "off"), flush=True)
-    return latch.exit_code(None)
+            report = controller.shutdown(abort=lambda: signals.abort)  # first: a second
+            if server is not None:                                    # signal acts at once
+                server.shutdown()
+                server.server_close()
+        line, safe = _farewell(report, aborted=signals.abort)
+        print(f"biped panel: stopped; {line}", flush=True)
+    return latch.exit_code(None) if safe else 1

@@ -132,8 +132,9 @@ class Guard:
         if not self.token:
             return
         given = query_token
-        if authorization.startswith("Bearer "):
-            given = authorization[len("Bearer "):].strip()
+        scheme, _, credentials = authorization.strip().partition(" ")
+        if scheme.lower() == "bearer":       # auth schemes are case-insensitive (RFC 7235)
+            given = credentials.strip()
         if not hmac.compare_digest(given.encode(), self.token.encode()):
             raise Refused(401, "missing or wrong token; use Authorization: Bearer <token> "
                                "or ?token=<token>")

@@ -10,9 +10,10 @@ from __future__ import annotations
 
 import logging
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
+from typing import Protocol
 
-from robot.bus.base import Bus, ServoState
+from robot.bus.base import ServoState
 from robot.bus.servo_map import ServoMap
 from robot.errors import BipedError
 
@@ -22,11 +23,17 @@ log = logging.getLogger(__name__)
 IDLE_RATE_HZ = 5.0
 
 
+class StateReader(Protocol):
+    """What the idle pose reads through (a bus, or the bus lease outside any session)."""
+
+    def read_state(self, ids: Iterable[int]) -> dict[int, ServoState]: ...
+
+
 class IdlePose:
     """``poll()`` → ``(q_present [rad] in joint order, {servo_id: ServoState})`` or None
     (the last read failed). Not thread-safe: the caller holds its own lock."""
 
-    def __init__(self, bus: Bus, servo_map: ServoMap, *, rate_hz: float = IDLE_RATE_HZ,
+    def __init__(self, bus: StateReader, servo_map: ServoMap, *, rate_hz: float = IDLE_RATE_HZ,
                  clock: Callable[[], float] = time.monotonic) -> None:
         self.bus = bus
         self.map = servo_map

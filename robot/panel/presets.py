@@ -53,7 +53,7 @@ class PresetStore:
     def names(self) -> list[str]:
         own = {p.stem for p in self.presets_dir.glob("*.toml")} if self.presets_dir.is_dir() \
             else set()
-        return sorted({n for n in own if NAME_RE.match(n)} | set(gait_names()))
+        return sorted({n for n in own if NAME_RE.fullmatch(n)} | set(gait_names()))
 
     def path(self, name: object) -> Path:
         name = check_name(name)
@@ -92,7 +92,7 @@ class PresetStore:
 
 def check_name(name: object) -> str:
     """A preset name: letters, digits, '_' and '-', 1-48 characters, no path parts."""
-    if not isinstance(name, str) or not NAME_RE.match(name):
+    if not isinstance(name, str) or not NAME_RE.fullmatch(name):
         raise ConfigError(f"preset name {name!r}: use 1-48 letters, digits, '_' or '-' "
                           "(starting with a letter or digit)")
     return name

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import socket
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from http import HTTPStatus
@@ -36,13 +37,15 @@ STATIC = {"/": ("index.html", _HTML), "/index.html": ("index.html", _HTML),
 
 @dataclass(frozen=True)
 class Request:
-    """One admitted request: ``headers`` by lowercase name (the first of repeats)."""
+    """One admitted request: ``headers`` by lowercase name (the first of repeats);
+    ``received``: when it arrived (its connection was accepted) [s, time.monotonic]."""
 
     method: str
     path: str
     query: Mapping[str, list[str]] = field(default_factory=dict)
     headers: Mapping[str, str] = field(default_factory=dict)
     body: Body = field(default_factory=dict)
+    received: float = field(default_factory=time.monotonic)
 
 
 @dataclass(frozen=True)
@@ -91,11 +94,8 @@ def static_file(name: str) -> bytes:
 
 def live_snapshot(controller: PanelController, studio: Studio) -> dict[str, Any]:
     """What the WebSocket pushes: the state, the parameters in effect, the studio."""
-    streamer = controller.streamer
-    params = streamer.engine.params if controller.running and streamer is not None \
-        else controller.params
-    return {**controller.state(), "params": params.as_dict(), "preset": controller.preset,
-            "driver": controller.driver if controller.running else None,
+    return {**controller.state(), "params": controller.live_params().as_dict(),
+            "preset": controller.preset, "driver": controller.driver,
             "studio": studio.status()}
 
 
@@ -115,17 +115,17 @@ def _live(hub: LiveHub) -> Handler:
     return live
 
 
-def _action(controller: PanelController, act: Callable[[], object]) -> Handler:
+def _action(controller: PanelController, act: Callable[[Request], object]) -> Handler:
     """start / stop / estop / reset: run it, answer the state it left."""
-    def action(_: Request) -> Reply:
-        act()
+    def action(request: Request) -> Reply:
+        act(request)
         return ok({"ok": True, "state": controller.state()["state"]})
     return action
 
 
-def _studio(studio: Studio, act: Callable[[Body], Mapping[str, object]]) -> Handler:
+def _studio(studio: Studio, act: Callable[[Request], Mapping[str, object]]) -> Handler:
     """A studio action: its reply fields, with ok and the studio's status."""
-    return lambda r: ok({"ok": True, **act(r.body), "studio": studio.status()})
+    return lambda r: ok({"ok": True, **act(r), "studio": studio.status()})
 
 
 def _panel_routes(c: PanelController) -> dict[tuple[str, str], Handler]:
@@ -140,6 +140,11 @@ def _panel_routes(c: PanelController) -> dict[tuple[str, str], Handler]:
         saved = c.save_preset(r.body.get("name"), overwrite=r.body.get("overwrite") is True)
         return ok({"saved": saved, "presets": c.presets.names()})
 
+    def estop(r: Request) -> Reply:
+        """Answered once torque off has been sent; ``failed``: what the bus refused."""
+        failed = c.emergency_stop(received=r.received)
+        return ok({"ok": not failed, "state": "estop", "failed": failed})
+
     return {
         ("GET", "/api/state"): lambda _: ok(c.state()),
         ("GET", "/api/params"): lambda _: ok(c.describe()),
@@ -147,10 +152,10 @@ def _panel_routes(c: PanelController) -> dict[tuple[str, str], Handler]:
         ("POST", "/api/params"): set_params,
         ("POST", "/api/preset"): load_preset,
         ("POST", "/api/save"): save_preset,
-        ("POST", "/api/start"): _action(c, c.start),
-        ("POST", "/api/stop"): _action(c, c.stop),
-        ("POST", "/api/estop"): _action(c, c.emergency_stop),
-        ("POST", "/api/reset"): _action(c, c.reset_sim),
+        ("POST", "/api/start"): _action(c, lambda r: c.start(received=r.received)),
+        ("POST", "/api/stop"): _action(c, lambda r: c.stop()),
+        ("POST", "/api/estop"): estop,
+        ("POST", "/api/reset"): _action(c, lambda r: c.reset_sim(received=r.received)),
     }
 
 
@@ -195,15 +200,19 @@ def _studio_routes(s: Studio) -> dict[tuple[str, str], Handler]:
         ("GET", "/api/takes"): lambda _: ok({"takes": s.takes(), "dir": str(s.takes_dir)}),
         ("GET", "/api/sequences"): sequences,
         ("GET", "/api/show/audio"): audio,
-        ("POST", "/api/record"): _studio(s, lambda b: {"take": s.record(b.get("name"))}),
-        ("POST", "/api/play"): _studio(s, lambda b: s.play(b.get("name"))),
-        ("POST", "/api/pose/release"): _studio(s, lambda b: s.release(b.get("limb"))),
-        ("POST", "/api/pose/capture"): _studio(s, lambda b: s.capture(b.get("t"))),
+        ("POST", "/api/record"): _studio(s, lambda r: {
+            "take": s.record(r.body.get("name"), received=r.received)}),
+        ("POST", "/api/play"): _studio(s, lambda r: s.play(r.body.get("name"),
+                                                         received=r.received)),
+        ("POST", "/api/pose/release"): _studio(s, lambda r: s.release(
+            r.body.get("limb"), received=r.received)),
+        ("POST", "/api/pose/capture"): _studio(s, lambda r: s.capture(
+            r.body.get("t"), received=r.received)),
         ("POST", "/api/pose/clear"): _studio(s, lambda _: s.clear()),
-        ("POST", "/api/pose/save"): _studio(s, lambda b: {"saved": s.save(b.get("name")),
+        ("POST", "/api/pose/save"): _studio(s, lambda r: {"saved": s.save(r.body.get("name")),
                                                           "sequences": s.sequences()}),
-        ("POST", "/api/sequence/play"): _studio(
-            s, lambda b: s.play_sequence(b.get("name"), layer=b.get("layer") is True)),
+        ("POST", "/api/sequence/play"): _studio(s, lambda r: s.play_sequence(
+            r.body.get("name"), layer=r.body.get("layer") is True, received=r.received)),
     }
 
 

@@ -19,73 +19,89 @@ Endpoints (JSON in and out; errors are ``{"error": "..."}``, never an empty repl
        {"name"} | /api/sequence/play {"name", "layer": bool}: posing by hand (panel.studio)
 
 The endpoints are a table (``robot.panel.routes``); this module is the HTTP plumbing
-around it. Every request passes ``robot.panel.guard`` here, once, before its route is
-looked up (Host, Origin, token, JSON content type, body length), the WebSocket handshake
-too (browsers always send Origin on it). With a token, every /api request needs
-``Authorization: Bearer <token>`` or ``?token=<token>`` (401 otherwise; a browser's
-WebSocket can only send the query); the page and its assets are public (they hold no
-secret) and the page sends the token from its own URL with each API call. Serving beyond
-loopback requires a token.
+around it: the server (its connection caps and deadlines, robot.panel.admission) and one
+connection (robot.panel.handler). Every request passes ``robot.panel.guard`` there, once,
+before its route is looked up (Host, Origin, token, JSON content type, body length), the
+WebSocket handshake too (browsers always send Origin on it). With a token, every /api
+request needs ``Authorization: Bearer <token>`` or ``?token=<token>`` (401 otherwise; a
+browser's WebSocket can only send the query); the page and its assets are public (they
+hold no secret) and the page sends the token from its own URL with each API call.
+Serving beyond loopback requires a token.
 """
 
 from __future__ import annotations
 
-import json
 import logging
 import socket
 import sys
 import threading
-from dataclasses import replace
-from http import HTTPStatus
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+import time
+from http.server import ThreadingHTTPServer
 from typing import Any
-from urllib.parse import parse_qs, urlsplit
 
-from robot.errors import BipedError, ConfigError
-from robot.panel.controller import PanelController, PanelStateError
-from robot.panel.guard import WILDCARD, Guard, Refused, is_loopback, lan_address
+from robot.errors import ConfigError
+from robot.panel.admission import HEAD_TIMEOUT_S, Admission
+from robot.panel.controller import PanelController
+from robot.panel.guard import WILDCARD, Guard, is_loopback, lan_address
+from robot.panel.handler import Handler
 from robot.panel.live import LiveHub
-from robot.panel.presets import PresetExistsError
-from robot.panel.routes import (
-    Body,
-    Request,
-    Response,
-    Routes,
-    Upgrade,
-    dispatch,
-    json_response,
-    live_snapshot,
-    route_table,
-)
+from robot.panel.routes import Routes, live_snapshot, route_table
 from robot.panel.studio import Studio
 
 log = logging.getLogger(__name__)
 
-READ_TIMEOUT_S = 10.0  # a client that stalls mid-request is dropped after this
-HEADERS = {"Cache-Control": "no-store", "X-Content-Type-Options": "nosniff",
-           "Referrer-Policy": "no-referrer", "X-Frame-Options": "DENY",
-           "Content-Security-Policy": "default-src 'self'; img-src 'self' data:; "
-           "style-src 'self' 'unsafe-inline'; frame-ancestors 'none'; base-uri 'none'; "
-           "form-action 'none'"}
+READ_TIMEOUT_S = 10.0  # a body that stalls after its headers is answered 408 after this
 
 __all__ = ["PanelServer", "build_server", "is_loopback", "panel_url", "serve_in_thread"]
 
 
 class PanelServer(ThreadingHTTPServer):
     """The panel on one address: its guard, its route table, its live hub (closed with
-    the server), and how long a client may stall mid-request [s]."""
+    the server), its connection caps and deadlines (robot.panel.admission), and how long
+    a client may stall mid-body [s]. Every connection is stamped when it is accepted
+    (``Request.received``): the order of requests against an e-stop."""
 
     daemon_threads = True
+    request_queue_size = 128
 
     def __init__(self, address: tuple[str, int], *, guard: Guard, routes: Routes,
-                 hub: LiveHub, read_timeout_s: float = READ_TIMEOUT_S) -> None:
+                 hub: LiveHub, read_timeout_s: float = READ_TIMEOUT_S,
+                 head_timeout_s: float = HEAD_TIMEOUT_S,
+                 admission: Admission | None = None) -> None:
         self.guard = guard
         self.routes = routes
         self.hub = hub
         self.read_timeout_s = read_timeout_s
+        self.head_timeout_s = head_timeout_s
+        self.admission = admission or Admission()
         if ":" in address[0]:
             self.address_family = socket.AF_INET6
-        super().__init__(address, _Handler)
+        super().__init__(address, Handler)
+
+    def verify_request(self, request: Any, client_address: Any) -> bool:
+        """Over a cap: closed at once, no thread made for it."""
+        return self.admission.admit(str(client_address[0]))
+
+    def process_request(self, request: Any, client_address: Any) -> None:
+        received = time.monotonic()
+        thread = threading.Thread(target=self._serve_connection,
+                                  args=(request, client_address, received), daemon=True)
+        try:
+            thread.start()
+        except RuntimeError:           # no thread to be had: drop the connection
+            self.admission.leave(str(client_address[0]))
+            self.shutdown_request(request)
+
+    def _serve_connection(self, request: Any, client_address: Any, received: float) -> None:
+        counted = [True]  # until it becomes a WebSocket (the live hub counts those)
+        try:
+            Handler(request, client_address, self, received=received, counted=counted)
+        except Exception:
+            self.handle_error(request, client_address)
+        finally:
+            self.shutdown_request(request)
+            if counted[0]:
+                self.admission.leave(str(client_address[0]))
 
     def server_close(self) -> None:
         self.hub.close()
@@ -100,114 +116,16 @@ class PanelServer(ThreadingHTTPServer):
                 type(exc).__name__, exc)
 
 
-class _Handler(BaseHTTPRequestHandler):
-    """One connection: parse, admit (the guard), read the body, dispatch, answer."""
-
-    server: PanelServer
-    server_version = "biped-panel/1"
-    default_request_version = "HTTP/1.0"  # errors always get a status line and headers
-
-    def setup(self) -> None:
-        super().setup()
-        self.connection.settimeout(self.server.read_timeout_s)
-
-    def log_message(self, format: str, *args: Any) -> None:  # noqa: A002
-        log.debug("%s " + format, self.address_string(), *args)
-
-    def do_GET(self) -> None:
-        self._serve("GET")
-
-    def do_POST(self) -> None:
-        self._serve("POST")
-
-    def send_error(self, code: int, message: str | None = None,
-                   explain: str | None = None) -> None:
-        """The base class's errors (bad request line, unknown method...) as JSON."""
-        self.close_connection = True
-        self._answer(json_response(code, {"error": message or HTTPStatus(code).phrase}))
-
-    def _serve(self, method: str) -> None:
-        try:
-            request = self._admitted(method)
-            if method == "POST":
-                request = replace(request, body=self._body())
-            reply = dispatch(self.server.routes, request)
-            if isinstance(reply, Upgrade):
-                self.close_connection = True
-                reply.accept(self.connection, self.requestline, list(self.headers.items()))
-            else:
-                self._answer(reply)
-        except ConnectionError:
-            raise  # the client went away: nothing to answer (handle_error logs it)
-        except Exception as e:
-            self._answer(self._failure(method, e))
-
-    def _admitted(self, method: str) -> Request:
-        """The request, once the guard has let it through (else Refused)."""
-        url = urlsplit(self.path)
-        headers: dict[str, str] = {}
-        for k, v in self.headers.items():
-            headers.setdefault(k.lower(), v)
-        request = Request(method, url.path, parse_qs(url.query), headers)
-        self.server.guard.admit(method, request.path, request.query, headers,
-                                str(self.connection.getsockname()[0]))
-        return request
-
-    def _failure(self, method: str, e: Exception) -> Response:
-        """The JSON answer to what a request raised (closing the connection when the
-        rest of it cannot be trusted to be a request)."""
-        if isinstance(e, Refused):
-            self.close_connection = True  # an unread body must not be parsed as a request
-            return json_response(e.status, {"error": str(e)})
-        if isinstance(e, (PresetExistsError, PanelStateError)):
-            return json_response(HTTPStatus.CONFLICT, {"error": str(e)})
-        if isinstance(e, BipedError):
-            return json_response(HTTPStatus.BAD_REQUEST, {"error": str(e)})
-        self.close_connection = True
-        if isinstance(e, TimeoutError):
-            return json_response(HTTPStatus.REQUEST_TIMEOUT, {
-                "error": f"request body not received within {self.server.read_timeout_s:g} s"})
-        log.error("panel: %s %s failed: %s: %s", method, self.path, type(e).__name__, e,
-                  exc_info=log.isEnabledFor(logging.DEBUG))  # a bug: answer, keep serving
-        return json_response(HTTPStatus.INTERNAL_SERVER_ERROR,
-                             {"error": f"internal error: {type(e).__name__}: {e}"})
-
-    def _body(self) -> Body:
-        cl = self.headers.get_all("Content-Length")
-        n = self.server.guard.body_length(", ".join(cl) if cl else None,
-                                          self.headers.get("Transfer-Encoding"))
-        raw = self.rfile.read(n) if n else b""
-        if len(raw) < n:
-            raise Refused(HTTPStatus.BAD_REQUEST,
-                          f"request body ended after {len(raw)} of {n} bytes")
-        try:
-            body = json.loads(raw or b"{}")
-        except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as e:
-            raise ConfigError(f"request body is not JSON: {e}") from None
-        if not isinstance(body, dict):
-            raise ConfigError("request body must be a JSON object")
-        return body
-
-    def _answer(self, response: Response) -> None:
-        self.send_response(response.status)
-        self.send_header("Content-Type", response.content_type)
-        self.send_header("Content-Length", str(len(response.body)))
-        for k, v in {**HEADERS, **response.headers}.items():
-            self.send_header(k, v)
-        if self.close_connection:
-            self.send_header("Connection", "close")
-        self.end_headers()
-        if self.command != "HEAD":
-            self.wfile.write(response.body)
-
-
 def build_server(controller: PanelController, *, host: str = "127.0.0.1", port: int = 0,
                  token: str | None = None, read_timeout_s: float = READ_TIMEOUT_S,
+                 head_timeout_s: float = HEAD_TIMEOUT_S, admission: Admission | None = None,
                  studio: Studio | None = None) -> PanelServer:
     """A PanelServer bound to (host, port) (port 0: ephemeral) serving the panel for
     ``controller``. Call ``serve_forever()`` (e.g. in a thread) and ``shutdown()``, then
     ``server_close()`` (which also closes the WebSockets).
-    read_timeout_s: a client silent this long mid-request is answered 408 or dropped;
+    read_timeout_s: a body not received this long after its headers is answered 408;
+    head_timeout_s: a request line and headers not received this long after the accept
+    drop the connection; admission: the connection caps (robot.panel.admission);
     studio: takes and keyframes (default: in the user's data directory)."""
     if not is_loopback(host) and not token:
         raise ConfigError(f"--host {host}: serving beyond loopback needs a token (--token)")
@@ -215,7 +133,8 @@ def build_server(controller: PanelController, *, host: str = "127.0.0.1", port: 
     hub = LiveHub(lambda: live_snapshot(controller, room))
     return PanelServer((host, port), guard=Guard.for_bind(host, token=token),
                        routes=route_table(controller, room, hub), hub=hub,
-                       read_timeout_s=read_timeout_s)
+                       read_timeout_s=read_timeout_s, head_timeout_s=head_timeout_s,
+                       admission=admission)
 
 
 def serve_in_thread(server: ThreadingHTTPServer) -> tuple[threading.Thread, str]:
@@ -224,7 +143,8 @@ def serve_in_thread(server: ThreadingHTTPServer) -> tuple[threading.Thread, str]
     host, port = str(server.server_address[0]), int(server.server_address[1])
     if host in WILDCARD:
         host = "127.0.0.1" if host == "0.0.0.0" else "::1"
-    thread = threading.Thread(target=server.serve_forever, name="panel-http", daemon=True)
+    thread = threading.Thread(target=server.serve_forever, kwargs={"poll_interval": 0.1},
+                              name="panel-http", daemon=True)
     thread.start()
     return thread, base_url(host, port)
 

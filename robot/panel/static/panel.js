@@ -141,6 +141,7 @@ function drawView(canvas, cmd, present, horizontal) {
 }
 
 function row(k, v) { return "<tr><td>" + k + "</td><td>" + v + "</td></tr>"; }
+function esc(t) { const d = document.createElement("div"); d.textContent = t; return d.innerHTML; }
 
 function showState(s) {
   last = s;
@@ -158,7 +159,8 @@ function showState(s) {
       row("torso height", fmt(s.sim.torso_height_m, 3) + " m") +
       row("tilt", fmt(s.sim.tilt_deg, 1) + "°") + row("distance", fmt(s.sim.distance_m, 3) + " m");
   }
-  if (s.stop_reason) html += row("stop reason", s.stop_reason);
+  if (s.stop_reason) html += row("stop reason", esc(s.stop_reason));
+  if (s.fault) html += row("fault", "<b style='color:#ff4d4d'>" + esc(s.fault) + "</b>");
   $("loop").innerHTML = html;
   $("servos").tBodies[0].innerHTML = s.servos.map((v) => "<tr><td>" + v.id + "</td><td>" +
     v.joint + "</td><td>" + fmt(v.temperature, 1) + "</td><td>" + fmt(v.load, 1) + "</td><td>" +

@@ -97,7 +97,7 @@ def test_scan_calibrate_walk(variant: tuple[Variant, Path],
 
 #: The rate each model ships at (its manual's initial Baud Rate).
 FACTORY_BAUD = {"XL-320": 1_000_000, "SCS0009": 1_000_000, "XM430-W350": 57_600,
-                "XL330-M288": 57_600, "MX-28(2.0)": 57_600, "MX-64": 57_600,
+                "XL330-M288": 57_600, "MX-28(2.0)": 57_600, "MX-28": 57_600, "MX-64": 57_600,
                 "MX-106": 57_600, DUAL_MODEL: 57_600}
 
 

@@ -34,6 +34,7 @@ VARIANTS: dict[str, Variant] = {
     "dynamixel_xm": Variant("dynamixel", "biped18-dynamixel", "XM430-W350", (116, 4)),
     "dynamixel_xl330": Variant("dynamixel", "biped18-dynamixel", "XL330-M288", (116, 4)),
     "dynamixel_mx2": Variant("dynamixel", "biped18-dynamixel", "MX-28(2.0)", (116, 4)),
+    "dynamixel_mx28_1": Variant("dynamixel1", "biped18-dynamixel", "MX-28", (30, 2)),
     "dynamixel_mx64_1": Variant("dynamixel1", "biped18-dynamixel", "MX-64", (30, 2)),
     "dynamixel_mx106_1": Variant("dynamixel1", "biped18-dynamixel", "MX-106", (30, 2)),
     "dynamixel_2xl": Variant("dynamixel", "biped18-dynamixel", "XL430-W250", (116, 4),

@@ -18,6 +18,8 @@ from typing import Any
 import dynamixel_sdk as dxl
 import pytest
 import scservo_sdk as scs
+import sdk_link
+from sdk_link import ok
 from sdk_timeouts import allow_slow_replies
 
 from sim.emulator.chain import Emulator
@@ -50,12 +52,7 @@ def watchdog() -> Iterator[None]:
 
 def served(protocol: str) -> Iterator[tuple[Emulator, Any, Any]]:
     """Three servos (ids 1-3, 1 Mbps) and an open SDK port with its packet handler."""
-    sdk: Any = dxl if protocol == "dynamixel" else scs
-    with Emulator(protocol, ids=IDS, baud=BAUD) as emu:
-        port = sdk.PortHandler(emu.port)
-        assert port.openPort() and port.setBaudRate(BAUD)
-        yield emu, port, (dxl.PacketHandler(2.0) if sdk is dxl else scs.PacketHandler(0))
-        port.closePort()
+    yield from sdk_link.served(protocol, IDS, BAUD)
 
 
 @pytest.fixture
@@ -75,13 +72,6 @@ def until(cond: Callable[[], bool], seconds: float = 5.0) -> bool:
             return True
         time.sleep(0.02)
     return False
-
-
-def ok(result: tuple[Any, ...]) -> Any:
-    """The value of an SDK ``(value, comm, error)`` read that must succeed cleanly."""
-    value, comm, error = result
-    assert (comm, error) == (0, 0)
-    return value
 
 
 def signed32(v: int) -> int:

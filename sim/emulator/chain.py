@@ -111,8 +111,8 @@ class Emulator:
 
         The child is a fresh interpreter (``python -c``), not a ``multiprocessing`` spawn,
         so callers need no ``if __name__ == "__main__"`` guard; the control channel is a
-        socketpair wrapped in a ``multiprocessing`` Connection.
-        """
+        socketpair in a ``multiprocessing`` Connection. It runs in ``ROOT`` (``-c`` puts the
+        working directory first on sys.path, where another checkout's ``sim`` may be)."""
         if self._port is not None:
             return self._port
         parent_sock, child_sock = socket.socketpair()
@@ -122,7 +122,7 @@ class Emulator:
             p for p in (str(ROOT), env.get("PYTHONPATH", "")) if p)
         self._proc = subprocess.Popen(
             [sys.executable, "-c", f"import sim.emulator.server as s; s.child_main({fd})"],
-            pass_fds=[fd], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, env=env)
+            pass_fds=[fd], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, env=env, cwd=ROOT)
         child_sock.close()
         self._conn = Connection(parent_sock.detach())
         try:

@@ -198,7 +198,8 @@ class _ChainServer:
         if cmd == "registers_of":
             return self.advance(self.servos[args[0]]).snapshot()
         if cmd == "set_register":
-            return self.advance(self.by_id(args[0])).set(args[1], args[2])
+            s = self.advance(self.by_id(args[0]))
+            return getattr(s, "pin", s.set)(args[1], args[2])   # LX servos compute none
         raise EmulatorError(f"unknown emulator request {cmd!r}")
 
     def advance(self, s: EmulatedServo) -> EmulatedServo:

@@ -29,7 +29,9 @@ class ServoState(Protocol):
 
     mem: the control table's bytes; owner: per byte, 0 (no register) or the index + 1 of
     its register in ``regs``; regs: the table's (name, entry) rows in order; frozen: names
-    whose host writes are acknowledged but not stored (an injected fault).
+    whose host writes are acknowledged but not stored (an injected fault); table: name ->
+    entry; horn: where the horn actually is [ticks, before any offset, several turns in
+    the multi-turn modes]; step_target: where STS step mode takes it [ticks, actual].
     """
 
     family: str
@@ -40,6 +42,9 @@ class ServoState(Protocol):
     mem: bytearray
     owner: bytearray
     regs: list[tuple[str, Entry]]
+    table: dict[str, Entry]
+    horn: float
+    step_target: float
     eeprom_end: int
     watchdog: BusWatchdog | None
 
@@ -51,6 +56,8 @@ class ServoState(Protocol):
     def set(self, name: str, value: int) -> None: ...
 
     def set_raw(self, name: str, value: int) -> None: ...
+
+    def hold(self) -> None: ...
 
 
 def decode_value(family: str, address: int, data: bytes) -> int:

@@ -161,6 +161,21 @@ def test_out_of_reach_the_swing_ends_when_the_step_just_fits() -> None:
     assert corr.feet[0] == pytest.approx(0.04, rel=1e-6)
 
 
+def test_a_planned_step_is_kept_until_touchdown_and_a_new_swing_plans_afresh() -> None:
+    """A 2 cm error plans a step; the error falling back to 0 later in the same swing
+    does not withdraw it; the other foot's swing starts from its own plan (0 here)."""
+    push = LEVEL._replace(pitch_rate=0.02 / (H / W0))
+    state, corr = settle(LEARNT, push, STEP, SWING_R, 0.6)
+    planned = lip_grow(0.02, T_LEFT)
+    assert corr.feet[0] == pytest.approx(planned, rel=1e-5)
+    state, corr = settle(state, LEVEL, STEP, SWING_R, 0.3)
+    assert corr.feet[0] == pytest.approx(planned, rel=1e-5)
+    swing_l = GaitPhase(theta=2 * math.pi - 0.6, height=H, swinging=(False, True), inward=1.0)
+    state, corr = settle(state, LEVEL, STEP, swing_l, 0.3)
+    assert corr.feet[0] == pytest.approx(planned, rel=1e-5)   # the right foot stands on it
+    assert corr.feet[2:] == (0.0, 0.0)
+
+
 def test_no_foot_crosses_the_other() -> None:
     """Falling left, the swinging right foot may move left only by ``inward``."""
     gait = GaitPhase(height=H, swinging=(True, False), inward=0.004)

@@ -72,7 +72,8 @@ class StepState(NamedTuple):
     tempo: phase speed-up [-]; brace: 0 walking .. 1 braced (feet down, gait still);
     brace_s: how much longer to stay braced [s]; hold: 0 .. 1 the gait holds in double
     support; next_lift: the foot the gait lifts next (0 right, 1 left); rhythm: the
-    learned walk."""
+    learned walk; latch: the largest capture step (forward, left) [m] planned during the
+    current swing (a step once planned is not withdrawn before touchdown)."""
 
     feet: Quad = (0.0, 0.0, 0.0, 0.0)
     level: Quad = (0.0, 0.0, 0.0, 0.0)
@@ -82,6 +83,7 @@ class StepState(NamedTuple):
     hold: float = 0.0
     next_lift: int = 0
     rhythm: Rhythm = Rhythm()
+    latch: tuple[float, float] = (0.0, 0.0)
 
 
 def _clip(x: float, limit: float) -> float:
@@ -91,6 +93,11 @@ def _clip(x: float, limit: float) -> float:
 def _dead(x: float, band: float) -> float:
     """``x`` with ``band`` taken off its magnitude (0 inside the band)."""
     return x - band if x > band else x + band if x < -band else 0.0
+
+
+def _further(old: float, new: float) -> float:
+    """``new`` if it is further from 0 than ``old``, else ``old``."""
+    return new if abs(new) > abs(old) else old
 
 
 def _follow(x: float, want: float, dt: float, tau: float) -> float:
@@ -206,6 +213,13 @@ def step(state: StepState, values: tuple[float, float, float, float], p: GaitPar
     xi = capture_error(legs, g.height)
     next_lift = 1 if g.swinging[0] else 0 if g.swinging[1] else state.next_lift
     plan, want_tempo = capture_step(state.feet, xi, p, g, next_lift)
+    # Latch: late in a swing the torso's tilt no longer says where the body goes (the
+    # swinging foot already takes weight, the ankles push); the foot keeps the furthest
+    # step this swing planned. A new swing starts from its own plan.
+    latch = (0.0, 0.0) if next_lift != state.next_lift else state.latch
+    if any(g.swinging) and not all(g.swinging):
+        latch = (_further(latch[0], plan.dx), _further(latch[1], plan.dy))
+        plan = plan._replace(dx=latch[0], dy=latch[1])
     feet = _feet(state.feet, plan, p, g, dt)
     tempo = _follow(state.tempo, want_tempo, dt, TEMPO_TAU_S)
     size = math.hypot(*xi)
@@ -218,7 +232,7 @@ def step(state: StepState, values: tuple[float, float, float, float], p: GaitPar
     holding = not any(g.swinging) and 0.0 < p.bal_hold_xi < toward
     hold = _follow(state.hold, 1.0 if holding else 0.0, dt,
                    BRACE_IN_S if holding else BRACE_OUT_S)
-    return StepState(feet, level, tempo, brace, brace_s, hold, next_lift, rhythm), xi
+    return StepState(feet, level, tempo, brace, brace_s, hold, next_lift, rhythm, latch), xi
 
 
 def phase_rate(state: StepState, amplitude: float) -> float:

@@ -23,6 +23,10 @@ from robot.config.robot import RobotConfig
 from robot.gait import xmath as xm
 from robot.gait.expressions import FTAU_ALPHA, FTAU_DIVISOR, J_ERROR_STZ_IK, Phase
 from robot.gait.ik import REACH_TOL, SIDE_SIGN
+from robot.gait.rot_floats import apply_t as _apply_t
+from robot.gait.rot_floats import per_foot as _per_foot
+from robot.gait.rot_floats import rz_ry as _rz_ry
+from robot.gait.rot_floats import t_matmul as _t_matmul
 from robot.gait.targets import ARM_HANG, HAND_OUT, TURN_RANGE, BodyTrim
 from robot.gait.xmath import Rot
 
@@ -178,11 +182,13 @@ class TickKernel:
             c, sn = l_rot[4], -l_rot[1]
             lx_, ly_ = c * lx_ - sn * ly_, sn * lx_ + c * ly_
         right, l_leg = self._legs
-        q, ok = _leg_ik(right, _apply_t(pelvis, rx_ - px + trim.r_dx, ry_ - py + trim.r_dy, rz_),
-                        _t_matmul(pelvis, r_rot))
-        q_l, ok_l = _leg_ik(l_leg, _apply_t(pelvis, lx_ - px + trim.l_dx,
+        r_pel = _per_foot(pelvis, yaw, pitch, trim.roll, trim.r_roll, trim.r_pitch)
+        l_pel = _per_foot(pelvis, yaw, pitch, trim.roll, trim.l_roll, trim.l_pitch)
+        q, ok = _leg_ik(right, _apply_t(r_pel, rx_ - px + trim.r_dx, ry_ - py + trim.r_dy, rz_),
+                        _t_matmul(r_pel, r_rot))
+        q_l, ok_l = _leg_ik(l_leg, _apply_t(l_pel, lx_ - px + trim.l_dx,
                                              ly_ - py + trim.l_dy, lz_),
-                            _t_matmul(pelvis, l_rot))
+                            _t_matmul(l_pel, l_rot))
         q += q_l
         ok = ok & ok_l
         if self._arms:
@@ -205,30 +211,6 @@ class TickKernel:
         if layout is not None:   # 5-DoF legs, extra joints held at fixed angles
             q = [q[i] if i >= 0 else fixed for i, fixed in layout]
         return q, lift_r, lift_l, ok
-
-
-def _rz_ry(yaw: float, pitch: float) -> Rot:
-    """xmath.rz_ry on floats (a zero angle is common: cos(+-0) = 1, sin(+-0) = +-0)."""
-    cz, sz = (1.0, yaw) if yaw == 0.0 else (cos(yaw), sin(yaw))
-    cy, sy = (1.0, pitch) if pitch == 0.0 else (cos(pitch), sin(pitch))
-    return (cz * cy, -sz, cz * sy, sz * cy, cz, sz * sy, -sy, 0.0, cy)
-
-
-def _apply_t(r: Rot, x: float, y: float, z: float) -> tuple[float, float, float]:
-    """xmath.apply_t: r.T @ (x, y, z)."""
-    return (r[0] * x + r[3] * y + r[6] * z, r[1] * x + r[4] * y + r[7] * z,
-            r[2] * x + r[5] * y + r[8] * z)
-
-
-def _t_matmul(a: Rot, b: Rot) -> Rot:
-    """xmath.matmul(xmath.transpose(a), b)."""
-    a0, a3, a6, a1, a4, a7, a2, a5, a8 = a
-    b0, b1, b2, b3, b4, b5, b6, b7, b8 = b
-    return (
-        a0 * b0 + a1 * b3 + a2 * b6, a0 * b1 + a1 * b4 + a2 * b7, a0 * b2 + a1 * b5 + a2 * b8,
-        a3 * b0 + a4 * b3 + a5 * b6, a3 * b1 + a4 * b4 + a5 * b7, a3 * b2 + a4 * b5 + a5 * b8,
-        a6 * b0 + a7 * b3 + a8 * b6, a6 * b1 + a7 * b4 + a8 * b7, a6 * b2 + a7 * b5 + a8 * b8,
-    )
 
 
 def _leg_ik(k: _Leg, sole: tuple[float, float, float], f: Rot) -> tuple[list[float], bool]:

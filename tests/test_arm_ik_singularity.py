@@ -23,6 +23,7 @@ from hypothesis import strategies as st
 from test_engine import DT, cycles
 
 from robot.config.gait_file import Gait, load_gait
+from robot.config.joint_names import ARM_NAMES
 from robot.config.robot import Geometry, RobotConfig
 from robot.config.robot_file import load_robot
 from robot.gait import expressions as gait
@@ -398,7 +399,8 @@ def test_raising_the_hands_through_the_singularity_is_smooth(armed_robot: RobotC
         p = base.replace({"Ahgt_R": float(ahgt), "Ahgt_L": float(ahgt)})
         t = body_targets(gait.channels(gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0), p), p, g)
         q, _ = solve(t, robot)
-        arms = np.array(q[12:], dtype=float)
+        by_name = dict(zip(robot.joint_names, q, strict=True))
+        arms = np.array([by_name[n] for n in ARM_NAMES], dtype=float)
         for hand, qa in ((t.r_hand, arms[:3]), (t.l_hand, arms[3:])):
             target = np.array(hand, dtype=float)
             ok = bool(arm_ik(g, hand).reachable)

@@ -77,7 +77,7 @@ def test_zero_gain_balance_is_the_open_loop_walk(seconds: float) -> None:
     """With every balance gain 0 the corrections are exactly 0: the same simulation."""
     robot = load_robot("biped18-dynamixel")
     zero = {n: 0.0 for n in ("bal_ankle_pd", "bal_hip_pd", "bal_ankle_pp", "bal_lean_i",
-                             "bal_step_gain", "bal_brace_xi", "bal_tempo_gain", "bal_hold_xi",
+                             "bal_step_gain", "bal_brace_xi", "bal_swing_level", "bal_hold_xi",
                              "bal_heading_p", "bal_heading_i")}
     ends = []
     for with_stage in (False, True):

@@ -18,6 +18,7 @@ from robot.balance.law import (
 )
 from robot.balance.rhythm import BINS, Rhythm
 from robot.balance.stage import Balance
+from robot.balance.stepping import StepState
 from robot.config.gait_file import load_gait
 from robot.config.params import GaitParams
 from robot.config.robot_file import load_robot
@@ -32,7 +33,7 @@ STEP = GaitParams().replace({"bal_step_gain": 1.0, "bal_step_max": 0.08,
                              "bal_step_dead": 0.0, "bal_learn_cycles": 1.0,
                              "bal_ankle_pd": 0.0, "bal_lean_i": 0.0, "bal_heading_p": 0.0,
                              "bal_heading_i": 0.0})
-LEARNT = BalanceState(rhythm=Rhythm(cycles=LEARNED), started=True)
+LEARNT = BalanceState(stepping=StepState(rhythm=Rhythm(cycles=LEARNED)), started=True)
 
 
 def settle(state: BalanceState, tilt: Attitude, p: GaitParams, gait: GaitPhase,
@@ -86,7 +87,7 @@ def test_a_new_walk_is_learned_in_a_cycle_and_a_push_moves_it_little() -> None:
             for t in np.linspace(0, 2 * math.pi, 197)]
     assert max(errs) < 0.015 * 0.9
     learned = Rhythm(weight=(4.0,) * BINS, cycles=10.0)
-    state, _ = balance_step(BalanceState(rhythm=learned, started=True),
+    state, _ = balance_step(BalanceState(stepping=StepState(rhythm=learned), started=True),
                             LEVEL._replace(pitch_rate=2.0),
                             STEP.replace({"bal_learn_cycles": 4.0}), DT,
                             GaitPhase(theta=0.0, dtheta=dtheta, height=H))
@@ -95,6 +96,31 @@ def test_a_new_walk_is_learned_in_a_cycle_and_a_push_moves_it_little() -> None:
 
 
 # -- capture-point stepping -------------------------------------------------------------------
+# The test's gait: GaitParams' omega = 6 rad/s and delta_f = 0, so the right foot swings
+# over theta in (0, pi) and touches down at pi; at theta = pi - 0.6 it lands in 0.1 s.
+
+SWING_R = GaitPhase(theta=math.pi - 0.6, height=H, swinging=(True, False), inward=1.0)
+T_LEFT = 0.6 / 6.0                   # [s]
+
+
+def lip_grow(xi0: float, seconds: float, n: int = 20000) -> float:
+    """The capture point's offset from a fixed centre of pressure after ``seconds``:
+    xi' = omega0 xi integrated by the midpoint rule (not the law's closed form)."""
+    h, xi = seconds / n, xi0
+    for _ in range(n):
+        xi += h * W0 * (xi + 0.5 * h * W0 * xi)
+    return xi
+
+
+def lip_reach(xi0: float, room: float) -> float:
+    """The time [s] until the capture point, from ``xi0``, is ``room`` [m] out (bisection
+    on lip_grow)."""
+    lo, hi = 0.0, 1.0
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if abs(lip_grow(xi0, mid, 400)) < room else (lo, mid)
+    return 0.5 * (lo + hi)
+
 
 @pytest.mark.parametrize(("tilt", "want"), [
     (LEVEL._replace(pitch_rate=0.6), (H * 0.6 / W0, 0.0)),      # tipping forward: step forward
@@ -103,14 +129,51 @@ def test_a_new_walk_is_learned_in_a_cycle_and_a_push_moves_it_little() -> None:
     (LEVEL._replace(roll_rate=0.6), (0.0, -H * 0.6 / W0)),      # rolling right: step right
     (LEVEL._replace(roll=-0.04, roll_rate=-0.3), (0.0, H * (0.04 + 0.3 / W0))),
 ])
-def test_the_swinging_foot_goes_to_the_capture_point(tilt: Attitude,
-                                                     want: tuple[float, float]) -> None:
-    gait = GaitPhase(height=H, swinging=(True, False), inward=1.0)
-    state, corr = settle(LEARNT, tilt, STEP, gait, 1.0)
+def test_the_swinging_foot_lands_where_the_capture_point_will_be(
+        tilt: Attitude, want: tuple[float, float]) -> None:
+    """The swinging foot lands where the capture point will have drifted to by its
+    touchdown (0.1 s away), at the gait's own time when that is within reach."""
+    state, corr = settle(LEARNT, tilt, STEP, SWING_R, 1.0)
     rx, ry, lx, ly = corr.feet
     assert corr.capture == pytest.approx(want, abs=1e-12)
-    assert (rx, ry) == pytest.approx(want, rel=1e-5, abs=1e-12)
+    land = (lip_grow(want[0], T_LEFT), lip_grow(want[1], T_LEFT))
+    assert max(map(abs, land)) < 0.08                         # inside the reach
+    assert (rx, ry) == pytest.approx(land, rel=1e-5, abs=1e-9)
     assert (lx, ly) == (0.0, 0.0)           # the standing foot stays
+    assert corr.tempo == 0.0                # the gait's own rhythm
+
+
+def test_out_of_reach_the_swing_ends_when_the_step_just_fits() -> None:
+    """A 3 cm forward error would be 5.8 cm by the gait's touchdown, beyond a 4 cm reach:
+    the swing ends when the capture point is 4 cm out (lip_reach), the phase running
+    T_LEFT / that time faster, and the foot lands at the reach; with a shorter allowed
+    swing than that, the step comes at the shortest swing and is clipped."""
+    xi = 0.03
+    p = STEP.replace({"bal_step_max": 0.04, "bal_tempo_max": 2.0})
+    _, corr = settle(LEARNT, LEVEL._replace(pitch_rate=xi / (H / W0)), p, SWING_R, 1.0)
+    t = lip_reach(xi, 0.04)
+    assert 0.04 < t < T_LEFT / 2.0          # sooner, yet longer than the shortest swing
+    assert corr.tempo == pytest.approx(T_LEFT / t - 1.0, rel=1e-4)
+    assert corr.feet[0] == pytest.approx(0.04, rel=1e-6)
+    p = p.replace({"bal_tempo_max": 0.5})   # the shortest swing: T_LEFT / 1.5
+    _, corr = settle(LEARNT, LEVEL._replace(pitch_rate=xi / (H / W0)), p, SWING_R, 1.0)
+    assert corr.tempo == pytest.approx(0.5, rel=1e-6)
+    assert corr.feet[0] == pytest.approx(0.04, rel=1e-6)
+
+
+def test_a_planned_step_is_kept_until_touchdown_and_a_new_swing_plans_afresh() -> None:
+    """A 2 cm error plans a step; the error falling back to 0 later in the same swing
+    does not withdraw it; the other foot's swing starts from its own plan (0 here)."""
+    push = LEVEL._replace(pitch_rate=0.02 / (H / W0))
+    state, corr = settle(LEARNT, push, STEP, SWING_R, 0.6)
+    planned = lip_grow(0.02, T_LEFT)
+    assert corr.feet[0] == pytest.approx(planned, rel=1e-5)
+    state, corr = settle(state, LEVEL, STEP, SWING_R, 0.3)
+    assert corr.feet[0] == pytest.approx(planned, rel=1e-5)
+    swing_l = GaitPhase(theta=2 * math.pi - 0.6, height=H, swinging=(False, True), inward=1.0)
+    state, corr = settle(state, LEVEL, STEP, swing_l, 0.3)
+    assert corr.feet[0] == pytest.approx(planned, rel=1e-5)   # the right foot stands on it
+    assert corr.feet[2:] == (0.0, 0.0)
 
 
 def test_no_foot_crosses_the_other() -> None:
@@ -124,15 +187,14 @@ def test_no_foot_crosses_the_other() -> None:
 
 
 def test_steps_are_bounded_and_deadbanded() -> None:
-    gait = GaitPhase(height=H, swinging=(True, False), inward=1.0)
     p = STEP.replace({"bal_step_max": 0.03, "bal_step_dead": 0.01})
-    _, corr = settle(LEARNT, LEVEL._replace(pitch_rate=5.0), p, gait, 1.0)
+    _, corr = settle(LEARNT, LEVEL._replace(pitch_rate=5.0), p, SWING_R, 1.0)
     assert corr.feet[0] == pytest.approx(0.03)
     small = 0.009 / (H / W0)                 # a capture error of 9 mm: inside the band
-    _, corr = settle(LEARNT, LEVEL._replace(pitch_rate=small), p, gait, 1.0)
-    assert corr.feet[0] == 0.0
-    _, corr = settle(LEARNT, LEVEL._replace(pitch_rate=2 * small), p, gait, 1.0)
-    assert corr.feet[0] == pytest.approx(0.018 - 0.01, rel=1e-5)
+    _, corr = settle(LEARNT, LEVEL._replace(pitch_rate=small), p, SWING_R, 1.0)
+    assert corr.feet[0] == 0.0 and corr.tempo == 0.0
+    _, corr = settle(LEARNT, LEVEL._replace(pitch_rate=2 * small), p, SWING_R, 1.0)
+    assert corr.feet[0] == pytest.approx(lip_grow(0.018 - 0.01, T_LEFT), rel=1e-5)
 
 
 def test_nothing_steps_before_the_rhythm_is_learned() -> None:

@@ -74,9 +74,10 @@ def joint_field(joint: str, field: str, value: str) -> Callable[[str], str]:
 def test_bundled_robots_load() -> None:
     for path in sorted(ROBOTS_DIR.glob("*.toml")):
         r = load_robot(path)
-        n = 18 if r.has_arms else 12
+        n = (12 if r.has_hip_yaw else 10) + (6 if r.has_arms else 0)   # 5-DoF legs: no yaw
         assert len(r.joints) == n and len(set(r.ids)) == n
         assert r.source == str(path)
+    assert len(load_robot(ROBOTS_DIR / "robotis-mini.toml").ids) == 16   # its 16 XL-320s
 
 
 @pytest.mark.parametrize("edit, expect", [

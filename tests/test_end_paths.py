@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from bus_harness import TEST_TIMEOUT_MS, open_bus
+from waiting import wait_for
 
 import robot.cli as cli
 from robot.bus.base import Bus
@@ -288,3 +289,42 @@ def test_shield_in_another_thread_changes_nothing(command_latch: SignalLatch) ->
     worker.join()
     with shield():
         assert command_latch._shields == 1
+
+
+@pytest.mark.parametrize("protocol", ["dynamixel"])
+def test_second_signal_after_the_run_closed_turns_torque_off_at_the_end(
+        emu: Emulator, robot: RobotConfig, command_latch: SignalLatch) -> None:
+    """Item 4's last window: the run has closed holding, bus and all, and the command is
+    still printing when the second signal lands (it raises there: the first was the
+    loop's). At the command's end (``SignalLatch.settle``, which ``end`` runs before the
+    exit) the bus opens again and torque goes off, and the operator is told."""
+    run = posing(robot, open_bus(emu, robot), first_signal_at=5)
+    with run:
+        run.stream()
+    assert run.result.stats.holding and wire_torque(emu, robot) == {1}
+    with pytest.raises(Interrupted):
+        os.kill(os.getpid(), signal.SIGTERM)
+        wait_for(lambda: False, timeout_s=5)   # the handler raises at the next bytecode
+    try:
+        lines = command_latch.settle()
+    finally:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, (signal.SIGINT, signal.SIGTERM))
+    assert command_latch.emergency
+    assert wire_torque(emu, robot) == {0}
+    assert len(lines) == 1 and "second signal, SIGTERM" in lines[0] and "torque off" in lines[0]
+    assert not run.result.stats.holding
+
+
+def test_settle_without_a_second_signal_leaves_the_hold(command_latch: SignalLatch) -> None:
+    """One signal only: what was registered for a second one is not run."""
+    called: list[str] = []
+
+    def late() -> str:
+        called.append("late")
+        return "late"
+    command_latch.if_emergency_at_end(late)
+    command_latch.record(signal.SIGINT)
+    try:
+        assert command_latch.settle() == [] and called == []
+    finally:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, (signal.SIGINT, signal.SIGTERM))

@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from robot.config.gait_file import Gait, load_gait
+from robot.config.joint_names import LEG_NAMES
 from robot.config.params import SPECS, GaitParams
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
@@ -268,9 +269,10 @@ def test_start_pose_has_both_feet_flat_on_the_ground(any_robot: RobotConfig,
                                                      any_gait: Gait) -> None:
     p = any_gait.params
     g = any_robot.geometry
-    q = GaitEngine(any_robot, p).start_pose()
-    r_sole, r_rot = leg_fk_full(g, "r", tuple(q[0:6]))
-    l_sole, l_rot = leg_fk_full(g, "l", tuple(q[6:12]))
+    q = dict(zip(any_robot.joint_names, GaitEngine(any_robot, p).start_pose(), strict=True))
+    legs = [q.get(name, 0.0) for name in LEG_NAMES]   # 5-DoF legs: no hip yaw, at 0
+    r_sole, r_rot = leg_fk_full(g, "r", tuple(legs[0:6]))
+    l_sole, l_rot = leg_fk_full(g, "l", tuple(legs[6:12]))
     # Both feet have the same orientation, and it is the pelvis's inverse (level feet).
     assert np.allclose(r_rot, l_rot, atol=1e-9)
     level = np.array(r_rot).reshape(3, 3)       # pelvis → level frame = R_foot^T

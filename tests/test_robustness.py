@@ -43,10 +43,20 @@ def test_every_parameter_condition_is_inside_its_documented_range() -> None:
 def test_the_full_suite_has_every_group_of_the_issue() -> None:
     groups = {c.group for c in conditions(WALK)}
     assert groups == {"flat", "slope", "cross slope", "bumps", "push forward",
-                      "push backward", "push left", "push right", "params +/-20 %",
-                      "latency", "imu noise", "flat 60 s", "friction", "mass"}
-    pushes = [c for c in conditions(WALK) if c.group.startswith("push")]
-    assert len(pushes) == 16                               # 4 directions x 4 phases
+                      "push backward", "push left", "push right", "push 1.5 N*s",
+                      "params +/-20 %", "latency", "imu noise", "flat 60 s", "friction",
+                      "mass"}
+    hard = [c for c in conditions(WALK) if c.group == "push 1.5 N*s"]
+    pushes = [c for c in conditions(WALK) if c.group.startswith("push ")
+              and c not in hard]
+    assert len(pushes) == 16 and len(hard) == 16           # 4 directions x 4 phases each
+
+    def push(c: Condition) -> tuple[float, float, float]:
+        at, j = c.args[1].split(":")
+        jx, jy = j.split(",")
+        return float(at), float(jx), float(jy)
+    assert sorted(push(c) for c in hard) == sorted((t, 1.5 * jx, 1.5 * jy)
+                                                   for t, jx, jy in map(push, pushes))
     times = sorted({float(c.args[1].split(":")[0]) for c in pushes})
     assert times[0] == PUSH_AT_S
     assert times[-1] == pytest.approx(PUSH_AT_S + 0.75 * WALK.cycle_s, abs=1e-3)

@@ -54,7 +54,8 @@ params_st = st.fixed_dictionaries({
 phase_st = st.builds(gait.Phase, *[st.floats(-1e5, 1e5) for _ in range(5)])
 amp_st = st.one_of(st.just(1.0), st.just(0.0), st.floats(0.0, 1.0))
 trim_st = st.builds(BodyTrim, *[zero_or(st.floats(-lim, lim)) for lim in
-                                (0.3, 0.3, 0.05, 0.05, 0.05, 0.05, 0.5, 1.0, 1.0)])
+                                (0.3, 0.3, 0.05, 0.05, 0.05, 0.05, 0.5, 1.0, 1.0,
+                                 0.3, 0.3, 0.3, 0.3)])
 
 
 @pytest.mark.parametrize("name", ROBOTS)

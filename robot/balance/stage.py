@@ -109,8 +109,11 @@ class Balance:
         tilt = self._read_tilt()
         self.state, corr = balance_step(self.state, tilt, self.engine.live_params, dt,
                                         self.gait_phase())
+        r_roll, r_pitch, l_roll, l_pitch = corr.level
         self.engine.trim = BodyTrim(corr.pelvis_roll, corr.pelvis_pitch, *corr.feet,
-                                    turn=corr.turn, tempo=corr.tempo, land=corr.land)
+                                    turn=corr.turn, tempo=corr.tempo, land=corr.land,
+                                    r_roll=r_roll, r_pitch=r_pitch, l_roll=l_roll,
+                                    l_pitch=l_pitch)
         self.last = corr
         return apply(q, corr, self.slots)
 

@@ -108,10 +108,12 @@ SPECS: dict[str, ParamSpec] = {
                             "the lean a slope needs [rad/s per rad of tilt]", False),
     "bal_lean_max": ParamSpec(0.15, 0.0, 0.4, "rad", BALANCE, "largest learned lean (pelvis "
                               "roll/pitch relative to the feet)", False),
-    "bal_step_gain": ParamSpec(0.0, 0.0, 3.0, "-", BALANCE, "swinging foot placed this "
-                               "many times the capture-point error toward the fall (1: at "
-                               "the capture point; stepping)", False),
-    "bal_step_max": ParamSpec(0.04, 0.0, 0.08, "m", BALANCE, "largest step toward the fall",
+    "bal_step_gain": ParamSpec(0.0, 0.0, 3.0, "-", BALANCE, "capture step: the swinging "
+                               "foot lands this many times the capture-point error at "
+                               "touchdown further toward the fall (1: the capture step; 0: "
+                               "no stepping)", False),
+    "bal_step_max": ParamSpec(0.04, 0.0, 0.1, "m", BALANCE, "largest capture step (each "
+                              "way forward, back and outward) from the gait's own footstep",
                               False),
     "bal_step_dead": ParamSpec(0.02, 0.0, 0.1, "m", BALANCE, "capture-point error ignored "
                                "by stepping and tempo (the walk's own unlearned rocking)",
@@ -124,10 +126,13 @@ SPECS: dict[str, ParamSpec] = {
     "bal_hold_xi": ParamSpec(0.0, 0.0, 0.2, "m", BALANCE, "lateral capture-point error "
                              "toward the foot that lifts next at which the gait holds in "
                              "double support (a loaded foot is not lifted; 0: never)", False),
-    "bal_tempo_gain": ParamSpec(0.0, 0.0, 50.0, "1/m", BALANCE, "faster gait phase per m "
-                                "of capture-point error (an earlier next step)", False),
-    "bal_tempo_max": ParamSpec(0.5, 0.0, 2.0, "-", BALANCE, "largest phase speed-up "
-                               "(0.5: up to 1.5 x the gait's rate)", False),
+    "bal_tempo_max": ParamSpec(0.5, 0.0, 3.0, "-", BALANCE, "largest phase speed-up when a "
+                               "capture step is out of reach (0.5: the swing ends up to 1.5 x "
+                               "sooner)", False),
+    "bal_swing_level": ParamSpec(0.0, 0.0, 1.5, "-", BALANCE, "the swinging foot turned "
+                                 "with this share of the torso's unexpected tilt (1: kept "
+                                 "level with the ground, so it lands where the step was "
+                                 "planned)", False),
     "bal_learn_cycles": ParamSpec(4.0, 0.0, 50.0, "cycle", BALANCE, "time constant of the "
                                   "learned gait rhythm the stepping ignores (0: none)", False),
     "bal_heading_p": ParamSpec(0.5, 0.0, 2.0, "1/step", BALANCE, "turn trim per rad of "
@@ -207,8 +212,8 @@ class GaitParams:
     bal_brace_xi: float = SPECS["bal_brace_xi"].default
     bal_brace_s: float = SPECS["bal_brace_s"].default
     bal_hold_xi: float = SPECS["bal_hold_xi"].default
-    bal_tempo_gain: float = SPECS["bal_tempo_gain"].default
     bal_tempo_max: float = SPECS["bal_tempo_max"].default
+    bal_swing_level: float = SPECS["bal_swing_level"].default
     bal_learn_cycles: float = SPECS["bal_learn_cycles"].default
     bal_heading_p: float = SPECS["bal_heading_p"].default
     bal_heading_i: float = SPECS["bal_heading_i"].default

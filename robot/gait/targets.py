@@ -68,7 +68,11 @@ class BodyTrim(NamedTuple):
     gait's ``turn`` [rad/step], the sum kept inside its range; tempo: the gait phase runs
     (1 + tempo) times faster [-] (read by robot.gait.engine, not here); land: 0 walks, 1 keeps
     both feet on the ground (each foot's lift x (1 - land); BodyTargets still report the
-    gait's own lift, so a feedback loop knows which foot the gait swings).
+    gait's own lift, so a feedback loop knows which foot the gait swings); r_roll,
+    r_pitch, l_roll, l_pitch: the pelvis turned further relative to that foot only [rad]
+    (a swinging foot kept level with the ground while the torso tilts: position and sole
+    turn about the pelvis origin; the pelvis relative to the foot is then
+    rz_ry(yaw, pitch + foot pitch) rx(roll + foot roll)).
     """
 
     roll: float = 0.0
@@ -80,6 +84,10 @@ class BodyTrim(NamedTuple):
     turn: float = 0.0
     tempo: float = 0.0
     land: float = 0.0
+    r_roll: float = 0.0
+    r_pitch: float = 0.0
+    l_roll: float = 0.0
+    l_pitch: float = 0.0
 
 
 NO_TRIM = BodyTrim()
@@ -107,6 +115,15 @@ def stride_turn(turn: Num, half_w: Num, stride: Num) -> Num:
     d = turn * half_w
     lim = STRIDE_TURN_MAX * stride
     return lim if d > lim else -lim if d < -lim else d
+
+
+def _per_foot(pelvis_rot: Rot, yaw: Num, pitch: Num, roll: float, foot_roll: float,
+              foot_pitch: float) -> Rot:
+    """The pelvis's rotation relative to one foot: ``pelvis_rot`` unless the trim turns
+    that foot (BodyTrim.r_roll, ...)."""
+    if foot_roll == 0.0 and foot_pitch == 0.0:
+        return pelvis_rot
+    return xm.post_rx(xm.rz_ry(yaw, pitch + foot_pitch), roll + foot_roll)
 
 
 def scale(g: Geometry, p: GaitParams) -> float:
@@ -174,12 +191,14 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
         r_pos = _yawed(r_pos, yaw_r)
         l_pos = _yawed(l_pos, yaw_l)
 
-    r_sole = xm.apply_t(pelvis_rot, (r_pos[0] - px + trim.r_dx, r_pos[1] - py + trim.r_dy,
-                                     r_pos[2]))
-    l_sole = xm.apply_t(pelvis_rot, (l_pos[0] - px + trim.l_dx, l_pos[1] - py + trim.l_dy,
-                                     l_pos[2]))
-    r_foot = xm.matmul(xm.transpose(pelvis_rot), r_rot)
-    l_foot = xm.matmul(xm.transpose(pelvis_rot), l_rot)
+    r_pelvis = _per_foot(pelvis_rot, yaw, pitch, trim.roll, trim.r_roll, trim.r_pitch)
+    l_pelvis = _per_foot(pelvis_rot, yaw, pitch, trim.roll, trim.l_roll, trim.l_pitch)
+    r_sole = xm.apply_t(r_pelvis, (r_pos[0] - px + trim.r_dx, r_pos[1] - py + trim.r_dy,
+                                   r_pos[2]))
+    l_sole = xm.apply_t(l_pelvis, (l_pos[0] - px + trim.l_dx, l_pos[1] - py + trim.l_dy,
+                                   l_pos[2]))
+    r_foot = xm.matmul(xm.transpose(r_pelvis), r_rot)
+    l_foot = xm.matmul(xm.transpose(l_pelvis), l_rot)
 
     # Hands relative to the shoulders (torso frame).
     sa = s * p.arm_scale

@@ -23,10 +23,11 @@ from robot.config.robot import RobotConfig
 from robot.gait import xmath as xm
 from robot.gait.expressions import FTAU_ALPHA, FTAU_DIVISOR, J_ERROR_STZ_IK, Phase
 from robot.gait.ik import REACH_TOL, SIDE_SIGN, Reach
+from robot.gait.rot_floats import apply_t as _apply_t
+from robot.gait.rot_floats import per_foot as _per_foot
+from robot.gait.rot_floats import rz_ry as _rz_ry
+from robot.gait.rot_floats import t_matmul as _t_matmul
 from robot.gait.targets import ARM_HANG, HAND_OUT, TURN_RANGE, BodyTrim, stride_turn
-from robot.gait.tick_math import rz_ry as _rz_ry
-from robot.gait.tick_math import t_apply as _apply_t
-from robot.gait.tick_math import t_matmul as _t_matmul
 from robot.gait.vectorised import spans
 from robot.gait.xmath import Rot
 
@@ -193,11 +194,13 @@ class TickKernel:
             c, sn = l_rot[4], -l_rot[1]
             lx_, ly_ = c * lx_ - sn * ly_, sn * lx_ + c * ly_
         right, l_leg = self._legs
-        q, ok = _leg_ik(right, _apply_t(pelvis, rx_ - px + trim.r_dx, ry_ - py + trim.r_dy, rz_),
-                        _t_matmul(pelvis, r_rot))
-        q_l, ok_l = _leg_ik(l_leg, _apply_t(pelvis, lx_ - px + trim.l_dx,
+        r_pel = _per_foot(pelvis, yaw, pitch, trim.roll, trim.r_roll, trim.r_pitch)
+        l_pel = _per_foot(pelvis, yaw, pitch, trim.roll, trim.l_roll, trim.l_pitch)
+        q, ok = _leg_ik(right, _apply_t(r_pel, rx_ - px + trim.r_dx, ry_ - py + trim.r_dy, rz_),
+                        _t_matmul(r_pel, r_rot))
+        q_l, ok_l = _leg_ik(l_leg, _apply_t(l_pel, lx_ - px + trim.l_dx,
                                              ly_ - py + trim.l_dy, lz_),
-                            _t_matmul(pelvis, l_rot))
+                            _t_matmul(l_pel, l_rot))
         q += q_l
         ok = ok & ok_l
         if self._hands is not None:

@@ -31,8 +31,8 @@ LABELS: dict[str, str] = {
     "bal_lean_max": "Largest learned lean", "bal_step_gain": "Step toward a fall",
     "bal_step_max": "Largest catch step", "bal_step_dead": "Ignore small wobbles",
     "bal_brace_xi": "Put the foot down at", "bal_brace_s": "Stand still for",
-    "bal_hold_xi": "Don't lift a loaded foot", "bal_tempo_gain": "Hurry the next step",
-    "bal_tempo_max": "Largest hurry", "bal_learn_cycles": "Learn the walk's rhythm",
+    "bal_hold_xi": "Don't lift a loaded foot", "bal_tempo_max": "Largest hurry",
+    "bal_swing_level": "Keep the swinging foot level", "bal_learn_cycles": "Learn the walk's rhythm",
     "bal_heading_p": "Heading hold",
     "bal_heading_i": "Heading hold, slow part", "bal_turn_max": "Largest heading trim",
 }

@@ -23,13 +23,13 @@ from typing import Generic
 
 from robot.balance.stage import Balance, attitude_reader
 from robot.bus.servo_map import ServoMap
-from robot.errors import ConfigError
+from robot.errors import BusError, ConfigError
 from robot.gait.engine import GaitEngine
 from robot.loop.ending import finish
 from robot.loop.source import Feedback, SourceT
 from robot.loop.streamer import Streamer
 from robot.loop.telemetry import LoopStats, Telemetry
-from robot.run.result import RunResult
+from robot.run.result import RunResult, torque_words
 from robot.run.signals import SignalLatch, installed, shield, stop_on_signals
 from robot.run.spec import RunSpec, RunWatch, WatchedBus
 
@@ -154,6 +154,8 @@ class Run(Generic[SourceT]):
         record_error = self._close()
         if self._stats is None:
             return
+        if self._stats.holding and self.spec.options.close_bus and self.latch is installed():
+            self.latch.if_emergency_at_end(self._release_late)
         metrics = (dict(self.watch.summary(self.spec.options.seconds))
                    if self.watch is not None else None)
         code = self.latch.exit_code(self._stats) or (1 if record_error else 0)
@@ -174,6 +176,26 @@ class Run(Generic[SourceT]):
         stats.stop_reason = (f"emergency stop (second signal, "
                              f"{signal.Signals(self.latch.last).name}) after it ended holding")
         log.warning("torque off: a second signal came after the run ended holding")
+
+    def _release_late(self) -> str | None:
+        """A second signal came after the run closed holding (the command was still
+        finishing): open the bus again and turn torque off; what to tell the operator."""
+        stats = self._stats
+        if stats is None or not stats.holding:
+            return None
+        assert self.latch.last is not None
+        bus, name = self.spec.bus, signal.Signals(self.latch.last).name
+        try:
+            bus.open()
+            stats.torque = finish(bus, self.spec.robot.ids, torque_off=True, bus_dead=False,
+                                  failsafe=False)
+        except BusError as e:
+            log.error("a second signal after the run ended holding: %s", e)
+            stats.torque = "unknown"
+        finally:
+            bus.close(torque_off=True)
+        stats.holding, stats.estop = False, True
+        return f"emergency stop (second signal, {name}) after the run ended: {torque_words(stats)}"
 
     def _close(self) -> str | None:
         """Close what the run opened. The streamer has already left the servos as its end

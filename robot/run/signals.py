@@ -65,6 +65,7 @@ class SignalLatch:
         self._raised = False
         self._pending = False        # arrived while shielded, not acted on yet
         self._ended: int | None = None
+        self._at_end: list[Callable[[], str | None]] = []
 
     @property
     def emergency(self) -> bool:
@@ -140,6 +141,13 @@ class SignalLatch:
         if self._pending and not self._shields and not self._routes:
             self._interrupt()
 
+    def if_emergency_at_end(self, fn: Callable[[], str | None]) -> None:
+        """Call ``fn`` when the command ends (``end``) if two or more signals have come by
+        then: a run that closed holding, with its bus, before the second signal arrived
+        (the command was still printing) turns torque off after all. ``fn`` returns a
+        line for the command's output, or None; it is called with the signals blocked."""
+        self._at_end.append(fn)
+
     def exit_code(self, stats: LoopStats | None) -> int:
         """1 for a fault, 128 + the first signal's number, else 0."""
         if stats is not None and stats.fault:
@@ -156,13 +164,39 @@ class SignalLatch:
                 signal.signal(s, h)
         return restore
 
+    def settle(self) -> list[str]:
+        """Block the stopping signals in this thread (for good: the process is ending),
+        count any that came meanwhile, and if two or more have come run what
+        ``if_emergency_at_end`` registered; the lines they return. A signal delivered
+        through another thread meanwhile is only counted (shielded for good)."""
+        self._shields += 1
+        signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+        for signum in sorted(signal.sigpending() & set(SIGNALS)):
+            self.record(signum)
+        lines: list[str] = []
+        if self.emergency:
+            for fn in self._at_end:
+                try:
+                    line = fn()
+                except Exception:   # noqa: BLE001 - the exit goes on; the log says what
+                    log.exception("after a second signal, at the end")
+                    continue
+                if line:
+                    lines.append(line)
+        return lines
+
     def end(self, code: int) -> NoReturn:
         """The command is over and this process ends with ``code``, now: stdout and stderr
         are flushed and the process exits without the interpreter's shutdown, during
         which the handlers are gone (a signal there would kill it: exit -15, not 143).
-        Every ``finally`` of the command has run; a signal from here on exits at once
-        with the same code."""
+        Every ``finally`` of the command has run. First ``settle``: a second signal that
+        came at any time before now still turns torque off (``if_emergency_at_end``);
+        from then on the stopping signals are blocked and go with the process (or, seen
+        through another thread, exit at once with the same code)."""
+        lines = self.settle()
         self._ended = code
+        for line in lines:
+            sys.stdout.write(line + "\n")
         for stream in (sys.stdout, sys.stderr):
             try:
                 stream.flush()

@@ -26,6 +26,10 @@ STRAIGHT_DRIFT = 0.05
 IMU_NOISE = (2.0, 3.0)
 #: A push needs this long after it [s] to tell a recovery from a slow fall.
 AFTER_PUSH_S = 2.0
+#: The harder push of the full suite's second grid [N*s] (issue 22: 12 of 16 with `walk`).
+PUSH_HARD_NS = 1.5
+#: The pushes' directions as (forward, left) unit impulses.
+PUSH_DIRECTIONS = {"forward": (1, 0), "backward": (-1, 0), "left": (0, 1), "right": (0, -1)}
 
 
 @dataclass(frozen=True)
@@ -79,16 +83,9 @@ def conditions(params: GaitParams, *, quick: bool = False) -> list[Condition]:
     heights, seeds = ((5.0,), (0,)) if quick else ((1.0, 3.0, 5.0), (0, 1, 2))
     out += [Condition("bumps", f"bumps {h:g} mm seed {s}", World(bumps_mm=h, terrain_seed=s))
             for h in heights for s in seeds]
-    phases = (0.0,) if quick else PUSH_PHASES
-    pushes = {"forward": (1, 0), "backward": (-1, 0), "left": (0, 1), "right": (0, -1)}
-    for direction, (ux, uy) in pushes.items():
-        for ph in phases:
-            # The gait time to the millisecond, as the `--push` option gives it.
-            t = float(f"{PUSH_AT_S + ph * cycle:.3f}")
-            push = Push(t, ux * PUSH_NS, uy * PUSH_NS)
-            out.append(Condition(f"push {direction}",
-                                 f"push {PUSH_NS:g} N*s {direction} at phase {ph:g}",
-                                 World(pushes=(push,))))
+    out += push_grid(cycle, PUSH_NS, phases=(0.0,) if quick else PUSH_PHASES)
+    if not quick:
+        out += push_grid(cycle, PUSH_HARD_NS, group=f"push {PUSH_HARD_NS:g} N*s")
     if not quick:
         out += scaled_params(params)
     for ms in ((20.0,) if quick else (10.0, 20.0)):
@@ -100,6 +97,23 @@ def conditions(params: GaitParams, *, quick: bool = False) -> list[Condition]:
         out += [Condition("friction", f"friction x{f:g}", World(friction_scale=f))
                 for f in (0.5, 2.0)]
         out += [Condition("mass", f"mass x{m:g}", World(mass_scale=m)) for m in (0.8, 1.2)]
+    return out
+
+
+def push_grid(cycle: float, impulse: float, *, phases: Iterable[float] = PUSH_PHASES,
+              group: str | None = None) -> list[Condition]:
+    """Pushes of ``impulse`` [N*s] forward, backward, left and right, each at gait time
+    PUSH_AT_S + each of ``phases`` x ``cycle`` [s]; grouped per direction ("push
+    forward", ...) unless ``group`` names one group for them all."""
+    out = []
+    for direction, (ux, uy) in PUSH_DIRECTIONS.items():
+        for ph in phases:
+            # The gait time to the millisecond, as the `--push` option gives it.
+            t = float(f"{PUSH_AT_S + ph * cycle:.3f}")
+            push = Push(t, ux * impulse, uy * impulse)
+            out.append(Condition(group or f"push {direction}",
+                                 f"push {impulse:g} N*s {direction} at phase {ph:g}",
+                                 World(pushes=(push,))))
     return out
 
 

@@ -102,7 +102,10 @@ def run_condition(job: WalkJob) -> Outcome:
     except Exception as e:      # a bug in a run must not take the suite down
         logging.getLogger(__name__).exception("walk %s failed", c.name)
         return Outcome(c, job.balance, None, error=f"{type(e).__name__}: {e}")
-    return Outcome(c, job.balance, bool(r.get("fell")), r.get("fell_at_s"),
+    # A run a servo fault stopped early (e.g. the watchdog on an overloaded knee: the
+    # servos go limp) did not survive either, though the torso had not yet fallen.
+    stopped = r.get("stop_reason") not in ("completed", None)
+    return Outcome(c, job.balance, bool(r.get("fell")) or stopped, r.get("fell_at_s"),
                    float(r.get("distance_m", 0.0)), float(r.get("heading_change_deg", 0.0)),
                    summary=r)
 

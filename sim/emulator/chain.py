@@ -22,9 +22,8 @@ adapter and talk Dynamixel Protocol 2.0 (``sim.emulator.dxl_protocol``) or Feete
   (goal := present), the register reads -1 and goal writes get a Data Range Error until
   0 is written; torque stays on. Evaluated lazily like motion, so ``registers()`` after a
   silent gap shows the trip. Feetech STS has no such register (see ``servo_status.BUS_WATCHDOG``).
-- Log: one :class:`Packet` per instruction packet with a valid checksum that at least one
-  servo heard. Broadcast writes log id 254. Written values are decoded little-endian
-  (signed for Dynamixel's signed registers); for bulk reads ``values`` maps id → address.
+- Log: one :class:`Packet` per heard instruction packet with a valid checksum (broadcast:
+  id 254); values in the servo's byte order, signed per the X table; bulk reads: id → address.
 - Servos: present position starts at the joint's ``zero_ticks`` (2048 without a robot),
   position limits are the joint limits in ticks (rounded outward). Sync/bulk reads answer
   in the order the ids appear in the packet; a missing servo silences the rest. A chain
@@ -57,10 +56,10 @@ from types import TracebackType
 from typing import Any
 
 from robot.config.robot import RobotConfig
-from sim.emulator.chain_specs import FACTORY_BAUD, FACTORY_ID, factory_servos, plan_chain
+from sim.emulator.chain_specs import FACTORY_BAUD, FACTORY_ID, factory_baud, factory_servos, plan_chain
 from sim.emulator.control_tables import BAUD_CODES, TABLES
 from sim.emulator.records import ChainSpec, EmulatorError, Packet
-from sim.emulator.servo_models import MODELS, PROTOCOL_FAMILY
+from sim.emulator.servo_models import MODELS
 from sim.emulator.servo_status import ERROR_BITS
 
 __all__ = ["ChainSpec", "Emulator", "EmulatorError", "Packet"]
@@ -80,7 +79,7 @@ class Emulator:
                  baud: int | None = None) -> None:
         choice = plan_chain(protocol, robot, ids=ids, model=model, baud=baud)
         self.protocol = protocol
-        self.family = PROTOCOL_FAMILY[protocol]
+        self.family = MODELS[choice.model].family     # the chain's table family
         self.model, self.baud, self.ids = choice.model, choice.baud, choice.ids
         self.spec = ChainSpec(protocol, choice.servos, seed)
         self._proc: subprocess.Popen[bytes] | None = None
@@ -101,8 +100,9 @@ class Emulator:
         if count < 1:
             raise EmulatorError(f"count: expected at least 1 servo, got {count}")
         emu = cls(protocol, ids=[FACTORY_ID] * count, model=model,
-                  baud=FACTORY_BAUD[protocol])
+                  baud=factory_baud(protocol, model))
         emu.spec = replace(emu.spec, plugged=(), servos=factory_servos(protocol, emu.spec.servos))
+        emu.ids = tuple(s.servo_id for s in emu.spec.servos)   # a dual-axis case: 1 and 2
         return emu
 
     # ------------------------------------------------------------------ lifecycle

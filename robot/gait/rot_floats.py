@@ -1,11 +1,12 @@
-"""Rotation helpers of the fused tick (robot.gait.tick) on Python floats: the operations
-of robot.gait.xmath written out for one 3x3 matrix (row-major tuples), the same bits."""
+"""3x3 rotations on Python floats for the fused tick (robot.gait.tick): the operations of
+robot.gait.xmath written out for floats, so the tick gives the same bits as the general
+functions. Rotations are row-major 9-tuples."""
 
 from __future__ import annotations
 
 from math import cos, sin
 
-from robot.gait.xmath import Rot
+from robot.gait.xmath import Rot, post_rx
 
 
 def rz_ry(yaw: float, pitch: float) -> Rot:
@@ -15,7 +16,15 @@ def rz_ry(yaw: float, pitch: float) -> Rot:
     return (cz * cy, -sz, cz * sy, sz * cy, cz, sz * sy, -sy, 0.0, cy)
 
 
-def t_apply(r: Rot, x: float, y: float, z: float) -> tuple[float, float, float]:
+def per_foot(pelvis: Rot, yaw: float, pitch: float, roll: float, foot_roll: float,
+              foot_pitch: float) -> Rot:
+    """targets._per_foot on floats."""
+    if foot_roll == 0.0 and foot_pitch == 0.0:
+        return pelvis
+    return post_rx(rz_ry(yaw, pitch + foot_pitch), roll + foot_roll)
+
+
+def apply_t(r: Rot, x: float, y: float, z: float) -> tuple[float, float, float]:
     """xmath.apply_t: r.T @ (x, y, z)."""
     return (r[0] * x + r[3] * y + r[6] * z, r[1] * x + r[4] * y + r[7] * z,
             r[2] * x + r[5] * y + r[8] * z)

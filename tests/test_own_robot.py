@@ -9,6 +9,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from five_dof import HEAD_RAD, LEGS, five_dof_with_head
 
 from robot.bus.servo_map import ServoMap
 from robot.config.bundled import ROBOTS_DIR
@@ -24,31 +25,6 @@ from robot.loop.streamer import Streamer, Telemetry
 from sim.mujoco.bus import MujocoBus
 from sim.mujoco.mjcf import build_mjcf
 
-LEGS = ROBOTS_DIR / "biped12-legs.toml"
-HEAD_RAD = 0.3
-
-
-def five_dof_with_head(tmp_path: Path) -> Path:
-    """The legs-only robot without hip yaw, XM430 knees and a head pan servo (id 20)."""
-    s = LEGS.read_text()
-    s = re.sub(r"(?ms)^\[joints\.[rl]_hip_yaw\].*?(?=^\[)", "", s)
-    s = re.sub(r"(?m)^hip_yaw_link = .*\n", "", s)       # no hip yaw servo, no such link
-    for side in "rl":
-        s = s.replace(f"[joints.{side}_knee]\n", f'[joints.{side}_knee]\nmodel = "XM430-W350"\n')
-    s = s.replace("[rest]", f"""[joints.head_pan]
-servo_id = 20
-sign = 1
-zero_ticks = 2048
-min_rad = -1.0
-max_rad = 1.0
-max_speed_rad_s = 3.0
-fixed_rad = {HEAD_RAD}
-
-[rest]""")
-    path = tmp_path / "five.toml"
-    path.write_text(s)
-    return path
-
 
 @pytest.fixture
 def five(tmp_path: Path) -> RobotConfig:
@@ -63,7 +39,7 @@ def test_legs_only_robot_loads_and_has_twelve_joints() -> None:
 
 def test_five_dof_legs_reach_their_targets_with_yaw_zero(five: RobotConfig) -> None:
     """FK of each 5-DoF leg (hip yaw 0) lands on the sole target built without yaw, for a
-    whole stride, even when a turn is asked for (it is ignored: no joint can yaw). Not
+    whole stride, even when a turn is asked for (it steers by step length: no joint yaws). Not
     exactly: a pitched foot under a rolled hip would need a trace of yaw; dropping it
     misses by micrometres."""
     params = load_gait("walk").params.replace({"turn": 0.4})

@@ -28,7 +28,7 @@ from robot.motion.posing import PoseMove
 from robot.motion.scripted import PlaybackEngine, RecordingEngine
 from robot.run.run import Run, execute
 from robot.run.spec import RunOptions, RunSpec
-from robot.run.walk import walk_imu
+from robot.run.walk import walk_imu, walk_summary
 from robot.tuning.objective import Setup, evaluate
 
 ROBOT = load_robot(DEFAULT_ROBOT_NAME)
@@ -57,9 +57,15 @@ def test_the_runs_result_on_the_sim_bus_is_the_clis_json(
     result = execute(spec)
     got = json.loads(json.dumps(result.as_dict()))
     header = {"robot", "gait", "bus", "seconds", "balance"}
-    assert set(got) == set(want) - header
+    # What walk_summary adds from the engine: the heading asked for and the drift beyond
+    # it, the time a target was out of reach and each joint held at a limit.
+    engine_keys = {"heading_asked_deg", "heading_drift_deg_min", "heading_drifts",
+                   "ik_unreachable_s", "clamped_joints_s"}
+    assert set(got) == set(want) - header - engine_keys
     wall = {"realtime_factor"}                    # wall clock: differs run to run
     assert {k: got[k] for k in set(got) - wall} == {k: want[k] for k in set(got) - wall}
+    summary = json.loads(json.dumps(walk_summary(spec, result, gait="walk")))
+    assert {k: summary[k] for k in set(want) - wall} == {k: want[k] for k in set(want) - wall}
     assert result.stats.ticks == want["ticks"] > SECONDS * 200   # ramps + gait ticks
     assert not bus.is_open                         # the run closed what it opened
 
@@ -151,11 +157,13 @@ def test_the_tuners_objective_walks_in_process(
     same = set(want) - {"gait", "realtime_factor"}
     assert {k: got[k] for k in same} == {k: want[k] for k in same}
     assert flat.fell is False and flat.distance_m == want["distance_m"]
-    # score = survived + 0.9 quality; with no references speed and energy count 1.
+    # score = walks x (runs + 1) + survived + 0.9 quality; with no references it walks
+    # when it stays up, and speed and energy count 1.
     drift = abs(want["lateral_drift_m"]) / max(want["distance_m"], 0.1)
     straight = max(0.0, 1 - abs(want["heading_change_deg"]) / 20 - drift / 0.2)
     knee = 1 - want["knee_load_pct"] / 100
-    assert ev.score == pytest.approx(1 + 0.9 * (0.4 + 0.3 * straight + 0.15 * knee + 0.15))
+    assert ev.walking
+    assert ev.score == pytest.approx(2 + 1 + 0.9 * (0.4 + 0.3 * straight + 0.15 * knee + 0.15))
     assert list(tmp_path.iterdir()) == []           # no candidate TOML, no files at all
 
 

@@ -4,6 +4,7 @@ one that walks the robustness --quick set where the detuned one fell."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import subprocess
 import sys
@@ -12,10 +13,13 @@ from pathlib import Path
 import optuna
 import pytest
 
+from robot.commands.tune import made_for
+from robot.config.bundled import DEFAULT_ROBOT
 from robot.config.gait_file import Gait, gait_to_toml, load_gait
 from robot.config.params import SPECS
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
-from robot.tuning.objective import Setup, combined, quality
+from robot.tuning.objective import Setup, combined, evaluate, quality, score, walks
 from robot.tuning.space import DEFAULT_KNOBS, apply, parse_knob, search_space
 
 WALK = load_gait("walk").params
@@ -77,6 +81,56 @@ def test_quality_terms_by_hand() -> None:
     assert t["energy"] == pytest.approx(1 - 15 / 60)
     assert combined(t) == pytest.approx(0.4 * 0.8 + 0.3 * 0.7 + 0.15 * 0.6 + 0.15 * 0.75)
     assert set(quality({**flat, "fell": True}, setup).values()) == {0.0}
+
+
+def flat_summary(speed: float) -> dict[str, float | bool]:
+    return {"fell": False, "distance_m": speed * 12, "speed_m_s": speed,
+            "lateral_drift_m": 0.0, "heading_change_deg": 0.0, "knee_load_pct": 20.0,
+            "energy_per_m": 10.0}
+
+
+def test_a_trial_that_survives_more_by_creeping_loses_to_one_that_walks() -> None:
+    """The issue's case: survival alone made a 0.04 m/s creep win where the robot walked
+    0.1 m/s. Creeping just under 80 % of the target and surviving all 11 runs scores below
+    walking just over it and surviving only the flat one, whatever the quality terms."""
+    setup = Setup("biped12-legs", target_speed=0.1, baseline_energy=30.0)
+    creep, walk = flat_summary(0.0799), flat_summary(0.0801)
+    assert not walks(creep, setup) and walks(walk, setup)
+    best_creep = score(11, {"speed": 1.0, "straight": 1.0, "knee": 1.0, "energy": 1.0},
+                       walking=False, runs=11)
+    worst_walk = score(1, {"speed": 0.0, "straight": 0.0, "knee": 0.0, "energy": 0.0},
+                       walking=True, runs=11)
+    assert best_creep < worst_walk
+    assert not walks({**walk, "fell": True}, setup)            # a fall never walks
+    assert walks(creep, Setup("biped12-legs"))                 # no target: standing up is all
+
+
+def test_a_preset_that_stands_still_loses_in_physics() -> None:
+    """The walk with speed 0 (stepping on the spot) on the legs-only robot's flat: it stays
+    up and does not walk, so it scores below the walk itself."""
+    skip = tuple(g for g in ("slope", "cross slope", "bumps", "push*", "latency", "imu noise"))
+    setup = Setup("biped12-legs", seconds=6.0, target_speed=0.1, skip=skip)
+    still = evaluate(setup, WALK.replace({"speed": 0.0}))
+    moving = evaluate(setup, WALK)
+    assert still.survived == moving.survived == 1
+    assert abs(still.flat["speed_m_s"]) < 0.02 and moving.flat["speed_m_s"] >= 0.08
+    assert not still.walking and moving.walking
+    assert still.score < moving.score - 1.0
+
+
+def test_the_target_speed_of_a_bundled_preset_is_measured_on_the_default_robot(
+        tmp_path: Path) -> None:
+    walk = load_gait("walk")
+    args = argparse.Namespace(speed=None, set=["Slgt_R=0.5"])
+    where, params = made_for(args, walk, load_robot("biped12-legs"))
+    assert where == str(DEFAULT_ROBOT)
+    assert params == walk.for_robot(load_robot(DEFAULT_ROBOT)).replace({"Slgt_R": 0.5})
+    assert made_for(argparse.Namespace(speed=0.1, set=[]), walk, load_robot("biped12-legs")) \
+        is None                                                # --speed given
+    assert made_for(args, walk, load_robot(DEFAULT_ROBOT)) is None   # already there
+    own = tmp_path / "own.toml"
+    own.write_text(gait_to_toml(Gait(name="own", params=WALK, source=str(own))))
+    assert made_for(args, load_gait(str(own)), load_robot("biped12-legs")) is None
 
 
 # -- the study ---------------------------------------------------------------------------------

@@ -18,11 +18,17 @@ from robot.commands.common import (
     bounded_int,
     output_file,
     params_from,
+    parse_sets,
     positive_int,
     robot_from,
     seconds,
     writing,
 )
+from robot.config.bundled import DEFAULT_ROBOT, GAITS_DIR
+from robot.config.gait_file import Gait
+from robot.config.params import GaitParams
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 
 #: --seed: the workers seed numpy's 32-bit generator with seed + 7919 x worker.
@@ -84,7 +90,14 @@ def run(args: argparse.Namespace) -> int:
 
     from robot.tuning.objective import Setup, check_skip, suite_for
     from robot.tuning.progress import TrialProgress
-    from robot.tuning.report import format_report, group_survival, plot_study, write_preset
+    from robot.tuning.report import (
+        WalkFigures,
+        cadence,
+        format_report,
+        group_survival,
+        plot_study,
+        write_preset,
+    )
     from robot.tuning.robustness import check_seconds
     from robot.tuning.space import search_space
     from robot.tuning.study import Plan, best_params, best_trial, references, run_study
@@ -114,7 +127,8 @@ def run(args: argparse.Namespace) -> int:
     if not args.json:
         print(f"{name}: measuring the starting preset '{gait.name}' on the {args.suite} "
               "suite ...", file=sys.stderr, flush=True)
-    setup, ref = references(study, setup, start, target_speed=args.speed)
+    setup, ref = references(study, setup, start, target_speed=args.speed,
+                            made_for=made_for(args, gait, robot))
     plan = Plan(storage, name, setup, start, knobs, args.trials, args.seed)
     progress = TrialProgress(args.trials, quiet=args.json)
     t_study = time.perf_counter()
@@ -133,8 +147,9 @@ def run(args: argparse.Namespace) -> int:
     groups.update({c.name: c.group for c in suite_for(setup, best)})
     start_groups = group_survival(ref["runs"], groups)
     best_groups = group_survival(top.user_attrs["runs"], groups) if top else {}
-    if top is not None and top.user_attrs.get("survived", 0) < ref["survived"]:
+    if top is not None and (top.value or 0.0) < ref["score"]:
         best, best_groups = start, start_groups       # never write something worse
+        top = None
     with writing("--out", out):
         written = write_preset(out, best, name=out.stem,
                                description=f"tuned by biped tune for {robot.name} from "
@@ -148,6 +163,11 @@ def run(args: argparse.Namespace) -> int:
         "cpu_s_per_trial": per_trial, "start_survived": ref["survived"],
         "best_survived": best_groups and sum(ok for ok, _ in best_groups.values()),
         "runs_per_trial": ref["runs_total"], "best_score": best_score,
+        "target_speed_m_s": setup.target_speed, "start_speed_m_s": ref.get("speed_m_s"),
+        "best_speed_m_s": top.user_attrs.get("speed_m_s") if top else ref.get("speed_m_s"),
+        "best_walking": bool(top.user_attrs.get("walking")) if top else None,
+        "start_cadence_steps_min": cadence(start), "best_cadence_steps_min": cadence(best),
+        "start_crouch": start.stance, "best_crouch": best.stance,
         "knobs": {k.name: {"start": getattr(start, k.targets[0]),
                            "best": getattr(best, k.targets[0]), "lo": k.lo, "hi": k.hi}
                   for k in knobs},
@@ -158,12 +178,27 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(result))
     else:
         print(format_report(knobs, start, written.params, start_score + 0.0, best_score,
-                            start_groups, best_groups))
+                            start_groups, best_groups, walk=WalkFigures(
+                                setup.target_speed, ref.get("speed_m_s"),
+                                top.user_attrs.get("speed_m_s") if top else
+                                ref.get("speed_m_s"))))
         print(f"\nwrote {out} ({done} trials in {study_s:.0f} s on {jobs} workers: "
               f"{per_trial:.1f} s of one core per trial); plots: "
               + ", ".join(str(p) for p in pngs))
         print(f"resume or extend: the same command (study '{name}' in {storage})")
     return 0
+
+
+def made_for(args: argparse.Namespace, gait: Gait, robot: RobotConfig
+             ) -> tuple[str, GaitParams] | None:
+    """Where the target speed is measured without --speed: a bundled preset on the
+    bundled robot it was made for (the default robot: docs/gait.md), with the same --set;
+    None (the robot being tuned) for the user's own preset or the default robot itself."""
+    if args.speed is not None or Path(gait.source).parent != GAITS_DIR \
+            or Path(robot.source) == DEFAULT_ROBOT:
+        return None
+    params = gait.for_robot(load_robot(DEFAULT_ROBOT))
+    return str(DEFAULT_ROBOT), params.replace(parse_sets(args.set), where="--set")
 
 
 def sensitivity(args: argparse.Namespace, start: Any) -> int:

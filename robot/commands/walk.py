@@ -29,7 +29,7 @@ from robot.motion.keyframes import load_sequence
 from robot.run.result import TORQUE_WORDS
 from robot.run.run import execute
 from robot.run.spec import RunOptions
-from robot.run.walk import walk_spec, walk_summary
+from robot.run.walk import HEADING_DRIFT_DEG_MIN, walk_spec, walk_summary
 
 log = logging.getLogger(__name__)
 
@@ -116,10 +116,12 @@ def format_summary(r: dict[str, Any]) -> str:
         lines += [
             f"  distance      {r['distance_m']:+.3f} m forward ({r['speed_m_s']:.3f} m/s)",
             f"  lateral drift {r['lateral_drift_m']:+.3f} m",
-            f"  heading       {r['heading_change_deg']:+.1f} deg",
+            f"  heading       {r['heading_change_deg']:+.1f} deg{heading_words(r)}",
             f"  fell          {fell} (lowest torso {r['min_torso_height_m']:.3f} m,"
             f" max tilt {r['max_tilt_deg']:.1f} deg)",
         ]
+        if r.get("clamped_joints_s") or r.get("ik_unreachable_s"):
+            lines.append(f"  joint limits  {clamp_words(r)}")
         world = describe_world(r.get("world"))
         if world:
             lines.append(f"  world         {world}")
@@ -135,6 +137,27 @@ def format_summary(r: dict[str, Any]) -> str:
     if r.get("record_error"):
         lines.append(f"  record        FAILED: {r['record_error']}")
     return "\n".join(lines)
+
+
+def heading_words(r: dict[str, Any]) -> str:
+    """What the summary says after the heading change: the asked turn and the drift beyond
+    it per minute, flagged when it is more than robot.run.walk.HEADING_DRIFT_DEG_MIN."""
+    if "heading_drift_deg_min" not in r:
+        return ""
+    asked = f"asked {r['heading_asked_deg']:+.1f} deg, " if r["heading_asked_deg"] else ""
+    flag = (f": DRIFTS more than {HEADING_DRIFT_DEG_MIN:g} deg/min unasked"
+            if r["heading_drifts"] else "")
+    return f" ({asked}drift {r['heading_drift_deg_min']:+.1f} deg/min{flag})"
+
+
+def clamp_words(r: dict[str, Any]) -> str:
+    """Which joints the gait held at a limit and for how long, and how long a target was
+    out of the IK's reach."""
+    held = ", ".join(f"{name} {t:.2f} s" for name, t in r["clamped_joints_s"].items())
+    words = [f"held at a limit: {held}"] if held else []
+    if r["ik_unreachable_s"]:
+        words.append(f"target out of reach {r['ik_unreachable_s']:.2f} s")
+    return "; ".join(words)
 
 
 def servo_words(torque: str) -> str:

@@ -2,8 +2,9 @@
 
 Pure (no I/O). ``tick(dt)`` serves the control loop on floats (the engine is a motion
 source, robot.loop.source); ``curves(times)`` serves previs on numpy arrays. Joint angles
-come out in ``robot.joints`` order, clamped to the joint limits; unreachable targets are
-clamped by the IK and counted, never NaN.
+come out in ``robot.joints`` order, clamped to the joint limits (each joint's clamped
+poses counted: ``clamp_ticks``); unreachable targets are clamped by the IK and counted,
+never NaN.
 """
 
 from __future__ import annotations
@@ -87,9 +88,6 @@ class GaitEngine:
             raise ValueError("robot joints must be in canonical order")
         self.robot = robot
         self._leg_yaw = robot.has_hip_yaw
-        if not self._leg_yaw and params.turn != 0.0:
-            log.warning("%s has no hip yaw (5-DoF legs): turn = %g is ignored", robot.name,
-                        params.turn)
         self._params = params
         self._target = within_steering_budget(params)
         self._live = self._target
@@ -98,6 +96,10 @@ class GaitEngine:
         self._ramp = 0.0          # linear ramp variable in [0, 1]
         self._running = False
         self.unreachable_ticks = 0
+        #: The heading change [rad] the gait's ``turn`` asked for so far: ``turn`` per step,
+        #: two steps per cycle of the phase, times the envelope (a feedback loop's trim
+        #: not included: it corrects, it does not ask).
+        self.asked_yaw = 0.0
         #: Posture change relative to the feet, set by a feedback loop (robot.balance).
         self.trim = NO_TRIM
         #: Lift of the right and left foot [m] at the last ``pose`` (> 0: swinging).
@@ -105,6 +107,10 @@ class GaitEngine:
         self._lo = [j.min_rad for j in robot.joints]
         self._hi = [j.max_rad for j in robot.joints]
         self._limits = list(zip(self._lo, self._hi, strict=True))
+        #: Poses in which each joint (robot order) was held at its limit, and the joints
+        #: (indices) held there in the last pose.
+        self.clamp_ticks = [0] * len(robot.joints)
+        self.clamped: tuple[int, ...] = ()
         self._kernel = TickKernel(robot)
         self._plain_p: GaitParams | None = None   # the last parameters found _plain
         self._plain_trim: BodyTrim | None = None  # the last trim found _plain
@@ -216,8 +222,16 @@ class GaitEngine:
                 log.warning("gait target out of reach (%d ticks so far): clamped to the "
                             "nearest reachable pose; reduce stride, foot height or crouch",
                             self.unreachable_ticks)
-        return [lo if v < lo else hi if v > hi else v
-                for v, (lo, hi) in zip(q, self._limits, strict=True)]
+        out = [lo if v < lo else hi if v > hi else v
+               for v, (lo, hi) in zip(q, self._limits, strict=True)]
+        if out != q:       # a joint held at its limit: counted per joint (clamp_ticks)
+            self.clamped = tuple(i for i, (a, b) in enumerate(zip(out, q, strict=True))
+                                 if a != b)
+            for i in self.clamped:
+                self.clamp_ticks[i] += 1
+        elif self.clamped:
+            self.clamped = ()
+        return out
 
     def _plain_inputs(self, p: GaitParams, ph: gait.Phase, a: float, trim: BodyTrim) -> bool:
         """Every input a Python float or int, so the kernel's arithmetic is exactly the
@@ -252,7 +266,10 @@ class GaitEngine:
         else:
             self._ramp = max(0.0, self._ramp - step)
         if self._ramp > 0.0:
+            theta = self.phase.theta
             self.phase = gait.advance(self.phase, p, dt * (1.0 + self.trim.tempo))
+            if p.turn != 0.0:
+                self.asked_yaw += self.amplitude * p.turn * (self.phase.theta - theta) / math.pi
         else:
             # Fully ramped out: at zero amplitude the pose does not depend on the phase, so
             # resetting it is invisible and the next start begins a fresh stride.

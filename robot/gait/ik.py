@@ -17,6 +17,7 @@ lateral caps: see arm_ik): never NaN, never an exception, no division by ~0;
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -74,6 +75,36 @@ def bend(a: float, b: float, s: Num, t: Num = 0.0) -> Num:
     return 2.0 * xm.atan2(xm.sqrt(out), xm.sqrt(inn))
 
 
+class Reach(NamedTuple):
+    """The distances [m] a two-link chain spans within its middle joint's limits: ``lo``
+    at its largest bend, ``hi`` at its smallest."""
+
+    lo: float
+    hi: float
+
+
+def reach(a: float, b: float, bend_lo: float, bend_hi: float) -> Reach:
+    """Links ``a``, ``b`` [m] joined by a joint bent between ``bend_lo`` and ``bend_hi``
+    [rad] (0 straight, pi folded; a limit beyond those is the geometry's own): their far
+    ends are sqrt(a^2 + b^2 + 2ab cos(bend)) [m] apart, exactly a + b and |a - b| at the
+    ends of the geometry."""
+    def span(bend: float) -> float:
+        return math.sqrt(max(a * a + b * b + 2.0 * a * b * math.cos(bend), 0.0))
+    lo = abs(a - b) if bend_hi >= math.pi else span(max(bend_hi, 0.0))
+    hi = a + b if bend_lo <= 0.0 else span(min(bend_lo, math.pi))
+    return Reach(min(lo, hi), hi)
+
+
+def leg_reach(g: Geometry, knee_lo: float = 0.0, knee_hi: float = math.pi) -> Reach:
+    """Hip to ankle distances [m] within the knee's limits [rad] (knee >= 0 bends)."""
+    return reach(g.thigh, g.shin, knee_lo, knee_hi)
+
+
+def arm_reach(g: Geometry, elbow_lo: float = -math.pi, elbow_hi: float = 0.0) -> Reach:
+    """Shoulder to hand distances [m] within the elbow's limits [rad] (elbow <= 0 bends)."""
+    return reach(g.upper_arm, g.forearm, -elbow_hi, -elbow_lo)
+
+
 def leg_fk_full(g: Geometry, side: str, q: tuple[Num, ...]) -> tuple[Vec, Rot]:
     """Sole point [m] and foot rotation in the pelvis frame for leg angles ``q`` (6)."""
     hx, hy, hz = hip_centre(g, side)
@@ -93,15 +124,20 @@ def leg_fk(g: Geometry, side: str, q: np.ndarray) -> np.ndarray:
     return np.array(pos)
 
 
-def leg_ik(g: Geometry, side: str, sole: Vec, foot_rot: Rot = xm.IDENTITY) -> LegIK:
+def leg_ik(g: Geometry, side: str, sole: Vec, foot_rot: Rot = xm.IDENTITY, *,
+           span: Reach | None = None) -> LegIK:
     """Leg angles [rad] that put the sole point at ``sole`` [m] with foot rotation
     ``foot_rot`` (both in the pelvis frame).
 
-    Degenerate targets divide by nothing: an ankle point at the hip centre folds the knee
-    (pi) and, with thigh == shin, is reached; one nearer than |thigh - shin| or farther
-    than thigh + shin is clamped along the ankle → hip line (``reachable`` False).
+    span: the hip to ankle distances the knee's limits allow (``leg_reach``; None: the
+    geometry's, |thigh - shin| to thigh + shin). A target nearer or farther is clamped
+    along the ankle → hip line (``reachable`` False): the foot keeps its orientation and
+    direction from the hip and the knee stays inside its limits, where clamping the knee
+    afterwards would move the foot off that line. Degenerate targets divide by nothing:
+    an ankle point at the hip centre folds the knee as far as it may.
     """
     a, b = g.thigh, g.shin
+    lo, hi = span if span is not None else (abs(a - b), a + b)
     hx, hy, hz = hip_centre(g, side)
     # Ankle point: the sole plus the foot's own up vector times the ankle height.
     ax = sole[0] + foot_rot[2] * g.ankle_height
@@ -109,8 +145,8 @@ def leg_ik(g: Geometry, side: str, sole: Vec, foot_rot: Rot = xm.IDENTITY) -> Le
     az = sole[2] + foot_rot[8] * g.ankle_height
     rx, ry, rz = xm.apply_t(foot_rot, (hx - ax, hy - ay, hz - az))  # ankle → hip, foot frame
     c = xm.sqrt(rx * rx + ry * ry + rz * rz)
-    reachable = (c >= abs(a - b) - REACH_TOL) & (c <= a + b + REACH_TOL)
-    knee = bend(a, b, c)
+    reachable = (c >= lo - REACH_TOL) & (c <= hi + REACH_TOL)
+    knee = bend(a, b, xm.clip(c, lo, hi))
     # Angle at the ankle between the shin and the ankle → hip line. atan2, not the
     # law-of-sines asin: that one picks the acute branch, wrong when thigh > shin.
     ankle_a = xm.atan2(a * xm.sin(knee), b + a * xm.cos(knee))
@@ -148,8 +184,11 @@ def arm_fk(g: Geometry, side: str, q: np.ndarray) -> np.ndarray:
     return np.add(local, shoulder_centre(g, side))
 
 
-def arm_ik(g: Geometry, hand: Vec) -> ArmIK:
+def arm_ik(g: Geometry, hand: Vec, *, span: Reach | None = None) -> ArmIK:
     """Arm angles [rad] putting the hand point at ``hand`` [m] relative to the shoulder centre.
+
+    span: the distances the elbow's limits allow (``arm_reach``; None: the geometry's
+    annulus |f - u| to u + f); "the annulus" below is this one.
 
     The elbow (bent forward, <= 0) sets the distance d; in the elbow's plane the hand is
     then at (vx, vz) = (-f sin(elbow), -u - f cos(elbow)) [m], and the roll about x sends it
@@ -179,11 +218,11 @@ def arm_ik(g: Geometry, hand: Vec) -> ArmIK:
     px, py, pz = hand
     rho2 = px * px + pz * pz  # squared distance from the pitch axis
     d = xm.sqrt(rho2 + py * py)
-    lo, hi = abs(u - f), u + f
+    lo, hi = span if span is not None else (abs(u - f), u + f)
     dc = xm.clip(d, lo, hi)
-    k = dc / xm.maximum(d, 1e-300)  # radially onto the annulus
+    k = dc / xm.maximum(d, 1e-300)  # radially onto the annulus (1 exactly inside it)
     y = xm.clip(py * k, -dc, dc)
-    out, inn = spans(u, f, py, xm.sqrt(rho2))  # clamp by themselves
+    out, inn = spans(u, f, py * k, xm.sqrt(rho2) * k)  # and onto the geometry's
     elbow = -2.0 * xm.atan2(xm.sqrt(out), xm.sqrt(inn))
     # The hand in the elbow's plane, by algebra (the same bits on floats and arrays):
     vx = xm.sqrt(out * inn) / (2.0 * u)  # -f sin(elbow) >= 0

@@ -9,7 +9,8 @@ The paper animates a Maya rig (Y up, Z forward, rig units). Here, once:
 - foot heights below the ground are stance: clamped at the ground;
 - lateral sway of the pelvis in step with the stride (weight over the stance foot);
 - steering: ``speed`` scales the stride, ``turn`` yaws the feet (hip yaw) about the
-  body's vertical axis (orientation and position) and
+  body's vertical axis (orientation and position), or on 5-DoF legs (no hip yaw) makes
+  one stride longer than the other (``stride_turn``), and
   ``side_step`` moves them sideways, both in step with the stride;
 - eq 14/15: the up-leg translations move the pelvis: their mean shifts it forward, their
   difference yaws it, ``UpLeg_tY`` sets the hip height;
@@ -94,6 +95,28 @@ NO_TRIM = BodyTrim()
 TURN_RANGE = (SPECS["turn"].lo, SPECS["turn"].hi)
 
 
+#: 5-DoF legs (no hip yaw) steer by step length, as a differential drive does: for
+#: ``turn`` [rad/step] each foot's stride is shifted by ``turn`` x the half gap of the feet
+#: [m] (the right one forward and the left one back in step with the stride, so the right
+#: stride grows and the left one shrinks by that much: over the two stances of a cycle the
+#: right side of the body moves 4 x turn x half gap farther than the left, which turns a
+#: body of that track by ``turn`` per step), at most STRIDE_TURN_MAX x the stride
+#: amplitude (Slgt, not the speed: turning on the spot still steps). In physics the body
+#: can only yaw by its feet slipping, so which way it turns depends on the robot: in
+#: MuJoCo the 5-DoF Dynamixel legs-only robot turns against the stride law, the AX-12
+#: one with it (docs/gait.md). A heading loop's turn trim is therefore not steered this
+#: way (a wrong sign would run away: the 5-DoF Feetech robot fell): only the asked turn.
+STRIDE_TURN_MAX = 0.5
+
+
+def stride_turn(turn: Num, half_w: Num, stride: Num) -> Num:
+    """The stride shift [m] of 5-DoF steering for ``turn`` [rad/step], the feet ``half_w``
+    [m] either side of the pelvis, a stride amplitude ``stride`` [m] (>= 0)."""
+    d = turn * half_w
+    lim = STRIDE_TURN_MAX * stride
+    return lim if d > lim else -lim if d < -lim else d
+
+
 def _per_foot(pelvis_rot: Rot, yaw: Num, pitch: Num, roll: float, foot_roll: float,
               foot_pitch: float) -> Rot:
     """The pelvis's rotation relative to one foot: ``pelvis_rot`` unless the trim turns
@@ -114,7 +137,8 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
     """Map the paper's channels (robot.gait.channels at ``amplitude``) to body targets.
 
     leg_yaw: False for 5-DoF legs (no hip yaw): no foot yaws relative to the pelvis, so
-    ``turn`` and the pelvis yaw of eq 14/15 are left out and the IK's hip yaw is 0.
+    the pelvis yaw of eq 14/15 is left out, the IK's hip yaw is 0, and ``turn`` steers
+    by step length instead (``stride_turn``).
     trim: a feedback loop's change of posture (robot.balance), see ``BodyTrim``.
     """
     s = scale(g, p)
@@ -125,6 +149,8 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
     hip_h = p.stance * g.leg_length + g.ankle_height + s * ch["RightUpLeg_tY"]
     px = s * 0.5 * (ch["RightUpLeg_tZ"] + ch["LeftUpLeg_tZ"])
     yaw = s * (ch["RightUpLeg_tZ"] - ch["LeftUpLeg_tZ"]) / g.hip_width if leg_yaw else 0.0
+    turn = (p.turn if trim.turn == 0.0
+            else min(max(p.turn + trim.turn, TURN_RANGE[0]), TURN_RANGE[1]))
     py = p.sway * (sin_t * xm.cos(p.sway_phase) - tz * xm.sin(p.sway_phase))
     pitch = p.torso_lean + trim.pitch + p.spine_gain * (ch["StZ_ik"] - ch["CtZ"])
     pelvis_rot = xm.rz_ry(yaw, pitch)
@@ -147,13 +173,19 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
              -hip_h + lift_l * down)
     w_r = xm.clip(ty, 0.0, 1.0) * down
     w_l = xm.clip(ty_l, 0.0, 1.0) * down
-    turn = (0.0 if not leg_yaw else p.turn if trim.turn == 0.0
-            else min(max(p.turn + trim.turn, TURN_RANGE[0]), TURN_RANGE[1]))
-    yaw_r = -0.5 * turn * tz
-    yaw_l = 0.5 * turn * tz
+    yaw_turn = turn if leg_yaw else 0.0
+    yaw_r = -0.5 * yaw_turn * tz
+    yaw_l = 0.5 * yaw_turn * tz
     r_rot = xm.rz_ry(yaw_r, -p.toe_gain * ch["RightToe_tY"] * w_r)
     l_rot = xm.rz_ry(yaw_l, -p.toe_gain * ch["LeftToe_tY"] * w_l)
-    if turn != 0.0:
+    if not leg_yaw and p.turn != 0.0:
+        # 5-DoF steering by step length (STRIDE_TURN_MAX): both feet x - tz * dx, so for
+        # a left turn the right stride (-tz * Slgt_R) grows and the left (+tz) shrinks.
+        # The asked turn only, not a feedback loop's trim (see STRIDE_TURN_MAX).
+        dx = stride_turn(p.turn, half_w, s * 0.5 * (abs(p.Slgt_R) + abs(p.Slgt_L))) * tz
+        r_pos = (r_pos[0] - dx, r_pos[1], r_pos[2])
+        l_pos = (l_pos[0] - dx, l_pos[1], l_pos[2])
+    if yaw_turn != 0.0:
         # Turning: the body rotates about its own vertical axis over the planted foot, so
         # each foot's position turns with its yaw too (otherwise it would have to slip).
         r_pos = _yawed(r_pos, yaw_r)

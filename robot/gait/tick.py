@@ -22,12 +22,13 @@ from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.gait import xmath as xm
 from robot.gait.expressions import FTAU_ALPHA, FTAU_DIVISOR, J_ERROR_STZ_IK, Phase
-from robot.gait.ik import REACH_TOL, SIDE_SIGN
+from robot.gait.ik import REACH_TOL, SIDE_SIGN, Reach
 from robot.gait.rot_floats import apply_t as _apply_t
 from robot.gait.rot_floats import per_foot as _per_foot
 from robot.gait.rot_floats import rz_ry as _rz_ry
 from robot.gait.rot_floats import t_matmul as _t_matmul
-from robot.gait.targets import ARM_HANG, HAND_OUT, TURN_RANGE, BodyTrim
+from robot.gait.targets import ARM_HANG, HAND_OUT, TURN_RANGE, BodyTrim, stride_turn
+from robot.gait.vectorised import spans
 from robot.gait.xmath import Rot
 
 
@@ -43,8 +44,10 @@ class _Leg(NamedTuple):
     far: float     # a + b
     near: float    # |a - b|
     span: float    # 4 a b
-    lo: float      # |a - b| - REACH_TOL
-    hi: float      # a + b + REACH_TOL
+    lo: float      # c_lo - REACH_TOL
+    hi: float      # c_hi + REACH_TOL
+    c_lo: float    # the hip to ankle distances the knee limits allow (ik.leg_reach)
+    c_hi: float
 
 
 class _Arm(NamedTuple):
@@ -52,8 +55,10 @@ class _Arm(NamedTuple):
 
     py: float
     py2: float     # py * py
-    lo: float      # |u - f|
-    hi: float      # u + f
+    lo: float      # the distances the elbow limits allow (ik.arm_reach)
+    hi: float
+    far: float     # u + f
+    near: float    # |u - f|
     far_s: float   # (far - |py|) (far + |py|) of ik.spans
     s_near: float  # (|py| - near) (|py| + near) of ik.spans
     span: float    # 4 u f
@@ -85,26 +90,29 @@ class TickKernel:
         g = robot.geometry
         self._g = g
         self._leg_yaw = robot.has_hip_yaw
-        self._arms = robot.has_arms
         self._layout = robot.layout
-        self._legs = tuple(self._leg(side) for side in ("r", "l"))
-        self._hands = tuple(self._arm(py) for py in (-HAND_OUT, HAND_OUT))
+        r_leg, l_leg, r_arm, l_arm = spans(robot)
+        self._legs = (self._leg("r", r_leg), self._leg("l", l_leg))
+        self._hands: tuple[_Arm, _Arm] | None = (
+            (self._arm(-HAND_OUT, r_arm), self._arm(HAND_OUT, l_arm))
+            if r_arm is not None and l_arm is not None else None)
         self._hang = -ARM_HANG * (g.upper_arm + g.forearm)
         self._p: GaitParams | None = None
         self._derived: _Derived | None = None
 
-    def _leg(self, side: str) -> _Leg:
+    def _leg(self, side: str, span: Reach) -> _Leg:
         g = self._g
         a, b = g.thigh, g.shin
         return _Leg(0.0, SIDE_SIGN[side] * g.hip_width / 2, 0.0, a, b, g.ankle_height, a + b,
-                    abs(a - b), 4.0 * a * b, abs(a - b) - REACH_TOL, a + b + REACH_TOL)
+                    abs(a - b), 4.0 * a * b, span.lo - REACH_TOL, span.hi + REACH_TOL,
+                    span.lo, span.hi)
 
-    def _arm(self, py: float) -> _Arm:
+    def _arm(self, py: float, span: Reach) -> _Arm:
         u, f = self._g.upper_arm, self._g.forearm
-        lo, hi, s = abs(u - f), u + f, abs(py)
-        far, near = hi, lo
-        return _Arm(py, py * py, lo, hi, (far - s) * (far + s), (s - near) * (s + near),
-                    4.0 * u * f, 2.0 * u, f - u, lo - REACH_TOL, hi + REACH_TOL)
+        far, near, s = u + f, abs(u - f), abs(py)
+        return _Arm(py, py * py, span.lo, span.hi, far, near, (far - s) * (far + s),
+                    (s - near) * (s + near), 4.0 * u * f, 2.0 * u, f - u,
+                    span.lo - REACH_TOL, span.hi + REACH_TOL)
 
     def _derive(self, p: GaitParams) -> _Derived:
         g = self._g
@@ -170,13 +178,17 @@ class TickKernel:
                          -hip_h + lift_l * down)
         w_r = (0.0 if ty < 0.0 else 1.0 if ty > 1.0 else ty) * down
         w_l = (0.0 if ty_l < 0.0 else 1.0 if ty_l > 1.0 else ty_l) * down
-        turn = (0.0 if not self._leg_yaw else p.turn if trim.turn == 0.0
+        turn = (p.turn if trim.turn == 0.0
                 else min(max(p.turn + trim.turn, TURN_RANGE[0]), TURN_RANGE[1]))
-        yaw_r = -0.5 * turn * tz
-        yaw_l = 0.5 * turn * tz
+        yaw_turn = turn if self._leg_yaw else 0.0
+        yaw_r = -0.5 * yaw_turn * tz
+        yaw_l = 0.5 * yaw_turn * tz
         r_rot = _rz_ry(yaw_r, d.neg_toe * ftau * w_r)
         l_rot = _rz_ry(yaw_l, d.neg_toe * -ftau * w_l)
-        if turn != 0.0:  # targets._yawed, with cos and sin of the yaw from the rotations
+        if not self._leg_yaw and p.turn != 0.0:   # 5-DoF: by step length, asked turn only
+            dx = stride_turn(p.turn, half_w, s * 0.5 * (abs(p.Slgt_R) + abs(p.Slgt_L))) * tz
+            rx_, lx_ = rx_ - dx, lx_ - dx
+        if yaw_turn != 0.0:  # targets._yawed, with cos and sin of the yaw from the rotations
             c, sn = r_rot[4], -r_rot[1]
             rx_, ry_ = c * rx_ - sn * ry_, sn * rx_ + c * ry_
             c, sn = l_rot[4], -l_rot[1]
@@ -191,7 +203,7 @@ class TickKernel:
                             _t_matmul(l_pel, l_rot))
         q += q_l
         ok = ok & ok_l
-        if self._arms:
+        if self._hands is not None:
             # -- hands relative to the shoulders, then the arms' IK ------------------------
             s_ar, s_al = sin(ph.arm_R), sin(ph.arm_L)
             if a != 1.0:
@@ -215,7 +227,7 @@ class TickKernel:
 
 def _leg_ik(k: _Leg, sole: tuple[float, float, float], f: Rot) -> tuple[list[float], bool]:
     """ik.leg_ik on floats: the six leg angles [rad] and the reachable flag."""
-    hx, hy, hz, a, b, ah, far, near, span, lo, hi = k
+    hx, hy, hz, a, b, ah, far, near, span, lo, hi, c_lo, c_hi = k
     f0, f1, f2, f3, f4, f5, f6, f7, f8 = f
     x = hx - (sole[0] + f2 * ah)   # ankle → hip
     y = hy - (sole[1] + f5 * ah)
@@ -225,6 +237,7 @@ def _leg_ik(k: _Leg, sole: tuple[float, float, float], f: Rot) -> tuple[list[flo
     rz = f2 * x + f5 * y + f8 * z
     c = sqrt(rx * rx + ry * ry + rz * rz)
     reachable = (c >= lo) & (c <= hi)
+    c = c_lo if c < c_lo else c_hi if c > c_hi else c
     s = abs(c)                       # ik.spans and ik.bend with t = 0
     out = (far - s) * (far + s) - 0.0
     out = 0.0 if out < 0.0 else span if out > span else out
@@ -253,18 +266,24 @@ def _leg_ik(k: _Leg, sole: tuple[float, float, float], f: Rot) -> tuple[list[flo
 def _arm_ik(k: _Arm, px: float, pz: float) -> tuple[list[float], bool]:
     """ik.arm_ik on floats for the hand at (px, k.py, pz) [m]: three arm angles [rad] and
     the reachable flag."""
-    py, py2, lo, hi, far_s, s_near, span, two_u, f_u, lo_tol, hi_tol = k
+    py, py2, lo, hi, far, near, far_s, s_near, span, two_u, f_u, lo_tol, hi_tol = k
     rho2 = px * px + pz * pz
     d = sqrt(rho2 + py2)
     dc = lo if d < lo else hi if d > hi else d
     kk = dc / (d if d > 1e-300 else 1e-300)
     y = py * kk
     y = -dc if y < -dc else dc if y > dc else y
-    t = sqrt(rho2)                   # ik.spans(u, f, py, t)
-    t2 = t * t
-    out = far_s - t2
+    t = sqrt(rho2)                   # ik.spans(u, f, py * kk, t * kk)
+    if kk == 1.0:                    # inside the reach: py's terms precomputed
+        t2 = t * t
+        out = far_s - t2
+        inn = s_near + t2
+    else:
+        sk, tk = abs(py * kk), t * kk
+        t2 = tk * tk
+        out = (far - sk) * (far + sk) - t2
+        inn = (sk - near) * (sk + near) + t2
     out = 0.0 if out < 0.0 else span if out > span else out
-    inn = s_near + t2
     inn = 0.0 if inn < 0.0 else span if inn > span else inn
     elbow = -2.0 * atan2(sqrt(out), sqrt(inn))
     vx = sqrt(out * inn) / two_u

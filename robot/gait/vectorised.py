@@ -25,22 +25,37 @@ import numpy.typing as npt
 from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.gait import expressions as gait
-from robot.gait.ik import arm_ik, leg_ik
+from robot.gait.ik import Reach, arm_ik, arm_reach, leg_ik, leg_reach
 from robot.gait.targets import BodyTargets, body_targets
 from robot.gait.xmath import Num
 
 #: Frames per chunk: a chunk's temporaries stay in the CPU's caches.
 CHUNK = 16384
-def solve(t: BodyTargets, robot: RobotConfig) -> tuple[list[Num], Num]:
-    """IK for every joint of ``robot`` (its joint order) and a reachable flag."""
+def spans(robot: RobotConfig) -> tuple[Reach, Reach, Reach | None, Reach | None]:
+    """What the right and left knee and elbow limits let each leg and arm span (ik.Reach;
+    no arms: None)."""
+    def limits(name: str) -> tuple[float, float]:
+        j = robot.joint(name)
+        return j.min_rad, j.max_rad
     g = robot.geometry
-    r = leg_ik(g, "r", t.r_sole, t.r_foot)
-    lft = leg_ik(g, "l", t.l_sole, t.l_foot)
+    r_leg, l_leg = (leg_reach(g, *limits(f"{s}_knee")) for s in "rl")
+    if not robot.has_arms:
+        return r_leg, l_leg, None, None
+    return r_leg, l_leg, arm_reach(g, *limits("r_elbow")), arm_reach(g, *limits("l_elbow"))
+
+
+def solve(t: BodyTargets, robot: RobotConfig) -> tuple[list[Num], Num]:
+    """IK for every joint of ``robot`` (its joint order) within what its knee and elbow
+    limits let the chains span (``spans``), and a reachable flag."""
+    g = robot.geometry
+    r_leg, l_leg, r_arm, l_arm = spans(robot)
+    r = leg_ik(g, "r", t.r_sole, t.r_foot, span=r_leg)
+    lft = leg_ik(g, "l", t.l_sole, t.l_foot, span=l_leg)
     q: list[Num] = [*r.q, *lft.q]
     ok = r.reachable & lft.reachable
     if robot.has_arms:
-        ra = arm_ik(g, t.r_hand)
-        la = arm_ik(g, t.l_hand)
+        ra = arm_ik(g, t.r_hand, span=r_arm)
+        la = arm_ik(g, t.l_hand, span=l_arm)
         q += [*ra.q, *la.q]
         ok = ok & ra.reachable & la.reachable
     layout = robot.layout

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import math
 from typing import Any
 
 from robot.bus.base import Bus
@@ -75,10 +76,31 @@ def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
                    recorder=recorder)
 
 
+#: A walk whose heading changes by more than this [deg per minute of the run] beyond what
+#: its ``turn`` asked for is flagged in its summary (``heading_drifts``).
+HEADING_DRIFT_DEG_MIN = 10.0
+
+
 def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *,
                  gait: str) -> dict[str, Any]:
     """The JSON object of `biped walk --json`: robot, gait, bus, seconds, balance, then
-    the result (RunResult.as_dict)."""
-    return {"robot": spec.robot.name, "gait": gait, "bus": spec.bus.kind,
-            "seconds": spec.options.seconds, "balance": spec.imu is not None,
-            **result.as_dict()}
+    the result (RunResult.as_dict) and, where the bus measured the heading (simulation),
+    the heading the gait asked for, the drift beyond it per minute and whether that is
+    more than ``HEADING_DRIFT_DEG_MIN``; the time [s, at the loop's rate] the IK met an
+    unreachable target (``ik_unreachable_s``) and each joint was held at a limit
+    (``clamped_joints_s``: only those that were)."""
+    out = {"robot": spec.robot.name, "gait": gait, "bus": spec.bus.kind,
+           "seconds": spec.options.seconds, "balance": spec.imu is not None,
+           **result.as_dict()}
+    engine, rate = spec.source, result.stats.rate_hz
+    out["ik_unreachable_s"] = engine.unreachable_ticks / rate if rate else 0.0
+    out["clamped_joints_s"] = {name: n / rate for name, n in
+                               zip(spec.robot.joint_names, engine.clamp_ticks, strict=True)
+                               if n and rate}
+    ran_min = result.stats.ticks / result.stats.rate_hz / 60.0 if result.stats.rate_hz else 0.0
+    if "heading_change_deg" in out and ran_min > 0.0:
+        asked = math.degrees(engine.asked_yaw)
+        drift = (float(out["heading_change_deg"]) - asked) / ran_min
+        out.update({"heading_asked_deg": asked, "heading_drift_deg_min": drift,
+                    "heading_drifts": abs(drift) > HEADING_DRIFT_DEG_MIN})
+    return out

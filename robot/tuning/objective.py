@@ -6,10 +6,14 @@ or the full one) in this process, one after the other, through the same run as t
 `biped walk --stop-on-fall` a user runs (robot.tuning.robustness.run_condition: in
 process, a typed result, no files), with balance on, and scores
 
-    score = survived + 0.9 * quality,   quality in [0, 1] from the flat walk:
+    score = walks x (conditions + 1) + survived + 0.9 * quality,
+    quality in [0, 1] from the flat walk:
     quality = 0.4 speed + 0.3 straightness + 0.15 (1 - knee load) + 0.15 energy
 
-so one more survived condition always outranks any gain in quality. The terms: speed
+where walks is 1 when the flat walk did not fall and kept at least ``WALK_SHARE`` of the
+target speed: a trial that creeps (or stands) cannot beat one that walks, whatever it
+survives; among walking trials one more survived condition always outranks any gain in
+quality. The terms: speed
 1 - |v - v_target| / v_target; straightness 1 - |heading| / 20 deg - |drift| /
 (0.2 distance); knee load its mean share of stall torque; energy 1 - (J/m) / (2 x the
 starting preset's J/m). A callback sees the running score after every condition (Optuna
@@ -29,6 +33,8 @@ from robot.errors import ConfigError
 from robot.tuning.robustness import Condition, Outcome, WalkJob, conditions, run_condition
 
 QUALITY_WEIGHT = 0.9
+#: A flat walk slower than this share of the target speed does not count as walking.
+WALK_SHARE = 0.8
 
 
 @dataclass(frozen=True)
@@ -56,6 +62,7 @@ class Evaluation:
     outcomes: list[Outcome] = field(default_factory=list)
     terms: dict[str, float] = field(default_factory=dict)
     score: float = 0.0
+    walking: bool = False
 
     @property
     def survived(self) -> int:
@@ -106,6 +113,21 @@ def quality(flat: dict[str, Any], setup: Setup) -> dict[str, float]:
     return {"speed": speed, "straight": straight, "knee": knee, "energy": energy}
 
 
+def walks(flat: dict[str, Any], setup: Setup) -> bool:
+    """The flat walk stayed up and kept ``WALK_SHARE`` of the target speed (any speed when
+    there is no target)."""
+    if not flat or flat.get("fell", True):
+        return False
+    target = setup.target_speed
+    return target is None or float(flat["speed_m_s"]) >= WALK_SHARE * target
+
+
+def score(survived: int, terms: dict[str, float], *, walking: bool, runs: int) -> float:
+    """The score of the module docstring for ``runs`` conditions in all."""
+    tier = float(runs + 1) if walking else 0.0
+    return tier + survived + (QUALITY_WEIGHT * combined(terms) if terms else 0.0)
+
+
 def combined(terms: dict[str, float]) -> float:
     return (0.4 * terms["speed"] + 0.3 * terms["straight"] + 0.15 * terms["knee"]
             + 0.15 * terms["energy"])
@@ -120,13 +142,14 @@ def evaluate(setup: Setup, params: GaitParams, *,
     """Walk ``params`` through the suite. report(step, running score) after each
     condition may raise to stop early (a pruned trial)."""
     ev = Evaluation()
-    for step, c in enumerate(suite_for(setup, params)):
+    suite = suite_for(setup, params)
+    for step, c in enumerate(suite):
         ev.outcomes.append(run_condition(WalkJob(setup.robot, CANDIDATE, params,
                                                  setup.seconds, c, balance=True)))
         if c.group == "flat":
             ev.terms = quality(ev.outcomes[-1].summary, setup)
-        ev.score = ev.survived + QUALITY_WEIGHT * combined(ev.terms) if ev.terms else \
-            float(ev.survived)
+            ev.walking = walks(ev.outcomes[-1].summary, setup)
+        ev.score = score(ev.survived, ev.terms, walking=ev.walking, runs=len(suite))
         if report is not None:
             report(step, ev.score)
     return ev

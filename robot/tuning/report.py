@@ -5,16 +5,18 @@ group, and the optimisation history and parameter importance as PNGs."""
 from __future__ import annotations
 
 import json
+import math
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import optuna
 
 from robot.config.gait_file import Gait, gait_to_toml, load_gait
 from robot.config.params import SPECS, GaitParams
 from robot.errors import ConfigError
+from robot.tuning.objective import WALK_SHARE
 from robot.tuning.space import Knob
 
 
@@ -42,10 +44,29 @@ def group_survival(runs_json: str, groups: dict[str, str]) -> dict[str, tuple[in
     return out
 
 
+class WalkFigures(NamedTuple):
+    """The flat walk's speeds [m/s]: the target, the starting preset's and the tuned
+    one's (None: none, or it fell)."""
+
+    target: float | None
+    start: float | None
+    best: float | None
+
+
+def cadence(p: GaitParams) -> float:
+    """Steps per minute (two per gait cycle)."""
+    return 120.0 / p.cycle_s if math.isfinite(p.cycle_s) and p.cycle_s > 0 else 0.0
+
+
+def _speed(v: float | None) -> str:
+    return "fell" if v is None else f"{v:.3f}"
+
+
 def format_report(knobs: Sequence[Knob], start: GaitParams, best: GaitParams,
                   start_score: float, best_score: float | None,
                   start_groups: dict[str, tuple[int, int]],
-                  best_groups: dict[str, tuple[int, int]]) -> str:
+                  best_groups: dict[str, tuple[int, int]], *,
+                  walk: WalkFigures | None = None) -> str:
     lines = [f"{'parameter':<18}{'start':>12}{'tuned':>12}  unit      range searched",
              "-" * 66]
     for k in knobs:
@@ -53,12 +74,20 @@ def format_report(knobs: Sequence[Knob], start: GaitParams, best: GaitParams,
         lines.append(f"{k.name:<18}{getattr(start, t):>12.4g}{getattr(best, t):>12.4g}  "
                      f"{SPECS[t].unit:<9} [{k.lo:.4g}, {k.hi:.4g}]")
     best_text = "-" if best_score is None else f"{best_score:.3f}"
-    lines += ["", f"score (survived + 0.9 x quality): start {start_score:.3f}, tuned "
+    lines += ["", f"score (walks x (runs + 1) + survived + 0.9 x quality): start {start_score:.3f}, tuned "
               f"{best_text}", "", f"{'condition':<18}{'start':>10}{'tuned':>10}",
               "-" * 38]
     for g in dict.fromkeys([*start_groups, *best_groups]):
         s, b = start_groups.get(g, (0, 0)), best_groups.get(g, (0, 0))
         lines.append(f"{g:<18}{s[0]:>6}/{s[1]:<3}{b[0]:>6}/{b[1]:<3}")
+    if walk is not None:
+        target = ("none (no reference)" if walk.target is None else
+                  f"{walk.target:.3f} m/s, walking from {WALK_SHARE * walk.target:.3f}")
+        lines += [f"{'speed m/s (flat)':<18}{_speed(walk.start):>10}{_speed(walk.best):>10}"
+                  f"  target {target}",
+                  f"{'cadence steps/min':<18}{cadence(start):>10.1f}{cadence(best):>10.1f}",
+                  f"{'crouch (stance)':<18}{start.stance:>10.3f}{best.stance:>10.3f}"
+                  "  hip height / leg length"]
     return "\n".join(lines)
 
 
@@ -91,7 +120,7 @@ def plot_study(study: optuna.Study, prefix: str | Path, *,
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ax: Any = ovm.plot_optimization_history(study)
-        ax.set_ylabel("score (survived + 0.9 x quality)")
+        ax.set_ylabel("score (walks x (runs + 1) + survived + 0.9 x quality)")
         ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         if start_score is not None:
             ax.axhline(start_score, color="tab:green", ls="--", lw=1.2,

@@ -28,15 +28,18 @@ import optuna
 
 from robot.config.params import GaitParams
 from robot.errors import ConfigError
+from robot.tuning.conditions import Condition
 from robot.tuning.objective import (
-    QUALITY_WEIGHT,
+    CANDIDATE,
     Evaluation,
     Setup,
-    combined,
     evaluate,
     quality,
+    score,
     summary_json,
+    walks,
 )
+from robot.tuning.robustness import WalkJob, run_condition
 from robot.tuning.space import Knob, apply
 
 log = logging.getLogger(__name__)
@@ -100,8 +103,16 @@ def objective(plan: Plan) -> Callable[[optuna.Trial], float]:
         trial.set_user_attr("runs", summary_json(ev))
         trial.set_user_attr("survived", ev.survived)
         trial.set_user_attr("terms", ev.terms)
+        trial.set_user_attr("speed_m_s", trial_speed(ev))
+        trial.set_user_attr("walking", ev.walking)
         return ev.score
     return run
+
+
+def trial_speed(ev: Evaluation) -> float | None:
+    """The flat walk's speed [m/s] (None: it fell or did not run)."""
+    flat = ev.flat
+    return None if not flat or flat.get("fell", True) else float(flat["speed_m_s"])
 
 
 def work(plan: Plan, worker: int = 0, parent: int | None = None, *,
@@ -172,23 +183,42 @@ def best_trial(study: optuna.Study) -> optuna.trial.FrozenTrial | None:
                default=None)
 
 
+def flat_speed(robot: str, params: GaitParams, seconds: float) -> float | None:
+    """The speed [m/s] of ``params``' flat walk on ``robot`` (balance on), None if it
+    fell: a fallen run's speed is no reference."""
+    flat = run_condition(WalkJob(robot, CANDIDATE, params, seconds, Condition("flat", "flat"),
+                                 balance=True)).summary
+    return None if not flat or flat.get("fell", True) else float(flat["speed_m_s"])
+
+
 def references(study: optuna.Study, setup: Setup, start: GaitParams,
-               *, target_speed: float | None) -> tuple[Setup, dict[str, Any]]:
+               *, target_speed: float | None,
+               made_for: tuple[str, GaitParams] | None = None) -> tuple[Setup, dict[str, Any]]:
     """The setup with its quality references and the starting preset's evaluation, both
     kept in the study: measured once (the starting preset through the suite), read back
-    when the study is resumed, so every trial of a study is scored alike."""
+    when the study is resumed, so every trial of a study is scored alike.
+
+    The target speed: ``target_speed`` (--speed), else the starting preset's flat speed on
+    the robot it was made for (``made_for``: robot and the preset's parameters there;
+    None: the robot being tuned), never a fallen run's (then no target: a warning)."""
     kept = study.user_attrs.get("reference")
     if kept is None:
         ev = evaluate(setup, start)
         flat = ev.flat
-        speed = target_speed if target_speed is not None else (
-            float(flat["speed_m_s"]) if flat and not flat.get("fell") else None)
+        speed = target_speed
+        if speed is None:
+            speed = (flat_speed(*made_for, setup.seconds) if made_for is not None
+                     else float(flat["speed_m_s"]) if flat and not flat.get("fell") else None)
+            if speed is None:
+                log.warning("no target speed: the starting preset fell on the flat on %s; "
+                            "give --speed", made_for[0] if made_for else setup.robot)
         energy = flat.get("energy_per_m") if flat and not flat.get("fell") else None
         ref_setup = Setup(setup.robot, setup.suite, setup.seconds, speed, energy, setup.skip)
-        score = ev.survived + QUALITY_WEIGHT * combined(quality(flat, ref_setup))
-        kept = {"target_speed": speed, "baseline_energy": energy, "score": score,
+        kept = {"target_speed": speed, "baseline_energy": energy,
+                "score": score(ev.survived, quality(flat, ref_setup),
+                               walking=walks(flat, ref_setup), runs=len(ev.outcomes)),
                 "runs": summary_json(ev), "survived": ev.survived, "runs_total":
-                len(ev.outcomes)}
+                len(ev.outcomes), "speed_m_s": trial_speed(ev)}
         study.set_user_attr("reference", kept)
     ref = Setup(setup.robot, setup.suite, setup.seconds, kept["target_speed"],
                 kept["baseline_energy"], setup.skip)

@@ -24,6 +24,7 @@ from sim.emulator import dxl1_protocol, dxl_protocol, lx_protocol, sts_protocol
 from sim.emulator.line import Line, Outbox, pty_speed
 from sim.emulator.records import ChainSpec, EmulatorError, Packet
 from sim.emulator.servo import EmulatedServo
+from sim.emulator.servo_dynamics import ServoDynamics
 
 __all__ = ["ChainSpec", "EmulatorError", "Packet", "child_main"]
 
@@ -53,6 +54,8 @@ class _ChainServer:
         now = time.monotonic()
         servo_class = getattr(self.codec, "SERVO", EmulatedServo)  # LX: no control table
         self.servos = [servo_class(s, now) for s in spec.servos]
+        for servo, model in zip(self.servos, spec.dynamics, strict=False):
+            servo.dynamics = None if model is None else ServoDynamics(model)
         self.plugged: set[int] = set(range(len(self.servos)) if spec.plugged is None
                                      else spec.plugged)
         self.rng = random.Random(spec.seed)
@@ -198,7 +201,10 @@ class _ChainServer:
         if cmd == "registers_of":
             return self.advance(self.servos[args[0]]).snapshot()
         if cmd == "set_register":
-            return self.advance(self.by_id(args[0])).set(args[1], args[2])
+            s = self.advance(self.by_id(args[0]))
+            if s.dynamics is not None:
+                s.dynamics.pinned.add(args[1])     # a read-back set by hand stays as set
+            return s.set(args[1], args[2])
         raise EmulatorError(f"unknown emulator request {cmd!r}")
 
     def advance(self, s: EmulatedServo) -> EmulatedServo:

@@ -5,10 +5,8 @@ The servo is protocol-agnostic: ``sim.emulator.dispatch`` calls :meth:`EmulatedS
 :meth:`EmulatedServo.write` (checked in ``sim.emulator.servo_write``) with raw addresses and bytes,
 and the instruction methods (reg write / action, reboot, factory reset, clear multi-turn).
 Power: EEPROM (below ``EEPROM_END``) survives unplugging; RAM comes back at its power-on
-values (a reboot is the same).
-Motion is evaluated lazily: call :meth:`EmulatedServo.update` with the current time [s]
-before touching the table; present position then moves toward goal position
-(``sim.emulator.servo_motion``) while torque is enabled.
+values (a reboot is the same). Motion is lazy: :meth:`EmulatedServo.update` (a time [s])
+moves it by its model (``sim.emulator.servo_motion``, ``servo_dynamics``) to that time.
 
 Communication watchdog (``servo_status.BUS_WATCHDOG``): the chain calls
 :meth:`EmulatedServo.hear` for every instruction packet addressed to the servo (its id,
@@ -22,6 +20,7 @@ from dataclasses import dataclass
 
 from sim.emulator import servo_motion, servo_write
 from sim.emulator.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, UNPRINTED, Entry
+from sim.emulator.servo_dynamics import ServoDynamics
 from sim.emulator.servo_models import MODELS
 from sim.emulator.servo_state import WriteError
 from sim.emulator.servo_status import BUS_WATCHDOG, ERROR_BITS, RETURN_DELAY_UNIT_S
@@ -46,7 +45,9 @@ class ServoSpec:
 
 
 class EmulatedServo:
-    """Control table plus a first-order position model for one servo."""
+    """Control table plus the motion of one servo (``dynamics``: its model, set by the chain)."""
+
+    dynamics: ServoDynamics | None = None
 
     def __init__(self, spec: ServoSpec, now: float) -> None:
         self.spec = spec
@@ -57,6 +58,7 @@ class EmulatedServo:
         self.mem = bytearray(max(r.address + r.size for r in self.table.values()))
         self.owner = bytearray(len(self.mem))  # 0: no register; else index+1
         self.regs = list(self.table.items())
+        self.names = frozenset(self.table)
         for i, (_, reg) in enumerate(self.regs):
             self.owner[reg.address:reg.address + reg.size] = bytes([i + 1]) * reg.size
         self.conditions: set[str] = set()   # injected hardware faults (names of ERROR_BITS)

@@ -1,4 +1,8 @@
-"""The emulated servo's motion: constant-speed travel toward the goal while torque is on.
+"""The emulated servo's motion and what it reports of it.
+
+A servo with a model (``sim.emulator.servo_dynamics``: every servo of a chain the emulator
+builds, LX aside) moves by it; it is "moving" while its speed exceeds one position step
+per ``MOVING_WINDOW_S``. Without one: constant-speed travel toward the goal while torque is on.
 
 Speed: the model's no-load speed, or slower when the host set one: Dynamixel X Profile
 Velocity(112) (0.229 rev/min per unit, 0 = no limit; X manual), Feetech STS Goal Speed(46)
@@ -23,6 +27,7 @@ P1_SPEED_MASK = 0x3FF
 P1_DIRECTION_BIT = 0x400
 MOVING_IN_POSITION = 0x01
 MOVING_PROFILE_ONGOING = 0x02
+MOVING_WINDOW_S = 0.1          # [s] (see the module docstring)
 
 
 def dxl_velocity_unit_ticks_s(resolution: int) -> float:
@@ -51,7 +56,11 @@ def advance(servo: ServoState, pos: float, dt: float) -> float:
     goal = servo.get("goal_position")
     torque = bool(servo.get("torque_enable"))
     velocity = 0.0
-    if torque and not servo.stuck and dt > 0:
+    dynamics = servo.dynamics
+    if dynamics is not None:
+        pos, velocity = dynamics.advance(servo, pos, dt)
+        dynamics.report(servo, servo.names)
+    elif torque and not servo.stuck and dt > 0:
         speed = speed_ticks_s(servo)
         step = speed * dt
         pos = min(goal, pos + step) if goal > pos else max(goal, pos - step)
@@ -59,7 +68,8 @@ def advance(servo: ServoState, pos: float, dt: float) -> float:
             velocity = speed if goal > pos else -speed
     present = round(pos)
     servo.set_raw("present_position", present)
-    moving = present != goal and torque
+    moving = (present != goal and torque if dynamics is None
+              else abs(velocity) * MOVING_WINDOW_S > 1.0)
     servo.set("moving", int(moving))
     if servo.family == "dynamixel_x":
         servo.set("present_velocity",

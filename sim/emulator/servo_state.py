@@ -10,6 +10,7 @@ import enum
 from typing import Protocol
 
 from sim.emulator.control_tables import DXL_SIGNED, TABLES, Entry
+from sim.emulator.servo_dynamics import ServoDynamics
 from sim.emulator.servo_models import ServoModel
 from sim.emulator.servo_status import BusWatchdog
 
@@ -42,6 +43,9 @@ class ServoState(Protocol):
     regs: list[tuple[str, Entry]]
     eeprom_end: int
     watchdog: BusWatchdog | None
+    #: the servo model moving it (None: constant-speed travel); its table's register names
+    dynamics: ServoDynamics | None
+    names: frozenset[str]
 
     @property
     def watchdog_tripped(self) -> bool: ...

@@ -18,6 +18,8 @@ from typing import Any
 import dynamixel_sdk as dxl
 import pytest
 import scservo_sdk as scs
+import sdk_link
+from sdk_link import ok
 from sdk_timeouts import allow_slow_replies
 
 from sim.emulator.chain import Emulator
@@ -49,15 +51,8 @@ def watchdog() -> Iterator[None]:
 
 
 def served(protocol: str) -> Iterator[tuple[Emulator, Any, Any]]:
-    """Three servos (ids 1-3, 1 Mbps) and an open SDK port with its packet handler. The
-    horns travel at constant speed onto their goals (``motion="travel"``): these tests are
-    about the SDKs' features and the registers' meaning, and want exact positions."""
-    sdk: Any = dxl if protocol == "dynamixel" else scs
-    with Emulator(protocol, ids=IDS, baud=BAUD, motion="travel") as emu:
-        port = sdk.PortHandler(emu.port)
-        assert port.openPort() and port.setBaudRate(BAUD)
-        yield emu, port, (dxl.PacketHandler(2.0) if sdk is dxl else scs.PacketHandler(0))
-        port.closePort()
+    """Three servos (ids 1-3, 1 Mbps) and an open SDK port with its packet handler."""
+    yield from sdk_link.served(protocol, IDS, BAUD)
 
 
 @pytest.fixture
@@ -77,13 +72,6 @@ def until(cond: Callable[[], bool], seconds: float = 5.0) -> bool:
             return True
         time.sleep(0.02)
     return False
-
-
-def ok(result: tuple[Any, ...]) -> Any:
-    """The value of an SDK ``(value, comm, error)`` read that must succeed cleanly."""
-    value, comm, error = result
-    assert (comm, error) == (0, 0)
-    return value
 
 
 def signed32(v: int) -> int:
@@ -304,8 +292,8 @@ def test_sts_status_return_level_zero_still_answers_reads(
 
 
 def test_multi_port_two_chains_at_once() -> None:
-    with Emulator("dynamixel", ids=[1], baud=BAUD, motion="travel") as a, \
-            Emulator("dynamixel", ids=[2], baud=57600, motion="travel") as b:
+    with Emulator("dynamixel", ids=[1], baud=BAUD) as a, \
+            Emulator("dynamixel", ids=[2], baud=57600) as b:
         ports = [dxl.PortHandler(a.port), dxl.PortHandler(b.port)]
         ph = dxl.PacketHandler(2.0)
         for port, baud in zip(ports, (BAUD, 57600), strict=True):

@@ -76,7 +76,7 @@ class Emulator:
     def __init__(self, protocol: str, robot: RobotConfig | None = None, *,
                  ids: Sequence[int] | None = None, model: str | None = None, seed: int = 0,
                  baud: int | None = None, loads: Mapping[int, BenchLoad] | None = None,
-                 motion: str = "model") -> None:
+                 motion: str = "travel") -> None:
         choice = plan_chain(protocol, robot, ids=ids, model=model, baud=baud, loads=loads,
                             motion=motion)
         self.protocol = protocol
@@ -111,8 +111,8 @@ class Emulator:
 
         The child is a fresh interpreter (``python -c``), not a ``multiprocessing`` spawn,
         so callers need no ``if __name__ == "__main__"`` guard; the control channel is a
-        socketpair wrapped in a ``multiprocessing`` Connection.
-        """
+        socketpair in a ``multiprocessing`` Connection. It runs in ``ROOT`` (``-c`` puts the
+        working directory first on sys.path, where another checkout's ``sim`` may be)."""
         if self._port is not None:
             return self._port
         parent_sock, child_sock = socket.socketpair()
@@ -122,7 +122,7 @@ class Emulator:
             p for p in (str(ROOT), env.get("PYTHONPATH", "")) if p)
         self._proc = subprocess.Popen(
             [sys.executable, "-c", f"import sim.emulator.server as s; s.child_main({fd})"],
-            pass_fds=[fd], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, env=env)
+            pass_fds=[fd], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, env=env, cwd=ROOT)
         child_sock.close()
         self._conn = Connection(parent_sock.detach())
         try:

@@ -68,7 +68,7 @@ def _limits(robot: RobotConfig | None, servo_id: int, model: str) -> tuple[int, 
 
 def plan_chain(protocol: str, robot: RobotConfig | None, *, ids: Sequence[int] | None,
                model: str | None, baud: int | None,
-               loads: Mapping[int, BenchLoad] | None = None, motion: str = "model"
+               loads: Mapping[int, BenchLoad] | None = None, motion: str = "travel"
                ) -> ChainChoice:
     """The chain ``Emulator(protocol, robot, ids=, model=, baud=)`` serves; EmulatorError
     (one line, naming the argument and its valid values) when something does not fit."""
@@ -108,7 +108,7 @@ def factory_servos(protocol: str, servos: Sequence[ServoSpec]) -> tuple[ServoSpe
 
 
 def plan_dynamics(protocol: str, robot: RobotConfig | None, servos: Sequence[ServoSpec],
-                  loads: Mapping[int, BenchLoad], *, motion: str = "model"
+                  loads: Mapping[int, BenchLoad], *, motion: str = "travel"
                   ) -> tuple[DynamicsSpec | None, ...]:
     """Each servo's model (``sim.emulator.servo_dynamics``): its physics and supply from the
     robot file where a joint has its id (the model file it names, ``bus.voltage``), else its

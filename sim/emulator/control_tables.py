@@ -15,7 +15,8 @@ or 0). EEPROM is every address below ``EEPROM_END`` (saved over power-off), RAM 
 - MX-28 on Protocol 1.0 firmware: ROBOTIS e-Manual, MX-28 control table
   (https://emanual.robotis.com/docs/en/dxl/mx/mx-28/#control-table): the AX layout with
   D/I/P Gain at 26/27/28 where the AX has compliance margins and slopes.
-- Feetech STS: Feetech "STS series memory table" (FT-SMS-STS-emanual, STS3215 column).
+- Feetech STS: Feetech "STS series memory table" (FT-SMS-STS-emanual, STS3215 column);
+  Torque switch(40) takes 0, 1 and 128 ("arbitrary current position correction to 2048").
 """
 
 from __future__ import annotations
@@ -215,6 +216,16 @@ FEETECH_STS: dict[str, Entry] = {
     "status": Entry(65, 1, "R", 0),
     "moving": Entry(66, 1, "R", 0),
     "present_current": Entry(69, 2, "R", None),
+    # Factory parameters (memory table section 2.5; addresses and names as LeRobot's
+    # STS_SMS_SERIES_CONTROL_TABLE lists them): no initial values printed in a
+    # transcription we could read, so the emulator serves 0 until written. RAM here.
+    "moving_velocity_threshold": Entry(80, 1, "RW", None),
+    "dts": Entry(81, 1, "RW", None),                  # [ms]
+    "velocity_unit_factor": Entry(82, 1, "RW", None),
+    "hts": Entry(83, 1, "RW", None),                  # [ns], firmware >= 2.54
+    "maximum_velocity_limit": Entry(84, 1, "RW", None),
+    "maximum_acceleration": Entry(85, 1, "RW", None),
+    "acceleration_multiplier": Entry(86, 1, "RW", None),   # in effect when Acceleration is 0
 }
 
 #: Control tables by layout: a family's own (its key), or a model's where it differs

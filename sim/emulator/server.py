@@ -202,9 +202,7 @@ class _ChainServer:
             return self.advance(self.servos[args[0]]).snapshot()
         if cmd == "set_register":
             s = self.advance(self.by_id(args[0]))
-            if s.dynamics is not None:
-                s.dynamics.pinned.add(args[1])     # a read-back set by hand stays as set
-            return s.set(args[1], args[2])
+            return getattr(s, "pin", s.set)(args[1], args[2])   # LX servos compute none
         raise EmulatorError(f"unknown emulator request {cmd!r}")
 
     def advance(self, s: EmulatedServo) -> EmulatedServo:

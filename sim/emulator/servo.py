@@ -1,29 +1,36 @@
 """One emulated servo: a control table (bytearray) laid out by ``sim.emulator.control_tables``
-(the manuals' tables, initial values included).
+(the manuals' tables, initial values included), and where its horn is (``horn`` [ticks]).
 
-The servo is protocol-agnostic: ``sim.emulator.dispatch`` calls :meth:`EmulatedServo.read` /
-:meth:`EmulatedServo.write` (checked in ``sim.emulator.servo_write``) with raw addresses and bytes,
-and the instruction methods (reg write / action, reboot, factory reset, clear multi-turn).
-Power: EEPROM (below ``EEPROM_END``) survives unplugging; RAM comes back at its power-on
-values (a reboot is the same). Motion is lazy: :meth:`EmulatedServo.update` (a time [s])
-moves it by its model (``sim.emulator.servo_motion``, ``servo_dynamics``) to that time.
-
-Communication watchdog (``servo_status.BUS_WATCHDOG``): the chain calls
-:meth:`EmulatedServo.hear` for every instruction packet addressed to the servo (its id,
-broadcast, or listed in a sync/bulk packet); :meth:`update` trips it (goal := present where
-the gap ran out, register -1, goal writes refused) and leaves torque as it was.
+Protocol-agnostic: ``sim.emulator.dispatch`` calls :meth:`EmulatedServo.read` / :meth:`write`
+(checked and applied in ``servo_write``) with raw addresses and bytes, and the instruction
+methods (reg write / action, reboot, factory reset, clear multi-turn). EEPROM (below
+``EEPROM_END``) survives unplugging; RAM comes back at its power-on values (so does a
+reboot). Motion is lazy: :meth:`update` with the time [s] before touching the table moves
+the horn by its operating mode (``servo_motion``; in a position mode by the servo model,
+``dynamics``, set by the chain) and refreshes the read-back registers.
+Communication watchdog (``servo_status.BUS_WATCHDOG``): the chain calls :meth:`hear` for
+every instruction packet addressed to the servo (its id, broadcast, or listed in a
+sync/bulk packet); :meth:`update` trips it (goal := present where the gap ran out, register
+-1, goal writes refused) and leaves torque as it was.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from sim.emulator import servo_motion, servo_write
+from sim.emulator import servo_frame, servo_indirect, servo_motion, servo_write
 from sim.emulator.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, UNPRINTED, Entry
 from sim.emulator.servo_dynamics import ServoDynamics
 from sim.emulator.servo_models import MODELS
 from sim.emulator.servo_state import WriteError
 from sim.emulator.servo_status import BUS_WATCHDOG, ERROR_BITS, RETURN_DELAY_UNIT_S
+
+#: The registers that hold a family's position limits (low, high).
+POSITION_LIMITS: dict[str, tuple[str, str]] = {
+    "dynamixel_x": ("min_position_limit", "max_position_limit"),
+    "dynamixel_p1": ("cw_angle_limit", "ccw_angle_limit"),
+    "feetech_sts": ("min_angle_limit", "max_angle_limit"),
+}
 
 
 @dataclass(frozen=True)
@@ -45,7 +52,7 @@ class ServoSpec:
 
 
 class EmulatedServo:
-    """Control table plus the motion of one servo (``dynamics``: its model, set by the chain)."""
+    """Control table plus the horn's motion model for one servo."""
 
     dynamics: ServoDynamics | None = None
 
@@ -58,7 +65,8 @@ class EmulatedServo:
         self.mem = bytearray(max(r.address + r.size for r in self.table.values()))
         self.owner = bytearray(len(self.mem))  # 0: no register; else index+1
         self.regs = list(self.table.items())
-        self.names = frozenset(self.table)
+        self._slots = {n: (e.address, e.address + e.size, self.family == "dynamixel_x" and n in
+                           DXL_SIGNED, 1 << 8 * e.size) for n, e in self.regs}   # get / set_raw
         for i, (_, reg) in enumerate(self.regs):
             self.owner[reg.address:reg.address + reg.size] = bytes([i + 1]) * reg.size
         self.conditions: set[str] = set()   # injected hardware faults (names of ERROR_BITS)
@@ -75,15 +83,13 @@ class EmulatedServo:
         values.update(model_number=self.model.number, id=spec.servo_id,
                       baud_rate=codes[spec.baud], return_delay_time=spec.return_delay,
                       present_position=spec.zero_ticks, goal_position=spec.zero_ticks)
-        if self.family == "dynamixel_x":
-            values.update(max_position_limit=spec.max_ticks, min_position_limit=spec.min_ticks)
-        elif self.family == "dynamixel_p1":
-            values.update(ccw_angle_limit=spec.max_ticks, cw_angle_limit=spec.min_ticks)
-        else:
-            values.update(max_angle_limit=spec.max_ticks, min_angle_limit=spec.min_ticks)
+        low, high = POSITION_LIMITS[self.family]
+        values.update({low: spec.min_ticks, high: spec.max_ticks})
         for name, v in values.items():
             self.set(name, v)
-        self._pos = float(spec.zero_ticks)
+        self.horn = float(spec.zero_ticks)     # where the horn is [ticks, actual]
+        self.step_target = self.horn            # STS step mode's target [ticks, actual]
+        self.pinned: dict[str, int] = {}        # back-door values motion must not overwrite
         self._t = now
         self.watchdog = BUS_WATCHDOG[self.family]
         self.heard = now    # time of the last instruction packet addressed to this servo [s]
@@ -93,29 +99,31 @@ class EmulatedServo:
         self.pending: tuple[int, bytes] | None = None     # a Reg Write waiting for Action
         self._registered = {"dynamixel_x": "registered_instruction",
                             "dynamixel_p1": "registered"}.get(self.family, "async_write_flag")
-        # Indirect Data address -> name of the Indirect Address register pointing it (X).
-        self._indirect = {e.address: name.replace("data", "address")
-                          for name, e in self.table.items() if name.startswith("indirect_data")}
+        self._indirect = servo_indirect.indirect_map(self.table)   # X only
 
-    # ------------------------------------------------------------------ raw access
     def get(self, name: str) -> int:
         """Value of a register by name (signed where the Dynamixel table says so)."""
-        reg = self.table[name]
-        signed = self.family == "dynamixel_x" and name in DXL_SIGNED
-        return int.from_bytes(self.mem[reg.address:reg.address + reg.size], "little",
-                              signed=signed)
+        start, end, signed, _ = self._slots[name]
+        return int.from_bytes(self.mem[start:end], "little", signed=signed)
 
     def set_raw(self, name: str, value: int) -> None:
         """Store a register by name, leaving the position model alone."""
-        reg = self.table[name]
-        self.mem[reg.address:reg.address + reg.size] = (value % (1 << 8 * reg.size)).to_bytes(
-            reg.size, "little")
+        start, end, _, modulus = self._slots[name]
+        self.mem[start:end] = (value % modulus).to_bytes(end - start, "little")
 
     def set(self, name: str, value: int) -> None:
-        """Store a register by name without any check (the emulator's back door)."""
+        """Store a register by name without any check (the emulator's back door).
+        ``present_position`` places the horn where the servo then reads ``value``."""
         self.set_raw(name, value)
+        self._idle = False      # at rest with nothing set since the last motion step: False
         if name == "present_position":
-            self._pos = float(self.get(name))
+            self.horn = float(servo_frame.actual_goal(self, self.get(name)))
+            self.step_target = self.horn
+
+    def pin(self, name: str, value: int) -> None:
+        """Back door: store ``value``; a register motion computes then keeps it."""
+        self.set(name, value)
+        self.pinned.update({name: value} if name in servo_motion.COMPUTED else {})
 
     def snapshot(self) -> dict[str, int]:
         return {name: self.get(name) for name in self.table}
@@ -160,14 +168,27 @@ class EmulatedServo:
             self.get(wd.register), torque_on=bool(self.get("torque_enable")), heard=self.heard)
         if wd is not None and deadline is not None and deadline < min(now, quiet_until):
             self._advance(max(deadline, self._t))
-            self.set("goal_position", round(self._pos))   # stop where it is
+            self.hold()                                                      # stop there
+            for name in ("goal_velocity", "goal_pwm"):     # in every mode (X: the one with it)
+                self.set_raw(name, 0)
             self.set(wd.register, wd.tripped)
         self._advance(now)
 
     def _advance(self, now: float) -> None:
         dt = max(0.0, now - self._t)
         self._t = now
-        self._pos = servo_motion.advance(self, self._pos, dt)
+        if self._idle:           # at rest and nothing set since: the registers hold
+            return
+        self.horn = servo_motion.advance(self, self.horn, dt)
+        for name, value in self.pinned.items():
+            self.set_raw(name, value)
+        self._idle = not self.get("moving") and (self.dynamics is None or self.dynamics.resting)
+
+    def hold(self) -> None:
+        """Goal := where the horn is (after a reset, power-on, mode change, multi-turn clear)."""
+        self.set_raw("goal_position", servo_frame.goal_for(self, self.horn))
+        self.step_target, self._idle = self.horn, False
+        self._advance(self._t)
 
     def _assert_faults(self) -> None:
         bits = {name: bit for bit, name in ERROR_BITS[self.family].items()}
@@ -182,7 +203,7 @@ class EmulatedServo:
         if self.family == "dynamixel_p1":
             self._p1_errors = value
             return
-        self.set(self.error_register, value)
+        self.set_raw(self.error_register, value)
 
     @property
     def error_bits(self) -> int:
@@ -200,7 +221,7 @@ class EmulatedServo:
             return None
         out = bytearray(self.mem[address:address + length])
         for i in range(length):
-            target = self._indirect_target(address + i)
+            target = servo_indirect.target(self._indirect, self.get, address + i)
             if target is not None:
                 out[i] = self.mem[target]
         return bytes(out)
@@ -209,32 +230,19 @@ class EmulatedServo:
         """Apply a host write if every byte lands in whole, writable registers (Indirect
         Data bytes land where their Indirect Address points); all or nothing."""
         plans = []
-        for run_address, run in self._runs(address, data):
+        for run_address, run in servo_indirect.runs(self._indirect, self.get, address, data):
             err, values = servo_write.plan(self, run_address, run)
             if err is not WriteError.NONE:
                 return err
             plans.append(values)
         for values in plans:
             servo_write.apply(self, values)
+        if any(v.get("torque_enable") == servo_write.STS_CENTRE_COMMAND for v in plans):
+            a, n = self.table["homing_offset"][:2]     # the firmware saves its new offset
+            self._saved = self._saved[:a] + bytes(self.mem[a:a + n]) + self._saved[a + n:]
         if address < self.eeprom_end and self._keeps_eeprom():
             self._saved = bytes(self.mem[:self.eeprom_end])
         return WriteError.NONE
-
-    def _indirect_target(self, address: int) -> int | None:
-        name = self._indirect.get(address)
-        return None if name is None else self.get(name)
-
-    def _runs(self, address: int, data: bytes) -> list[tuple[int, bytes]]:
-        """The write as (address, bytes) runs after indirect translation."""
-        runs: list[tuple[int, bytearray]] = []
-        for i, b in enumerate(data):
-            target = self._indirect_target(address + i)
-            a = address + i if target is None else target
-            if runs and runs[-1][0] + len(runs[-1][1]) == a:
-                runs[-1][1].append(b)
-            else:
-                runs.append((a, bytearray([b])))
-        return [(a, bytes(d)) for a, d in runs] or [(address, b"")]
 
     # ------------------------------------------------------------------ instructions
     def reg_write(self, address: int, data: bytes) -> WriteError:
@@ -255,22 +263,19 @@ class EmulatedServo:
         """X Factory Reset: 0xFF everything, 0x01 all but ID, 0x02 all but ID and baud."""
         keep = {0x01: ("id",), 0x02: ("id", "baud_rate")}.get(option, ())
         kept = {name: self.get(name) for name in keep}
-        pos = round(self._pos)
         for name, e in self.table.items():
             self.set_raw(name, e.initial if e.initial is not None else 0)
         for name, v in {**UNPRINTED[self.model.layout], **self.model.initial,
                         "model_number": self.model.number, **kept}.items():
             self.set_raw(name, v)
         self._saved = bytes(self.mem[:self.eeprom_end])
-        self.set("present_position", pos)
-        self.set("goal_position", pos)
+        self.hold()
 
     def clear_multi_turn(self) -> None:
         """X Clear (multi-turn): present position back within one turn, while stopped."""
         if not self.get("moving"):
-            pos = round(self._pos) % self.model.resolution
-            self.set("present_position", pos)
-            self.set("goal_position", pos)
+            self.horn = float(round(self.horn) % self.model.resolution)
+            self.hold()
 
     def _keeps_eeprom(self) -> bool:
         """Whether an EEPROM write survives power-off: always on Dynamixel X; on Feetech
@@ -285,11 +290,10 @@ class EmulatedServo:
     def power_on(self, now: float) -> None:
         """Plugged in again: EEPROM as saved, RAM at its power-on values, horn unmoved."""
         self.update(now)
-        pos = round(self._pos)
         self.mem[:self.eeprom_end] = self._saved
         self.mem[self.eeprom_end:] = self._ram_at_power_on
-        self.set("present_position", pos)
-        self.set("goal_position", pos)
+        self.horn = servo_frame.within_turn(self, self.horn)   # the turn count is not kept over power-off
+        self.hold()
         self._t = self.heard = now
 
     def reboot(self) -> None:

@@ -18,18 +18,17 @@ model (``robot.servo.gains``), through the family's register scale
 manuals say: X Profile Velocity (a gain register), STS Goal Speed(46) (steps/s, 0 = no
 limit), AX/MX Moving Speed(32) (0.111 rev/min, 0 = no limit).
 
-What the host reads back besides position and speed (:meth:`ServoDynamics.report`), each
-from the model: X Present PWM(124) (885 = full duty) and Present Load(126) (0.1 % of the
-stall torque at the supply, the XL430's unit), AX/MX Present Load(40) (0.1 %, bit 10 =
-CW), STS Present Load(60) (the duty in 0.1 %, bit 10 = negative) and Present Current(69)
-(6.5 mA), and the supply in Present (Input) Voltage (0.1 V).
+What the host reads back besides position and speed: the motor state (:attr:`ServoDynamics.duty`,
+:attr:`ServoDynamics.torque_share` of the stall torque at the supply, :attr:`current_a`)
+for ``servo_effort.write_effort``, which turns it into each table's load / current / PWM
+registers, and the supply in Present (Input) Voltage (0.1 V).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Protocol
 
 from robot.servo import law as servo_law
@@ -40,20 +39,19 @@ from robot.servo.models import MODELS
 from robot.servo.physics import ServoPhysics
 
 STEP_S = 0.002                 # integration step [s]: the MuJoCo robot's physics step
-X_PWM_FULL = 885               # X e-Manual: Present PWM(124) at 100 % duty
 P1_SPEED_UNIT_RPM = 0.111      # AX-12A / MX-28 Moving Speed(32) unit [rev/min]
-STS_CURRENT_UNIT_A = 0.0065    # STS memory table: Present Current(69) unit [A]
-LOAD_FULL = 1000               # Present Load in 0.1 % units at 100 %
-P1_LOAD_SIGN = 0x400           # AX/MX Present Load(40) bit 10: CW load
-STS_LOAD_SIGN = 0x400          # STS Present Load(60) bit 10: negative
+STS_SPEED_MASK = 0x7FFF        # STS Goal Speed(46): bit 15 is the direction
+P1_SPEED_MASK = 0x3FF
+#: The supply read-back (0.1 V) per register family.
+VOLTAGE_REGISTER = {"dynamixel_x": "present_input_voltage", "dynamixel_p1": "present_voltage",
+                    "feetech_sts": "present_voltage"}
 
 
-class ServoState(Protocol):
-    """What the model reads and writes of an emulated servo: its registers by name, its
-    table's bytes and rows (``mem``, ``regs``: (name, entry with .address, .size))."""
+class ServoRegisters(Protocol):
+    """What the model reads of an emulated servo: its registers by name, its table's bytes
+    and rows (``mem``, ``regs``: (name, entry with .address, .size))."""
 
     family: str
-    stuck: bool
     mem: bytearray
 
     @property
@@ -61,14 +59,12 @@ class ServoState(Protocol):
 
     def get(self, name: str) -> int: ...
 
-    def set(self, name: str, value: int) -> None: ...
-
 
 @dataclass(frozen=True)
 class DynamicsSpec:
     """One emulated servo's model: ``model``: a key of ``robot.servo.models.MODELS``;
     physics; voltage: its supply [V]; load: what it carries; zero_ticks: the position of
-    q = 0 (the arm hanging down) [ticks]."""
+    q = 0 (the arm hanging down) [ticks, actual]."""
 
     model: str
     physics: ServoPhysics
@@ -77,32 +73,40 @@ class DynamicsSpec:
     load: BenchLoad = NONE
 
 
-@dataclass
 class ServoDynamics:
-    """The model's state for one servo: speed [rad/s], the firmware's internal goal [rad],
-    the integral of the error [rad s], the last duty and motor torque [N m]; ``pinned``:
-    read-back registers the emulator's back door set by hand (left as set)."""
+    """The model's state for one servo: speed ``dq`` [rad/s], the firmware's internal goal
+    [rad], the integral of the error [rad s], the last duty and motor torque [N m];
+    ``resting``: held at rest by friction with nothing left to change (the servo's
+    registers may hold until the next write)."""
 
-    spec: DynamicsSpec
-    dq: float = 0.0
-    internal: float = 0.0
-    integral: float = 0.0
-    on: bool = False
-    duty: float = 0.0
-    motor: float = 0.0
-    pinned: set[str] = field(default_factory=set)
-    _pos: float | None = None
-    _law_key: bytes = b""
-    _law: servo_law.Law | None = None
-    _span: tuple[int, int] = (0, 0)
-    _reported: dict[str, int] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        model = MODELS[self.spec.model]
+    def __init__(self, spec: DynamicsSpec) -> None:
+        self.spec = spec
+        model = MODELS[spec.model]
         self.ticks_per_rad = model.ticks_per_rad
         self._gain_names = GAIN_SETS[model.gain_set].names if model.gain_set else ()
+        self.dq = self.internal = self.integral = self.duty = self.motor = 0.0
+        self.on = self.resting = False
+        self._pos: float | None = None
+        self._law_key = b""
+        self._law: servo_law.Law | None = None
+        self._span = (0, 0)
 
-    def law(self, servo: ServoState) -> servo_law.Law:
+    @property
+    def torque_share(self) -> float:
+        """The motor's torque as a share of the stall torque at the supply [-1..1]."""
+        stall = self.spec.physics.stall_torque(self.spec.voltage)
+        return max(-1.0, min(1.0, self.motor / stall)) if stall else 0.0
+
+    @property
+    def current_a(self) -> float:
+        """The motor's current [A]: its torque / kt."""
+        return abs(self.motor) / self.spec.physics.kt
+
+    @property
+    def voltage_tenths(self) -> int:
+        return round(self.spec.voltage * 10)
+
+    def law(self, servo: ServoRegisters) -> servo_law.Law:
         """The law at the gains in ``servo``'s registers (recomputed when the bytes that
         hold them change)."""
         if self._law is None:
@@ -112,7 +116,7 @@ class ServoDynamics:
         key = bytes(servo.mem[self._span[0]:self._span[1]])
         if self._law is None or key != self._law_key:
             model = MODELS[self.spec.model]
-            names = set(dict(servo.regs))
+            names = {n for n, _ in servo.regs}
             gains = {**model.factory_gains,
                      **{n: servo.get(n) for n in self._gain_names if n in names}}
             terms = law_terms(model, self.spec.physics, gains)
@@ -120,38 +124,36 @@ class ServoDynamics:
             self._law_key = key
         return self._law
 
-    def _slew_limit(self, servo: ServoState, law: servo_law.Law) -> float:
+    def _slew_limit(self, servo: ServoRegisters, law: servo_law.Law) -> float:
         """The goal slew [rad/s]: the firmware's, and the host's speed register."""
-        family = servo.family
-        if family == "feetech_sts":
-            steps = servo.get("goal_speed") & 0x7FFF
+        if servo.family == "feetech_sts":
+            steps = servo.get("goal_speed") & STS_SPEED_MASK
             host = steps / self.ticks_per_rad if steps else math.inf
-        elif family == "dynamixel_p1":
-            units = servo.get("moving_speed") & 0x3FF
+        elif servo.family == "dynamixel_p1":
+            units = servo.get("moving_speed") & P1_SPEED_MASK
             host = units * P1_SPEED_UNIT_RPM * 2 * math.pi / 60 if units else math.inf
         else:
             host = math.inf        # X: Profile Velocity is a gain register (law_terms)
         return min(law.max_velocity, host)
 
-    def advance(self, servo: ServoState, pos: float, dt: float) -> tuple[float, float]:
-        """Integrate ``dt`` [s] from ``pos`` [ticks]; (new position [ticks], speed
-        [ticks/s])."""
+    def advance(self, servo: ServoRegisters, pos: float, goal: float, dt: float, *,
+                torque: bool, stuck: bool) -> tuple[float, float]:
+        """Integrate ``dt`` [s] from ``pos`` toward ``goal`` [ticks, actual]; (new position
+        [ticks], speed [ticks/s]). ``stuck``: an injected jam, the horn does not move."""
         tpr, zero = self.ticks_per_rad, self.spec.zero_ticks
         if self._pos is None or pos != self._pos:
-            self.dq = 0.0          # placed by hand (power on, factory reset, a test)
-            self._reported.clear()  # ... and the read-backs with it
-        q = (pos - zero) / tpr
-        goal = (servo.get("goal_position") - zero) / tpr
-        on = bool(servo.get("torque_enable"))
-        if servo.stuck:            # an injected jam: the horn does not move
-            self.dq, self.on = 0.0, on
-            self._pos = pos
-            return pos, 0.0
+            self.dq = 0.0          # placed by hand (power on, factory reset, a mode change)
+        q, goal_q = (pos - zero) / tpr, (goal - zero) / tpr
         law = self.law(servo)
-        if on and not self.on:     # torque on: the firmware starts from where it is
+        if torque and not self.on:     # torque on: the firmware starts from where it is
             self.internal, self.integral = q, 0.0
-        self.on = on
-        q = self._integrate(law, q, goal, dt, self._slew_limit(servo, law))
+        self.on = torque
+        if stuck:
+            self.dq, self.resting = 0.0, True
+            self.duty = servo_law.duty(law, goal_q, q, 0.0, 0.0) if torque else 0.0
+            self.motor = servo_law.motor_torque(law, self.duty, 0.0, on=torque)
+        else:
+            q = self._integrate(law, q, goal_q, dt, self._slew_limit(servo, law))
         self._pos = zero + q * tpr
         return self._pos, self.dq * tpr
 
@@ -164,6 +166,7 @@ class ServoDynamics:
         h = dt / steps if steps else 0.0
         dq, internal, integral = self.dq, self.internal, self.integral
         motor, duty = self.motor, self.duty
+        self.resting = False
         for _ in range(steps):
             if on:
                 internal = servo_law.slew(internal, goal, slew, h)
@@ -180,6 +183,7 @@ class ServoDynamics:
             if dq == 0.0:
                 if abs(net) <= hold:
                     if not on or (law.ki == 0.0 and internal == goal):
+                        self.resting = True
                         break              # held at rest, nothing left to change
                     new = 0.0
                 else:
@@ -195,29 +199,3 @@ class ServoDynamics:
         self.dq, self.internal, self.integral = dq, internal, integral
         self.duty, self.motor = duty, motor
         return q
-
-    def report(self, servo: ServoState, names: frozenset[str]) -> None:
-        """Write the model's PWM, load, current and supply into ``servo``'s registers
-        (those of ``names`` it has and no one pinned)."""
-        stall = self.spec.physics.stall_torque(self.spec.voltage)
-        share = max(-1.0, min(1.0, self.motor / stall)) if stall else 0.0
-        load = round(abs(share) * LOAD_FULL)
-        tenths = round(self.spec.voltage * 10)
-        values: dict[str, int] = {}
-        if servo.family == "dynamixel_x":
-            values = {"present_pwm": round(self.duty * X_PWM_FULL),
-                      "present_load": round(share * LOAD_FULL),
-                      "present_input_voltage": tenths}
-        elif servo.family == "dynamixel_p1":
-            values = {"present_load": load | (P1_LOAD_SIGN if share < 0 else 0),
-                      "present_voltage": tenths}
-        elif servo.family == "feetech_sts":
-            pwm = round(abs(self.duty) * LOAD_FULL)
-            amps = abs(self.motor) / self.spec.physics.kt
-            values = {"present_load": pwm | (STS_LOAD_SIGN if self.duty < 0 else 0),
-                      "present_current": round(amps / STS_CURRENT_UNIT_A),
-                      "present_voltage": tenths}
-        for name, v in values.items():
-            if name in names and name not in self.pinned and self._reported.get(name) != v:
-                servo.set(name, v)
-                self._reported[name] = v

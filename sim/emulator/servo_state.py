@@ -30,7 +30,9 @@ class ServoState(Protocol):
 
     mem: the control table's bytes; owner: per byte, 0 (no register) or the index + 1 of
     its register in ``regs``; regs: the table's (name, entry) rows in order; frozen: names
-    whose host writes are acknowledged but not stored (an injected fault).
+    whose host writes are acknowledged but not stored (an injected fault); table: name ->
+    entry; horn: where the horn actually is [ticks, before any offset, several turns in
+    the multi-turn modes]; step_target: where STS step mode takes it [ticks, actual].
     """
 
     family: str
@@ -41,11 +43,13 @@ class ServoState(Protocol):
     mem: bytearray
     owner: bytearray
     regs: list[tuple[str, Entry]]
+    table: dict[str, Entry]
+    horn: float
+    step_target: float
     eeprom_end: int
     watchdog: BusWatchdog | None
-    #: the servo model moving it (None: constant-speed travel); its table's register names
+    #: the servo model moving it in position modes (None: constant-speed travel)
     dynamics: ServoDynamics | None
-    names: frozenset[str]
 
     @property
     def watchdog_tripped(self) -> bool: ...
@@ -55,6 +59,8 @@ class ServoState(Protocol):
     def set(self, name: str, value: int) -> None: ...
 
     def set_raw(self, name: str, value: int) -> None: ...
+
+    def hold(self) -> None: ...
 
 
 def decode_value(family: str, address: int, data: bytes) -> int:

@@ -59,8 +59,11 @@ class TakeWriter:
         if self._t0 is None:
             self._t0 = tel.t
         self.ticks += 1
-        self._line({"tick": tel.tick, "t": tel.t - self._t0, "state": tel.state,
-                    "q": tel.q_cmd})
+        line: dict[str, Any] = {"tick": tel.tick, "t": tel.t - self._t0, "state": tel.state,
+                                "q": tel.q_cmd}
+        if tel.fresh and tel.q_present:
+            line["present"] = tel.q_present     # read back this tick (biped sim-gap)
+        self._line(line)
 
     def close_quietly(self) -> str | None:
         """Close; the first failed write as one line, or None."""

@@ -10,9 +10,11 @@ everything up to the last line written); plain text that ``jq`` or pandas read:
       a parameter change, applied just before gait tick k (t = k / rate_hz [s] of gait
       time); every change made live (panel, gamepad, keyboard) is one such line
   {"gait_tick": k, "t": ..., "stop": true}     the gait told to ramp out before tick k
-  {"tick": n, "t": ..., "state": "walking", "q": [...]}
+  {"tick": n, "t": ..., "state": "walking", "q": [...], "present": [...]}
       one streamed tick: the commanded joint angles [rad] as they went to the bus (after
-      balance, clamp and slew), ``t`` [s] on the loop's clock since the first tick
+      balance, clamp and slew), ``t`` [s] on the loop's clock since the first tick;
+      ``present``: on the ticks that read the servos back, the joint angles read [rad]
+      (``biped sim-gap`` compares them with the commands and the simulation)
 
 The gait is a pure function of the parameter timeline, so replaying the timeline on the
 same robot and rate reproduces the stream (in the simulation with balance feedback too:
@@ -77,7 +79,8 @@ class TakeHeader:
 @dataclass(frozen=True)
 class Take:
     """A take read back: header, timeline (gait tick → changes; the tick of the stop, or
-    None) and the joint stream (``q``: ticks x joints [rad]; ``t`` [s]; ``states``)."""
+    None) and the joint stream (``q``: ticks x joints [rad]; ``t`` [s]; ``states``;
+    ``present``: ticks x joints read back [rad], NaN on ticks without a read-back)."""
 
     header: TakeHeader
     changes: Mapping[int, Mapping[str, float]]
@@ -86,6 +89,7 @@ class Take:
     q: npt.NDArray[np.float64]
     states: tuple[str, ...] = field(default=())
     source: str = "<memory>"
+    present: npt.NDArray[np.float64] | None = None
 
     @property
     def gait_seconds(self) -> float:
@@ -189,6 +193,8 @@ def read_take(path: str | Path) -> Take:
     t: list[float] = []
     q: list[list[float]] = []
     states: list[str] = []
+    present: list[list[float]] = []
+    nan = [math.nan] * n
     for where, row in rows[1:]:
         if not isinstance(row, dict):
             raise _fail(where, "expected a JSON object")
@@ -209,6 +215,8 @@ def read_take(path: str | Path) -> Take:
                 raise _fail(where, "expected \"set\": {name: value} or \"stop\": true")
         elif "tick" in row:
             q.append(_angles(where, row.get("q"), n))
+            seen = row.get("present")
+            present.append(nan if seen is None else _angles(f"{where}: present", seen, n))
             t.append(number(where, "t", row.get("t", len(t) / header.rate_hz)))
             states.append(str(row.get("state", "")))
         else:
@@ -217,5 +225,6 @@ def read_take(path: str | Path) -> Take:
         raise ConfigError(f"{p}: a header only (no gait ticks, no stream lines): nothing to "
                           "replay; record a take with `biped walk --record NAME.take.jsonl`")
     q_arr = np.asarray(q, dtype=float).reshape(len(q), n)
+    read = np.asarray(present, dtype=float).reshape(len(q), n)
     return Take(header, changes, stop, np.asarray(t, dtype=float), q_arr, tuple(states),
-                source=str(p))
+                source=str(p), present=read if np.isfinite(read).any() else None)

@@ -122,6 +122,12 @@ def advance(servo: ServoState, pos: float, dt: float) -> float:
     return pos
 
 
+def at_rest(servo: ServoState) -> bool:
+    """Not moving, and (with a model) held by friction with nothing left to change: its
+    registers hold until something is set."""
+    return not servo.get("moving") and (servo.dynamics is None or servo.dynamics.resting)
+
+
 def _feedback(servo: ServoState, mode: Mode, pos: float, velocity: float, *,
               moving: bool, torque: bool) -> None:
     single = servo_modes.single_turn(servo, mode)

@@ -175,3 +175,13 @@ def test_the_emulator_and_the_mujoco_servo_swing_the_same_pendulum(model: str,
     error = float(bench.errors(simulated)[0, 0])
     assert float(np.ptp(log.position)) > 1.0                 # it really swung
     assert error < AGREEMENT[trajectory], error
+
+
+def test_emulate_load_option_reads_id_mass_length() -> None:
+    from robot.commands.emulate import loads_from
+    from robot.errors import ConfigError
+
+    assert loads_from(["3=0.5@0.1", "4=0@0"]) == {3: BenchLoad(0.5, 0.1), 4: BenchLoad(0.0, 0.0)}
+    for bad in ("x=0.5@0.1", "3=0.5", "3=-1@0.1", "3=0.5@2"):
+        with pytest.raises(ConfigError, match=r"^--load"):
+            loads_from([bad])

@@ -142,41 +142,88 @@ def test_api_errors() -> None:
         emu.plug(1)
 
 
-def test_biped_emulate_factory_new_plugs_on_each_line() -> None:
-    exe = Path(sys.executable).parent / "biped"
-    proc = subprocess.Popen([str(exe), "emulate", "--factory-new", "2", "--protocol",
-                             "dynamixel"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, cwd=ROOT)
-    assert proc.stdin is not None and proc.stdout is not None
+class _Emulate:
+    """``biped emulate ARGS`` in a child: its stdout lines, lines sent to its stdin."""
 
-    def line() -> str:
-        assert proc.stdout is not None
-        ready, _, _ = select.select([proc.stdout], [], [], 15.0)
+    def __init__(self, *args: str) -> None:
+        exe = Path(sys.executable).parent / "biped"
+        self.proc = subprocess.Popen([str(exe), "emulate", *args], stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT)
+
+    def line(self) -> str:
+        assert self.proc.stdout is not None
+        ready, _, _ = select.select([self.proc.stdout], [], [], 15.0)
         assert ready, "biped emulate printed nothing"
-        return proc.stdout.readline().decode().strip()
+        return self.proc.stdout.readline().decode().strip()
 
-    try:
-        path = line()
+    def send(self, text: str) -> str:
+        """Send one stdin line; return the line it answers."""
+        assert self.proc.stdin is not None
+        self.proc.stdin.write(f"{text}\n".encode())
+        self.proc.stdin.flush()
+        return self.line()
+
+    def stop(self) -> int:
+        self.proc.send_signal(signal.SIGTERM)
+        return self.proc.wait(10.0)
+
+    def __enter__(self) -> _Emulate:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait()
+
+
+def test_biped_emulate_factory_new_plugs_on_each_line() -> None:
+    with _Emulate("--factory-new", "2", "--protocol", "dynamixel") as em:
+        path = em.line()
         assert path.startswith("/dev/"), path
         port = dxl.PortHandler(path)
         assert port.openPort() and port.setBaudRate(57600)
         ph = dxl.PacketHandler(2.0)
         assert ph.ping(port, 1)[1] == dxl.COMM_RX_TIMEOUT
         for n in (1, 2):
-            proc.stdin.write(b"\n")
-            proc.stdin.flush()
-            assert line() == f"plugged new servo {n} of 2"
+            assert em.send("") == f"plugged new servo {n} of 2"
             assert ph.ping(port, 1)[:2] == (1060, dxl.COMM_SUCCESS)
             assert ph.write1ByteTxRx(port, 1, X_ID, 20 + n)[0] == dxl.COMM_SUCCESS
-        proc.stdin.write(b"all\n")
-        proc.stdin.flush()
-        assert line() == "plugged all 2 servos"
+        assert em.send("all") == "plugged all 2 servos"
         found, result = ph.broadcastPing(port)
         assert result == dxl.COMM_SUCCESS and sorted(found) == [21, 22]
         port.closePort()
-        proc.send_signal(signal.SIGTERM)
-        assert proc.wait(10.0) == 0
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+        assert em.stop() == 0
+
+
+def test_biped_emulate_factory_new_dual_axis_cases() -> None:
+    """--model 2XL430-W250: each line plugs a whole case, both axes (model number 1090,
+    ids 1 and 2 from the factory: e-Manual 2XL430-W250 page)."""
+    with _Emulate("--factory-new", "2", "--protocol", "dynamixel",
+                  "--model", "2XL430-W250") as em:
+        port = dxl.PortHandler(em.line())
+        assert port.openPort() and port.setBaudRate(57600)
+        ph = dxl.PacketHandler(2.0)
+        for n in (1, 2):
+            assert em.send("") == f"plugged new servo {n} of 2"
+            found, result = ph.broadcastPing(port)
+            assert result == dxl.COMM_SUCCESS
+            assert {i: m for i, (m, _) in found.items()} == {1: 1090, 2: 1090}
+            for axis in (1, 2):
+                new = 10 * n + axis
+                assert ph.write1ByteTxRx(port, axis, X_ID, new)[:2] == (dxl.COMM_SUCCESS, 0)
+        assert em.send("all") == "plugged all 2 servos"
+        found, result = ph.broadcastPing(port)
+        assert result == dxl.COMM_SUCCESS and sorted(found) == [11, 12, 21, 22]
+        port.closePort()
+        assert em.stop() == 0
+
+
+@pytest.mark.parametrize(("args", "named"), [
+    (("--model", "2XL430-W250"), "--model"),
+    (("--factory-new", "1", "--protocol", "dynamixel", "--model", "STS3215"), "model"),
+])
+def test_biped_emulate_model_refused_in_one_line(args: tuple[str, ...], named: str) -> None:
+    with _Emulate(*args) as em:
+        _, err = em.proc.communicate(timeout=30.0)
+        lines = err.decode().strip().splitlines()
+        assert em.proc.returncode == 2 and len(lines) == 1 and named in lines[0], lines

@@ -81,7 +81,9 @@ def test_a_new_servo_holds_the_manuals_initial_values() -> None:
 
 #: Fault name -> bit mask, as printed: ROBOTIS e-Manual XL430-W250 "Hardware Error
 #: Status(70)"; e-Manual "Protocol 1.0" status packet error byte; Feetech STS memory table
-#: "Servo status(65)".
+#: "Servo status(65)"; e-Manual XL-320 "Shutdown(18)" (bit 0 Overload, 1 OverHeating,
+#: 2 Input Voltage; Hardware Error Status(50) holds them); Feetech SCSCL memory table "Servo
+#: Status" (BIT0 voltage, BIT2 temperature, BIT5 load; the SCS15 manual's status byte).
 MANUAL_ERROR_MASKS: dict[str, dict[str, int]] = {
     "dynamixel_x": {"voltage": 0x01, "overheating": 0x04, "encoder": 0x08,
                     "electrical_shock": 0x10, "overload": 0x20},
@@ -89,6 +91,8 @@ MANUAL_ERROR_MASKS: dict[str, dict[str, int]] = {
                      "range": 0x08, "checksum": 0x10, "overload": 0x20, "instruction": 0x40},
     "feetech_sts": {"voltage": 0x01, "encoder": 0x02, "overheating": 0x04,
                     "overcurrent": 0x08, "overload": 0x20},
+    "dynamixel_xl320": {"overload": 0x01, "overheating": 0x02, "voltage": 0x04},
+    "feetech_scs": {"voltage": 0x01, "overheating": 0x04, "overload": 0x20},
 }
 
 
@@ -153,14 +157,17 @@ def test_bus_watchdog_arming_and_deadline() -> None:
 
 
 def test_return_delay_units_are_2_us_and_the_drivers() -> None:
-    # XL430 Return Delay Time(9), AX-12A Return Delay Time(5), STS Return delay(7): 2 us.
+    # XL430 Return Delay Time(9), AX-12A Return Delay Time(5), STS Return delay(7), XL-320
+    # Return Delay Time(5), SCS15 Return delay time(7): 2 us.
     assert status.RETURN_DELAY_UNIT_S == {"dynamixel_x": 2e-6, "dynamixel_p1": 2e-6,
-                                          "feetech_sts": 2e-6}
+                                          "feetech_sts": 2e-6, "dynamixel_xl320": 2e-6,
+                                          "feetech_scs": 2e-6}
     assert driver.RETURN_DELAY_UNIT_S == status.RETURN_DELAY_UNIT_S
 
 
 def test_protocol_families_are_the_drivers() -> None:
-    assert models.PROTOCOL_FAMILY == driver_models.BUS_FAMILIES
+    assert models.PROTOCOL_FAMILIES == driver_models.BUS_FAMILIES
+    assert models.PROTOCOL_FAMILY == {k: f[0] for k, f in driver_models.BUS_FAMILIES.items()}
 
 
 def test_servo_models_agree_with_the_drivers() -> None:

@@ -64,12 +64,16 @@ def test_no_fusion_output_yet_is_no_quaternion(dev: FakeBno055) -> None:
         assert imu.read().quat is None
 
 
-def one_line_error(imu_config: ImuConfig, *, within_s: float = 3.0) -> str:
-    t0 = time.monotonic()
+#: The library's tries per register read (adafruit_bno055 ``BNO055_UART._read_register``
+#: gives up after three requests): a silent chip costs at most this many requests, so a
+#: read gives up rather than hangs, judged by what reached the chip, not by the clock.
+LIBRARY_TRIES = 3
+
+
+def one_line_error(imu_config: ImuConfig) -> str:
     with pytest.raises(ImuError) as e:
         with open_imu(imu_config) as imu:
             imu.read()
-    assert time.monotonic() - t0 < within_s
     text = str(e.value)
     assert "\n" not in text and imu_config.port in text
     return text
@@ -77,7 +81,9 @@ def one_line_error(imu_config: ImuConfig, *, within_s: float = 3.0) -> str:
 
 def test_silent_device_is_a_timeout_naming_the_port(dev: FakeBno055) -> None:
     dev.silent = True
-    text = one_line_error(config(dev), within_s=1.5)
+    text = one_line_error(config(dev))
+    assert wait_for(dev.drained)
+    assert 1 <= dev.requests <= LIBRARY_TRIES   # the chip-id read, tried and given up
     assert f"bno055 on {dev.path}: opening: no reply within 0.3 s at 115200 baud" in text
     assert "PS1 is high and PS0 low" in text
 
@@ -102,11 +108,12 @@ def test_faults_after_open_fail_the_read_not_hang(dev: FakeBno055) -> None:
         dev.read_status = None
         imu.read()
         dev.silent = True
-        t0 = time.monotonic()
+        assert wait_for(dev.drained)
+        before = dev.requests
         with pytest.raises(ImuError, match="reading: no reply within 0.3 s"):
             imu.read()
-        assert time.monotonic() - t0 < 1.0
         assert wait_for(dev.drained)   # the unanswered requests were taken while silent
+        assert 1 <= dev.requests - before <= LIBRARY_TRIES   # gave up on the first register
         dev.silent = False
         assert imu.read().accel[2] == pytest.approx(9.81, abs=ACCEL_LSB)  # recovers
 

@@ -59,7 +59,7 @@ def test_baud_order_puts_factory_and_robot_rates_first() -> None:
 def test_each_new_servo_gets_its_joint_id_and_the_robot_baud(
         fresh: Emulator, robot: RobotConfig, robot_toml: Path, bus_factory,
         capsys: pytest.CaptureFixture[str]) -> None:
-    family = BUS_FAMILIES[robot.bus.kind]
+    family = robot.bus.servo.family
     for index, joint in enumerate(JOINTS):
         fresh.plug(index)
         assert setup(fresh, robot_toml, "--joint", joint, "--yes") == 0
@@ -149,7 +149,7 @@ def test_a_used_servo_is_found_on_every_bus_kind(kind: str, tmp_path: Path,
     sid, baud = USED[kind]
     joint = robot.joint_by_id(5)          # not the servo's id: setup gives it id 5
     assert joint is not None
-    family = BUS_FAMILIES[kind]
+    family = BUS_FAMILIES[kind][0]
     with Emulator.factory_new(kind, 1) as emu:
         emu.plug(0)
         emu.set_register(1, "id", sid)
@@ -221,7 +221,7 @@ def test_prompts_walk_the_joints_in_order(fresh: Emulator, robot: RobotConfig,
 def test_a_servo_at_an_odd_id_and_baud_is_found_by_the_sweep(
         protocol: str, robot: RobotConfig, robot_toml: Path,
         monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
-    family = BUS_FAMILIES[protocol]
+    family = BUS_FAMILIES[protocol][0]
     odd_baud = 115_200
     monkeypatch.setattr("robot.setup.motor_setup.ALL_IDS", range(25, 36))   # per-id pings: short
     monkeypatch.setattr("robot.setup.motor_setup.baud_order",

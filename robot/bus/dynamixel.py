@@ -1,8 +1,10 @@
-"""ROBOTIS Dynamixel X series on Protocol 2.0 through ``dynamixel_sdk``.
+"""ROBOTIS Dynamixel on Protocol 2.0 through ``dynamixel_sdk``: the X series (and the MX
+series on 2.0 firmware) or the XL-320, by the robot file's servo model.
 
-Control table: ``tables.DYNAMIXEL_X``. ``read_state`` reads the contiguous block from
-present_load to present_temperature (21 bytes) in one sync read; a servo whose status
-packet carries the alert bit gets its Hardware Error Status register read as well.
+Control table: ``tables.DYNAMIXEL_X`` or ``tables.DYNAMIXEL_XL320``. ``read_state`` reads
+one block per servo in one sync read: X present_load .. present_temperature (21 bytes; a
+servo whose status packet carries the alert bit gets its Hardware Error Status read as
+well), XL-320 present_position .. hardware_error_status (14 bytes, the errors inside).
 """
 
 from __future__ import annotations
@@ -13,7 +15,10 @@ import dynamixel_sdk
 
 from robot.bus.base import ServoState
 from robot.bus.sdk_bus import SdkBus
-from robot.bus.sdk_port import TimedPort, error_names, twos_complement
+from robot.bus.sdk_port import TimedPort, error_names, sign_magnitude, twos_complement
+
+#: XL-320 Present Load(41): bit 10 the direction, bits 0-9 the magnitude [0.1 %].
+XL320_DIRECTION_BIT = 10
 
 
 class _Port(TimedPort, dynamixel_sdk.PortHandler):
@@ -21,17 +26,18 @@ class _Port(TimedPort, dynamixel_sdk.PortHandler):
 
 
 class DynamixelBus(SdkBus):
-    """Dynamixel X chain. ``DynamixelBus(port, baud=..., robot=..., retries=..., timeout_ms=...)``.
+    """Dynamixel Protocol 2.0 chain. ``DynamixelBus(port, baud=..., robot=..., retries=...,
+    timeout_ms=...)``.
 
-    Load is Present Load [0.1 %] (current-based models report current there instead),
-    voltage Present Input Voltage [0.1 V], temperature [°C].
+    Load is Present Load [0.1 %] (current-based models report current there instead; the
+    XL-320 signs it by bit 10), voltage [0.1 V], temperature [°C].
     """
 
     kind = "dynamixel"
     family = "dynamixel_x"
+    families = ("dynamixel_x", "dynamixel_xl320")
     sdk = dynamixel_sdk
     port_class = _Port
-    state_block = ("present_load", "present_temperature")
     firmware_register = "firmware_version"
 
     def _make_packet_handler(self) -> Any:
@@ -42,6 +48,13 @@ class DynamixelBus(SdkBus):
         return bool(error & ~dynamixel_sdk.ERRBIT_ALERT & 0xFF)
 
     def _decode_state(self, sid: int, block: bytes, status: int) -> ServoState:
+        if self.family == "dynamixel_xl320":
+            return ServoState(
+                id=sid, position=self.field(block, "present_position"),
+                load=sign_magnitude(self.field(block, "present_load"), XL320_DIRECTION_BIT) * 0.1,
+                temperature=float(self.field(block, "present_temperature")),
+                voltage=self.field(block, "present_voltage") * 0.1,
+                errors=error_names(self.family, self.field(block, "hardware_error_status")))
         errors: frozenset[str] = frozenset()
         if status & dynamixel_sdk.ERRBIT_ALERT:
             errors = error_names(self.family, self.read_register(sid, "hardware_error_status"))

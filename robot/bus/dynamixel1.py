@@ -1,4 +1,5 @@
-"""ROBOTIS Dynamixel on Protocol 1.0 (AX-12A, AX-18A, MX-28) through ``dynamixel_sdk``.
+"""ROBOTIS Dynamixel on Protocol 1.0 (AX-12A, AX-18A, MX-28 / MX-64 / MX-106 on 1.0
+firmware) through ``dynamixel_sdk``.
 
 Control table: ``tables.DYNAMIXEL_P1`` (ROBOTIS e-Manual, AX-12A). Protocol 1.0 has sync
 write (goals go out in one packet, as on the other buses) but no sync read on the AX
@@ -39,9 +40,9 @@ class Dynamixel1Bus(SdkBus):
 
     kind = "dynamixel1"
     family = "dynamixel_p1"
+    families = ("dynamixel_p1",)
     sdk = dynamixel_sdk
     port_class = _Port
-    state_block = ("present_position", "present_temperature")
     firmware_register = "firmware_version"
 
     def _make_packet_handler(self) -> Any:

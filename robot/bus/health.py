@@ -14,7 +14,7 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from robot.bus.tables import RETURN_DELAY_UNIT_S
+from robot.bus.tables import EEPROM_LOCK, RETURN_DELAY_UNIT_S
 from robot.errors import BusError
 from robot.servo.models import BAUD_CODES
 
@@ -144,11 +144,11 @@ def fix_return_delay(bus: SdkRegisters, ids: Iterable[int]) -> list[int]:
         if bus.read_register(sid, "return_delay_time") == 0:
             continue
         bus.set_torque([sid], enabled=False)
-        lock = bus.family == "feetech_sts"
+        lock = EEPROM_LOCK[bus.family]
         if lock:
-            bus.write_register(sid, "lock", 0)
+            bus.write_register(sid, lock[0], lock[1])
         bus.write_register(sid, "return_delay_time", 0)
         if lock:
-            bus.write_register(sid, "lock", 1)
+            bus.write_register(sid, lock[0], lock[2])
         changed.append(sid)
     return changed

@@ -1,9 +1,10 @@
 """What the Dynamixel and Feetech buses share: one vendor SDK behind ``base.Bus``.
 
-Subclasses set the SDK module, the control-table family and the state block, and
-implement three hooks (packet handler, status-byte failure, state decoding). Register
-access, retries and messages live in ``SdkRegisters`` (robot/bus/sdk_registers.py); the
-bus adds opening and closing, scans, goals, state reads and the failsafe, once.
+Subclasses set the SDK module and the control-table families their protocol speaks (the
+bus drives one: its robot's servo model's), and implement three hooks (packet handler,
+status-byte failure, state decoding). Register access, retries and messages live in
+``SdkRegisters`` (robot/bus/sdk_registers.py); the bus adds opening and closing, scans,
+goals, state reads and the failsafe, once.
 """
 
 from __future__ import annotations
@@ -19,10 +20,10 @@ from robot.bus.limits import TickLimits
 from robot.bus.sdk_port import PORT_ERRORS
 from robot.bus.sdk_registers import SdkRegisters
 from robot.bus.sync_read import BlockSyncRead, Reply
-from robot.bus.tables import COMM_WATCHDOG, RETURN_DELAY_UNIT_S
+from robot.bus.tables import COMM_WATCHDOG, RETURN_DELAY_UNIT_S, STATE_BLOCK, TABLES
 from robot.bus.wire_time import TickWire, tick_wire
 from robot.config.robot import RobotConfig
-from robot.servo.models import MODELS_BY_NUMBER, model_name
+from robot.servo.models import ServoModel, lookup
 
 log = logging.getLogger(__name__)
 
@@ -36,13 +37,15 @@ class SdkBus(SdkRegisters, Bus):
     """
 
     port_class: ClassVar[type]
-    state_block: ClassVar[tuple[str, str]]  # first and last register of the read_state block
     firmware_register: ClassVar[str]
 
     def __init__(self, port: str, *, baud: int, robot: RobotConfig | None = None,
                  retries: int | None = None, timeout_ms: float | None = None,
-                 check_health: bool = True) -> None:
-        super().__init__(port, baud=baud, robot=robot, retries=retries, timeout_ms=timeout_ms)
+                 check_health: bool = True, family: str | None = None) -> None:
+        super().__init__(port, baud=baud, robot=robot, retries=retries, timeout_ms=timeout_ms,
+                         family=family)
+        #: first and last register of the read_state block (tables.STATE_BLOCK)
+        self.state_block = STATE_BLOCK[self.family]
         self.check_health = check_health
         self.health: list[str] = []
         self.limits = TickLimits(robot)
@@ -109,7 +112,7 @@ class SdkBus(SdkRegisters, Bus):
             reg = self.table[name]
             group = self.sdk.GroupSyncWrite(port, self._ph, reg.address, reg.size)
             for sid in ids:
-                group.addParam(sid, list(value.to_bytes(reg.size, "little")))
+                group.addParam(sid, list(value.to_bytes(reg.size, self.byteorder)))
             result = group.txPacket()
             if result != self.sdk.COMM_SUCCESS:
                 log.warning("%s=%d on close failed: %s; servos %s: %s", name, value,
@@ -164,15 +167,32 @@ class SdkBus(SdkRegisters, Bus):
         wanted = sorted(set(ids))
         models = {sid: self.ping(sid) for sid in wanted}
         models.update({sid: self.ping(sid) for sid in wanted if models[sid] is None})
-        for sid, model in models.items():
-            if model is None:
+        for sid, number in models.items():
+            if number is None:
                 continue
+            servo = self.identify(sid, number)
+            # A servo of another family of this protocol (an XL-320 on an X chain) has its
+            # firmware and return delay at its own table's addresses.
+            table = TABLES[servo.family] if servo is not None else self.table
             found.append(ServoInfo(
-                id=sid, model=model, model_name=model_name(self.family, model),
-                firmware=self.read_register(sid, self.firmware_register),
-                return_delay_us=self.read_register(sid, "return_delay_time") * unit_us,
+                id=sid, model=servo.number if servo else number,
+                model_name=servo.name if servo else f"unknown({number})",
+                firmware=self.read_register(sid, self.firmware_register, table=table),
+                return_delay_us=self.read_register(sid, "return_delay_time",
+                                                   table=table) * unit_us,
                 baud=self.baud))
         return found
+
+    def identify(self, sid: int, number: int) -> ServoModel | None:
+        """The model behind servo ``sid`` that reported ``number`` on a ping: the robot
+        file's joint model when its number matches (two models may share one: the 7.4 V and
+        12 V STS3215), else the model with that number among the protocol's families."""
+        joint = self.robot.joint_by_id(sid) if self.robot else None
+        if joint is not None and self.robot is not None:
+            configured = self.robot.servo(joint)
+            if configured.number == number:
+                return configured
+        return lookup((self.family, *self.families), number)
 
     def arm_failsafe(self, ids: Iterable[int], *, timeout_s: float) -> float | None:
         wd = COMM_WATCHDOG[self.family]
@@ -215,15 +235,17 @@ class SdkBus(SdkRegisters, Bus):
 
     def read_gains(self, servo_id: int, *, model: int | None = None) -> dict[str, int] | None:
         joint = self.robot.joint_by_id(servo_id) if self.robot else None
-        servo = (self.robot.servo(joint) if self.robot and joint else
-                 MODELS_BY_NUMBER.get(self.family, {}).get(model if model is not None else -1))
+        servo = self.robot.servo(joint) if self.robot and joint else None
+        if model is not None and (servo is None or servo.number != model):
+            servo = self.identify(servo_id, model)   # the servo found is not the file's
         return None if servo is None else gain_writer.read(self, servo_id, servo.gain_set)
 
     def write_goals(self, goals: Mapping[int, int]) -> None:
         if not goals:
             return
         check, size, writer = self.limits.check, self._goal_size, self._writer
-        params = [(sid, check(sid, t).to_bytes(size, "little"))
+        order = self.byteorder
+        params = [(sid, check(sid, t).to_bytes(size, order))
                   for sid, t in goals.items()]
 
         def send() -> tuple[None, int, int]:
@@ -244,7 +266,7 @@ class SdkBus(SdkRegisters, Bus):
         return {sid: self._decode_state(sid, *got[sid]) for sid in ids}
 
     def field(self, block: bytes, name: str) -> int:
-        """Unsigned little-endian value of register ``name`` inside a state block."""
+        """Unsigned value of register ``name`` inside a state block (the table's byte order)."""
         reg = self.table[name]
         start = reg.address - self._block_start
-        return int.from_bytes(block[start:start + reg.size], "little")
+        return int.from_bytes(block[start:start + reg.size], self.byteorder)

@@ -15,7 +15,7 @@ from types import ModuleType
 from typing import Any, ClassVar
 
 from robot.bus.sdk_port import PORT_ERRORS
-from robot.bus.tables import TABLES, Register
+from robot.bus.tables import BYTE_ORDER, TABLES, Register
 from robot.config.robot import RobotConfig
 from robot.errors import BusError
 from robot.servo.models import BAUD_CODES
@@ -32,13 +32,18 @@ class SdkRegisters:
     """
 
     kind: str
-    family: ClassVar[str]
+    #: The control-table family this bus drives: the robot's servo model's when it has one
+    #: (a kind speaks several: Protocol 2.0 the X table and the XL-320's), else this default.
+    family: str
+    #: Every family this bus's protocol speaks (robot.servo.models.BUS_FAMILIES).
+    families: ClassVar[tuple[str, ...]]
     sdk: ClassVar[ModuleType]
     #: The servos' longest return delay, as the health check read it on open [s].
     return_delay_s: float = 0.0
 
     def __init__(self, port: str, *, baud: int, robot: RobotConfig | None = None,
-                 retries: int | None = None, timeout_ms: float | None = None) -> None:
+                 retries: int | None = None, timeout_ms: float | None = None,
+                 family: str | None = None) -> None:
         self.port_name = port
         self.baud = int(baud)
         self.robot = robot
@@ -49,12 +54,22 @@ class SdkRegisters:
         if self.retries < 0 or not self.timeout_ms > 0:
             raise BusError(f"retries must be >= 0 and timeout_ms > 0, got {self.retries}, "
                            f"{self.timeout_ms}")
+        self.family = self._pick_family(family, robot)
         self.table: dict[str, Register] = TABLES[self.family]
+        self.byteorder = BYTE_ORDER[self.family]
         self._port: Any = None
         self._ph: Any = None
         self._torqued: set[int] = set()
         self.failsafe_armed: set[int] = set()   # ids whose communication watchdog we armed
         self._lock = threading.RLock()
+
+    def _pick_family(self, family: str | None, robot: RobotConfig | None) -> str:
+        """``family`` when given, else the robot's servo model's, else the class default."""
+        chosen = family or (robot.bus.servo.family if robot is not None else self.family)
+        if chosen not in self.families:
+            raise BusError(f"a {self.kind} bus drives {', '.join(self.families)} servos, not "
+                           f"{chosen}; use the bus kind of {chosen}")
+        return chosen
 
     def _status_failed(self, error: int) -> bool:
         """Whether a status packet's error byte means the instruction failed (a hook)."""
@@ -160,10 +175,12 @@ class SdkRegisters:
             what = f"{what} (no valid reply from it)" if sid is not None else what
         raise self._error(sid, what, detail, result)
 
-    def read_register(self, sid: int, name: str) -> int:
-        """Unsigned value of register ``name`` of servo ``sid``."""
-        reg = self.table[name]
-        return int.from_bytes(self.read_bytes(sid, reg.address, reg.size, name), "little")
+    def read_register(self, sid: int, name: str, *,
+                      table: dict[str, Register] | None = None) -> int:
+        """Unsigned value of register ``name`` of servo ``sid`` (in ``table``: another
+        family's, for a scan that met one; default this bus's)."""
+        reg = (table or self.table)[name]
+        return int.from_bytes(self.read_bytes(sid, reg.address, reg.size, name), self.byteorder)
 
     def read_bytes(self, sid: int, address: int, length: int, what: str) -> bytes:
         """``length`` bytes of servo ``sid``'s control table from ``address`` (one read);
@@ -181,7 +198,7 @@ class SdkRegisters:
 
     def write_at(self, sid: int, reg: Register, value: int, what: str) -> None:
         """Write ``value`` to ``reg`` of servo ``sid`` and wait for its status reply."""
-        data = list(int(value).to_bytes(reg.size, "little", signed=value < 0))
+        data = list(int(value).to_bytes(reg.size, self.byteorder, signed=value < 0))
         self._transact(f"write {what}={value}", sid, lambda: (None, *self._ph.writeTxRx(
             self._port, sid, reg.address, reg.size, data)))
 
@@ -194,7 +211,7 @@ class SdkRegisters:
         def send() -> tuple[None, int, int]:
             group = self.sdk.GroupSyncWrite(self._port, self._ph, reg.address, reg.size)
             for sid, v in values.items():
-                group.addParam(sid, list(int(v).to_bytes(reg.size, "little")))
+                group.addParam(sid, list(int(v).to_bytes(reg.size, self.byteorder)))
             return None, group.txPacket(), 0
 
         self._transact(f"sync write {what}", None, send)

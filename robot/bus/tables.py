@@ -10,23 +10,29 @@ Each table maps a register name to ``Register(address, size)``. Sizes are in byt
   (https://emanual.robotis.com/docs/en/dxl/mx/mx-28/) keeps these addresses.
 - Feetech STS/SMS (little-endian, Protocol-1 style): Feetech "STS/SMS series memory table"
   (FT-SMS-STS-emanual), as used by feetech-servo-sdk's ``SMS_STS`` definitions.
+- ROBOTIS XL-320 and Feetech SCS: robot/bus/tables_more.py (registered here).
+
+The Dynamixel Protocol 1.0 table also serves the MX-64 and MX-106 on 1.0 firmware: their
+e-Manual tables keep the MX-28's addresses for every register named here (and add Current
+68, Torque Control Mode 70, Goal Torque 71; the MX-106 Drive Mode 10). The X table serves
+every X model and the MX series on 2.0 firmware; on the current-sensing models (XM, XH,
+XL330, XC330, MX-64/106(2.0)) register 126 is Present Current, not Present Load.
 """
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Literal, NamedTuple
 
+from robot.bus.register import Register
+from robot.bus.tables_more import (
+    DYNAMIXEL_XL320,
+    DYNAMIXEL_XL320_ERROR_BITS,
+    FEETECH_SCS,
+    FEETECH_SCS_ERROR_BITS,
+    GAIN_REGISTERS_MORE,
+)
 
-class Register(NamedTuple):
-    """One control-table entry.
-
-    address: byte address in the servo's control table
-    size: width [bytes]
-    """
-
-    address: int
-    size: int
-
+__all__ = ["Register", "TABLES"]
 
 # ROBOTIS e-Manual, X series control table (XL430-W250, XM430, XC430, ...).
 DYNAMIXEL_X: dict[str, Register] = {
@@ -139,6 +145,22 @@ FEETECH_STS: dict[str, Register] = {
 
 TABLES: dict[str, dict[str, Register]] = {
     "dynamixel_x": DYNAMIXEL_X, "dynamixel_p1": DYNAMIXEL_P1, "feetech_sts": FEETECH_STS,
+    "dynamixel_xl320": DYNAMIXEL_XL320, "feetech_scs": FEETECH_SCS,
+}
+#: Byte order of the two-byte and four-byte registers: little-endian everywhere but the
+#: Feetech SCS (SCSCL memory table: END(2) = 1, high byte first).
+BYTE_ORDER: dict[str, Literal["little", "big"]] = {
+    "dynamixel_x": "little", "dynamixel_p1": "little", "feetech_sts": "little",
+    "dynamixel_xl320": "little", "feetech_scs": "big",
+}
+#: First and last register of the block a state read fetches (position, load, voltage,
+#: temperature and, where the table has one in reach, the error register).
+STATE_BLOCK: dict[str, tuple[str, str]] = {
+    "dynamixel_x": ("present_load", "present_temperature"),
+    "dynamixel_xl320": ("present_position", "hardware_error_status"),
+    "dynamixel_p1": ("present_position", "present_temperature"),
+    "feetech_sts": ("present_position", "status"),
+    "feetech_scs": ("present_position", "status"),
 }
 
 # ROBOTIS e-Manual, MX-28 (Protocol 1.0 firmware) RAM table: D Gain(26), I Gain(27),
@@ -160,6 +182,7 @@ GAIN_REGISTERS: dict[str, dict[str, Register]] = {
                           "cw_compliance_slope", "ccw_compliance_slope"),
     "dynamixel_mx1": DYNAMIXEL_MX1_GAINS,
     "feetech_sts": _pick(FEETECH_STS, "p_coefficient", "d_coefficient", "i_coefficient"),
+    **GAIN_REGISTERS_MORE,
 }
 #: The EEPROM write lock of a family, as (register, unlocked value, locked value): Feetech
 #: STS Lock(55): 0 = EEPROM writes are saved, 1 = locked (the memory table; the factory
@@ -167,6 +190,7 @@ GAIN_REGISTERS: dict[str, dict[str, Register]] = {
 #: for good until power-off: never written here).
 EEPROM_LOCK: dict[str, tuple[str, int, int] | None] = {
     "dynamixel_x": None, "dynamixel_p1": None, "feetech_sts": ("lock", 0, 1),
+    "dynamixel_xl320": None, "feetech_scs": ("lock", 0, 1),   # SCS Lock(48), same values
 }
 
 # Hardware-error bits → normalised fault names.
@@ -204,6 +228,8 @@ ERROR_BITS: dict[str, dict[int, str]] = {
     "dynamixel_x": DYNAMIXEL_X_ERROR_BITS,
     "dynamixel_p1": DYNAMIXEL_P1_ERROR_BITS,
     "feetech_sts": FEETECH_STS_ERROR_BITS,
+    "dynamixel_xl320": DYNAMIXEL_XL320_ERROR_BITS,
+    "feetech_scs": FEETECH_SCS_ERROR_BITS,
     "lx": {0: "overheating", 1: "voltage", 2: "overload"},   # lx_tables.LX_ALARM_BITS
 }
 
@@ -211,6 +237,8 @@ ERROR_BITS: dict[str, dict[int, str]] = {
 # AX-12A "Return Delay Time(5)": 2 µs per step (factory 250 = 500 µs).
 RETURN_DELAY_UNIT_S: dict[str, float] = {
     "dynamixel_x": 2e-6, "dynamixel_p1": 2e-6, "feetech_sts": 2e-6,
+    "dynamixel_xl320": 2e-6,   # e-Manual XL-320 Return Delay Time(5): the X include, 2 us
+    "feetech_scs": 2e-6,       # SCS15 manual: 2 us per step, as the STS
 }
 
 
@@ -254,4 +282,7 @@ COMM_WATCHDOG: dict[str, CommWatchdog | None] = {
     # AX-12A / MX-28 Protocol 1.0 tables have no bus watchdog either.
     "dynamixel_p1": None,
     "feetech_sts": None,
+    # The XL-320 and SCS tables have no communication watchdog register either.
+    "dynamixel_xl320": None,
+    "feetech_scs": None,
 }

@@ -30,8 +30,10 @@ BITS_PER_BYTE = 10
 #: field bytes, has sync read) [bytes].
 FRAMING: dict[str, tuple[int, int, int, bool]] = {
     "dynamixel_x": (10, 11, 4, True),
+    "dynamixel_xl320": (10, 11, 4, True),    # the same Protocol 2.0 framing
     "dynamixel_p1": (6, 6, 2, False),
     "feetech_sts": (6, 6, 2, True),
+    "feetech_scs": (6, 6, 2, True),          # the same Feetech framing
 }
 
 

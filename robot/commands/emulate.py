@@ -6,6 +6,8 @@ bus at it (``biped scan --bus dynamixel --port /dev/pts/N``); SIGINT / SIGTERM s
 ``--factory-new N`` serves N servos as shipped (id 1, factory baud and return delay), none
 plugged in: each line read on stdin plugs the next one in alone (the previous one is
 unplugged), as a user connects one new servo at a time; the line ``all`` plugs in all.
+The servos are the robot's bus model unless ``--model`` names another; a dual-axis model
+(2XL430-W250) serves N cases, each a line plugs in whole (its two axes at ids 1 and 2).
 
 The servos move by the servo model (``sim.emulator.servo_dynamics``: the gains the driver
 wrote, the supply, gearbox friction; ``--motion travel``: at constant speed onto the goal);
@@ -55,6 +57,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p.add_argument("--load", action="append", default=[], metavar="ID=MASS@LENGTH",
                    help="a weight [kg] on an arm [m] on servo ID, e.g. 3=0.5@0.1 "
                         "(repeatable; --motion model)")
+    p.add_argument("--model", default=None,
+                   help="servo model of the --factory-new servos, e.g. 2XL430-W250 (a "
+                        "dual-axis case a servo; default: the robot config's bus model)")
     return p
 
 
@@ -70,7 +75,9 @@ def loads_from(texts: list[str]) -> dict[int, BenchLoad]:
 
 
 def _plug_from_stdin(emu: Emulator, count: int, stop: threading.Event) -> None:
-    """Plug the next factory-new servo per stdin line; 'all' plugs every one."""
+    """Plug the next factory-new servo per stdin line; 'all' plugs every one. A
+    dual-axis case is one servo here: its first axis is plugged, the emulator adds the other."""
+    axes = len(emu.ids) // count
     plugged = 0
     for line in sys.stdin:
         if stop.is_set():
@@ -79,7 +86,7 @@ def _plug_from_stdin(emu: Emulator, count: int, stop: threading.Event) -> None:
             emu.plug_all()
             print(f"plugged all {count} servos", flush=True)
         elif plugged < count:
-            emu.plug(plugged)
+            emu.plug(plugged * axes)
             plugged += 1
             print(f"plugged new servo {plugged} of {count}", flush=True)
         else:
@@ -94,6 +101,11 @@ def run(args: argparse.Namespace) -> int:
         print("biped emulate: error: --baud: factory-new servos listen at their factory "
               "baud; drop --baud or --factory-new", file=sys.stderr)
         return 2
+    if args.model and not args.factory_new:
+        print("biped emulate: error: --model: only for --factory-new servos (a chain "
+              "takes its models from the robot config); add --factory-new N",
+              file=sys.stderr)
+        return 2
     robot = robot_from(args)
     protocol = args.protocol or robot.bus.kind
     loads = loads_from(args.load)
@@ -105,7 +117,8 @@ def run(args: argparse.Namespace) -> int:
 
     old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
-        emu = (Emulator.factory_new(protocol, args.factory_new) if args.factory_new
+        model = args.model or (robot.bus.model if protocol == robot.bus.kind else None)
+        emu = (Emulator.factory_new(protocol, args.factory_new, model=model) if args.factory_new
                else Emulator(protocol, robot, baud=args.baud, loads=loads, motion=motion))
         with emu:
             print(emu.port, flush=True)

@@ -12,7 +12,7 @@ from robot.bus import health
 from robot.bus.base import ServoInfo
 from robot.bus.sdk_bus import SdkBus
 from robot.commands.common import HARDWARE_BUSES, add_bus_args, bus_from, id_list, one_line_errors
-from robot.config.bundled import DEFAULT_ROBOT, ROBOTS_DIR
+from robot.config.bundled import DEFAULT_ROBOT, ROBOTS_DIR, robot_names
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from robot.errors import BusError
@@ -42,6 +42,10 @@ def _robot(args: argparse.Namespace) -> RobotConfig:
         bundled = ROBOTS_DIR / f"biped18-{args.bus}.toml"
         if bundled.exists():
             return load_robot(bundled)
+        for name in robot_names():       # a bundled robot on that bus (dynamixel1: the AX's)
+            robot = load_robot(ROBOTS_DIR / f"{name}.toml")
+            if robot.bus.kind == args.bus:
+                return robot
     return load_robot(DEFAULT_ROBOT)
 
 
@@ -50,7 +54,8 @@ def _row(info: ServoInfo, robot: RobotConfig,
     joint = robot.joint_by_id(info.id)
     return {"id": info.id, "model": info.model, "model_name": info.model_name,
             "firmware": info.firmware, "return_delay_us": info.return_delay_us,
-            "baud": info.baud, "joint": joint.name if joint else None, "gains": gains}
+            "baud": info.baud, "joint": joint.name if joint else None, "gains": gains,
+            "case": joint.case if joint else None}
 
 
 def run(args: argparse.Namespace) -> int:
@@ -90,6 +95,8 @@ def _print_table(rows: list[dict[str, object]], robot: RobotConfig, *, bus_name:
         model = f"{r['model_name']} ({r['model']})"
         delay = f"{r['return_delay_us']:.0f} µs" if r["return_delay_us"] is not None else "?"
         joint = r["joint"] or "(not in robot config)"
+        if r["case"]:
+            joint = f"{joint} (axis of dual case {r['case']})"
         print(f"{r['id']:>4}  {model:<18} {r['firmware'] or '?':>4} {delay:>8}  {joint}")
     print("\n".join(gains_text))
     seen = {r["id"] for r in rows}

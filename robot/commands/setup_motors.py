@@ -18,17 +18,17 @@ from robot.bus.feetech import FeetechBus
 from robot.bus.lx import LxBus
 from robot.bus.sdk_bus import SdkBus
 from robot.commands.common import HARDWARE_BUSES, add_robot_args, one_line_errors, robot_from
-from robot.config.robot import RobotConfig
+from robot.config.robot import JointConfig, RobotConfig
 from robot.errors import ConfigError
 from robot.run.session import bus_session
 from robot.run.signals import shield
-from robot.servo.models import BUS_FAMILIES
+from robot.servo.models import factory_baud
+from robot.setup.dual_setup import assign_case
 from robot.setup.motor_setup import (
-    FACTORY_BAUD,
     answered,
     assign,
     check_model,
-    find_servo,
+    find_servos,
     joints_to_set,
 )
 
@@ -60,9 +60,29 @@ def _bus(args: argparse.Namespace, robot: RobotConfig) -> SdkBus | LxBus:
                      check_health=False)
     cls: type[SdkBus] = {"dynamixel": DynamixelBus, "dynamixel1": Dynamixel1Bus}.get(
         kind, FeetechBus)
-    # No robot on the bus: a servo at id 1 is a new servo, not joint 1 (and no health check).
-    return cls(args.port or robot.bus.port, baud=FACTORY_BAUD[BUS_FAMILIES[kind]],
+    # No robot on the bus: a servo at id 1 is a new servo, not joint 1 (and no health check);
+    # the robot's servo model says which table (the XL-320's, an SCS's) and the first baud.
+    servo = robot.bus.servo
+    return cls(args.port or robot.bus.port, baud=factory_baud(servo), family=servo.family,
                retries=robot.bus.retries, timeout_ms=robot.bus.timeout_ms, check_health=False)
+
+
+def _set_up(bus: SdkBus | LxBus, robot: RobotConfig, case: tuple[JointConfig, ...]) -> None:
+    """Find the servo (a dual-axis case: both axes) connected alone, check its model, give
+    it its joint's id (ids), the robot's baud and return delay 0."""
+    found = find_servos(bus, robot, len(case), progress=lambda m: print(f"  {m}", flush=True))
+    for f, joint in zip(sorted(found, key=lambda f: f.id), case, strict=True):
+        note = check_model(f, robot, joint)
+        if note:
+            print(f"  note: {note}")
+    where = ", ".join(f"id {f.id}" for f in sorted(found, key=lambda f: f.id))
+    print(f"  found: {robot.servo(case[0]).name} at {where}, {found[0].baud} baud")
+    with shield():           # id, baud, return delay: all of them or a signal waits
+        changes = (assign(bus, found[0], case[0], robot) if len(case) == 1 else
+                   assign_case(bus, found, case, robot))
+    done = "; ".join(changes) if changes else "already set, nothing changed"
+    ids = ", ".join(f"{j.name}: id {j.servo_id}" for j in case)
+    print(f"{ids} at {robot.bus.baud} baud, checked ({done})")
 
 
 def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
@@ -76,22 +96,23 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
     print(f"setting up {len(joints)} {robot.bus.model} servo(s) of {robot.name} on "
           f"{bus.port_name}: ids from the robot file, {robot.bus.baud} baud, return delay 0 "
           "(a servo waits that long before every reply: latency in each control tick)")
+    done: set[str] = set()
     with bus_session(bus, torque_off=False):
         for joint in joints:
+            case = robot.case_of(joint)     # a dual-axis servo: both joints of its case
+            if joint.name in done:
+                continue
+            done.update(j.name for j in case)
+            what = (f"the servo for {joint.name} (id {joint.servo_id})" if len(case) == 1
+                    else f"the {robot.servo(joint).name} case of "
+                    f"{' and '.join(j.name for j in case)} "
+                    f"(ids {' and '.join(str(j.servo_id) for j in case)})")
             if not args.yes:
-                reply = ask(f"connect only the servo for {joint.name} (id {joint.servo_id}) "
-                            "and press Enter (q to stop) ")
+                reply = ask(f"connect only {what} and press Enter (q to stop) ")
                 if reply.strip().lower() == "q":
                     print("stopped")
                     return 1
-            found = find_servo(bus, robot, progress=lambda m: print(f"  {m}", flush=True))
-            check_model(found, robot, joint)
-            print(f"  found: {robot.bus.model} at id {found.id}, {found.baud} baud")
-            with shield():           # id, baud, return delay: all of them or a signal waits
-                changes = assign(bus, found, joint, robot)
-            done = "; ".join(changes) if changes else "already set, nothing changed"
-            print(f"{joint.name}: id {joint.servo_id} at {robot.bus.baud} baud, checked "
-                  f"({done})")
+            _set_up(bus, robot, case)
     if not args.joint:
         print(f"done: connect the chain and check with `biped scan --robot {args.robot} "
               f"--bus {robot.bus.kind} --port {bus.port_name}`")

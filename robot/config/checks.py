@@ -18,7 +18,7 @@ from robot.config.joint_names import ARM_NAMES, EXTRA_NAME, HIP_YAW_NAMES, JOINT
 from robot.config.toml_io import TomlValue, show
 from robot.errors import ConfigError
 from robot.servo import ticks as tick_math
-from robot.servo.models import BAUD_CODES, BUS_FAMILIES, FIXED_BAUD, MODELS
+from robot.servo.models import BUS_FAMILIES, MODELS, bauds
 
 if TYPE_CHECKING:
     from robot.config.robot import BusConfig, JointConfig, RobotConfig
@@ -30,11 +30,9 @@ RAD_DIGITS = 4
 
 def standard_bauds(kind: str) -> list[int]:
     """The baud rates [bit/s] the servos of bus ``kind`` ("dynamixel" | "feetech" | ...)
-    offer (one, for a family without a Baud Rate register: FIXED_BAUD)."""
-    family = BUS_FAMILIES[kind]
-    if family in FIXED_BAUD:
-        return [FIXED_BAUD[family]]
-    return sorted(BAUD_CODES[family].values())
+    offer, over every family the kind speaks (one, for a family without a Baud Rate
+    register: FIXED_BAUD)."""
+    return sorted({b for family in BUS_FAMILIES[kind] for b in bauds(family)})
 
 
 def check_bus(src: str, bus: BusConfig) -> None:
@@ -45,12 +43,19 @@ def check_bus(src: str, bus: BusConfig) -> None:
     if bus.model not in MODELS:
         raise ConfigError(f"{src}: bus.model: unknown servo model {bus.model!r}; valid: "
                           f"{', '.join(MODELS)}")
-    if MODELS[bus.model].family != BUS_FAMILIES[bus.kind]:
-        raise ConfigError(f"{src}: bus.model: {bus.model} is not a {bus.kind} servo")
-    rates = standard_bauds(bus.kind)
+    family = MODELS[bus.model].family
+    if family not in BUS_FAMILIES[bus.kind]:
+        raise ConfigError(f"{src}: bus.model: {bus.model} is not a {bus.kind} servo; valid: "
+                          f"{', '.join(_models_of(BUS_FAMILIES[bus.kind]))}")
+    rates = bauds(family)
     if bus.baud not in rates:
-        raise ConfigError(f"{src}: bus.baud: expected a {bus.kind} baud rate (one of "
+        raise ConfigError(f"{src}: bus.baud: expected a {bus.model} baud rate (one of "
                           f"{', '.join(map(str, rates))}), got {show(bus.baud)}")
+
+
+def _models_of(families: tuple[str, ...] | str) -> list[str]:
+    fams = (families,) if isinstance(families, str) else families
+    return [m for m, s in MODELS.items() if s.family in fams]
 
 
 def _inward(lo: float, hi: float) -> tuple[float, float]:
@@ -132,16 +137,40 @@ def check_joint_set(src: str, jtab: Mapping[str, TomlValue]) -> None:
                           f"{', '.join(ARM_NAMES)}, or none)")
 
 
+def check_cases(src: str, joints: list[JointConfig], bus: BusConfig) -> None:
+    """Dual-axis servos: every joint on one has a ``case``, each case holds exactly two
+    joints, both on a dual-axis model; no other joint names a case."""
+    members: dict[str, list[str]] = {}
+    for j in joints:
+        dual = MODELS[j.model or bus.model].axes == 2
+        jp = f"joints.{j.name}.case"
+        if dual and j.case is None:
+            raise ConfigError(f"{src}: {jp}: missing ({j.model or bus.model} is a dual-axis "
+                              "servo: name its case, the same word on the joint of its other "
+                              "axis)")
+        if j.case is not None and not dual:
+            raise ConfigError(f"{src}: {jp}: {j.model or bus.model} has one axis; case is for "
+                              "the dual-axis 2XL430-W250 / 2XC430-W250")
+        if j.case is not None:
+            members.setdefault(j.case, []).append(j.name)
+    for case, names in members.items():
+        if len(names) != 2:
+            raise ConfigError(f"{src}: joints.{names[0]}.case: case {case!r} holds "
+                              f"{len(names)} joint(s) ({', '.join(names)}); a dual-axis case "
+                              "has two axes: name it on exactly two joints")
+
+
 def check_joint_extras(src: str, jp: str, j: JointConfig, bus: BusConfig, *,
                        extra: bool) -> None:
     """``model`` is a servo of the bus's family; ``fixed_rad`` only on extra joints and
     inside the joint's limits."""
     if j.model is not None:
-        family = BUS_FAMILIES[bus.kind]
-        valid = [m for m, s in MODELS.items() if s.family == family]
+        # One control table per bus: a joint's model shares bus.model's family.
+        valid = _models_of(MODELS[bus.model].family)
         if j.model not in valid:
             raise ConfigError(f"{src}: {jp}.model: {show(j.model)} is not a {bus.kind} servo "
-                              f"model; valid: {', '.join(valid)}")
+                              f"model; valid: {', '.join(valid)} (one control table per "
+                              f"bus: bus.model {bus.model}'s)")
     if j.fixed_rad is not None and not extra:
         raise ConfigError(f"{src}: {jp}.fixed_rad: the gait drives {j.name}; fixed_rad is for "
                           "extra joints only (e.g. head_pan)")

@@ -142,6 +142,9 @@ class JointConfig:
     gains: Mapping[str, int] = field(default_factory=dict)
     #: a fitted servo model file for this joint (overrides ``bus.servo_file``)
     servo_file: str | None = None
+    #: dual-axis servos (2XL430-W250, 2XC430-W250): the case this joint's axis sits in; the
+    #: two joints naming one case share it (two ids, one baud rate; setup-motors sets both)
+    case: str | None = None
 
 
 @dataclass(frozen=True)
@@ -191,6 +194,13 @@ class RobotConfig:
         """The gain registers ``joint``'s servo gets [register values]: its model's factory
         values, overridden by ``[bus.gains]``, overridden by ``[joints.<name>.gains]``."""
         return {**self.servo(joint).factory_gains, **self.bus.gains, **joint.gains}
+
+    def case_of(self, joint: JointConfig) -> tuple[JointConfig, ...]:
+        """The joints whose axes share ``joint``'s dual-axis case, in file order (just
+        ``joint`` for a one-axis servo)."""
+        if joint.case is None:
+            return (joint,)
+        return tuple(j for j in self.joints if j.case == joint.case)
 
     def servo_physics(self, joint: JointConfig) -> ServoPhysics:
         """The physics ``joint``'s servo is simulated with: the model file the robot file

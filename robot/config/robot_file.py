@@ -10,7 +10,13 @@ from dataclasses import replace
 from pathlib import Path
 
 from robot.config.bundled import DEFAULT_ROBOT, resolve_robot_path
-from robot.config.checks import check_bus, check_joint_extras, check_joint_set, check_ticks
+from robot.config.checks import (
+    check_bus,
+    check_cases,
+    check_joint_extras,
+    check_joint_set,
+    check_ticks,
+)
 from robot.config.gains_file import check_fits, parse_gains, split_gains
 from robot.config.imu_file import parse_imu
 from robot.config.joint_names import ARM_NAMES, HIP_YAW_NAMES, JOINT_NAMES
@@ -86,6 +92,7 @@ def parse_robot(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> R
                               f"must be < max_rad {j.max_rad}")
         joints.append(j)
 
+    check_cases(src, joints, bus)
     rest_raw = table(src, "rest", data.get("rest", {}))
     rest: dict[str, float] = {}
     names = {j.name: j for j in joints}

@@ -13,8 +13,9 @@ everything up to the last line written); plain text that ``jq`` or pandas read:
   {"tick": n, "t": ..., "state": "walking", "q": [...], "present": [...]}
       one streamed tick: the commanded joint angles [rad] as they went to the bus (after
       balance, clamp and slew), ``t`` [s] on the loop's clock since the first tick;
-      ``present``: on the ticks that read the servos back, the joint angles read [rad]
-      (``biped sim-gap`` compares them with the commands and the simulation)
+      ``present``: on the ticks that read the servos back, the joint angles read [rad],
+      ``present_t`` [s] when the reply was in (``biped sim-gap`` compares them with the
+      commands and the simulation)
 
 The gait is a pure function of the parameter timeline, so replaying the timeline on the
 same robot and rate reproduces the stream (in the simulation with balance feedback too:
@@ -80,7 +81,8 @@ class TakeHeader:
 class Take:
     """A take read back: header, timeline (gait tick → changes; the tick of the stop, or
     None) and the joint stream (``q``: ticks x joints [rad]; ``t`` [s]; ``states``;
-    ``present``: ticks x joints read back [rad], NaN on ticks without a read-back)."""
+    ``present``: ticks x joints read back [rad], NaN on ticks without a read-back;
+    ``present_t``: when each was read [s, the clock of ``t``; ``t`` if not recorded])."""
 
     header: TakeHeader
     changes: Mapping[int, Mapping[str, float]]
@@ -90,6 +92,7 @@ class Take:
     states: tuple[str, ...] = field(default=())
     source: str = "<memory>"
     present: npt.NDArray[np.float64] | None = None
+    present_t: npt.NDArray[np.float64] | None = None
 
     @property
     def gait_seconds(self) -> float:
@@ -194,6 +197,7 @@ def read_take(path: str | Path) -> Take:
     q: list[list[float]] = []
     states: list[str] = []
     present: list[list[float]] = []
+    read_t: list[float] = []
     nan = [math.nan] * n
     for where, row in rows[1:]:
         if not isinstance(row, dict):
@@ -215,10 +219,11 @@ def read_take(path: str | Path) -> Take:
                 raise _fail(where, "expected \"set\": {name: value} or \"stop\": true")
         elif "tick" in row:
             q.append(_angles(where, row.get("q"), n))
-            seen = row.get("present")
-            present.append(nan if seen is None else _angles(f"{where}: present", seen, n))
             t.append(number(where, "t", row.get("t", len(t) / header.rate_hz)))
             states.append(str(row.get("state", "")))
+            seen = row.get("present")
+            present.append(nan if seen is None else _angles(f"{where}: present", seen, n))
+            read_t.append(number(where, "present_t", row.get("present_t", t[-1])))
         else:
             raise _fail(where, "expected a timeline line (gait_tick) or a stream line (tick)")
     if not q and not stop:
@@ -227,4 +232,5 @@ def read_take(path: str | Path) -> Take:
     q_arr = np.asarray(q, dtype=float).reshape(len(q), n)
     read = np.asarray(present, dtype=float).reshape(len(q), n)
     return Take(header, changes, stop, np.asarray(t, dtype=float), q_arr, tuple(states),
-                source=str(p), present=read if np.isfinite(read).any() else None)
+                source=str(p), present=read if np.isfinite(read).any() else None,
+                present_t=np.asarray(read_t, dtype=float))

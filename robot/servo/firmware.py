@@ -20,6 +20,11 @@ Scales and where they come from:
 - Feetech STS: duty = 0.166 per P unit and radian, measured with an oscilloscope on an
   STS3215 by Rhoban/bam (``bam/feetech/actuator.py``, ``error_gain``); D and I on the same
   scale per 1 ms (an assumption; Feetech documents neither).
+- Dynamixel XL-320 (e-Manual XL-320: the MX PID registers at 27/28/29): duty = 0.0505 per
+  P unit and radian, measured with an oscilloscope on XL-320s by Rhoban/bam
+  (``bam/dynamixel/actuator.py``, ``XL320Actuator.error_gain``); I and D as for the MX.
+- Feetech SCS (SCSCL): the STS's coefficients (21/22/23); no measured scale: the STS3215's
+  is assumed.
 - Dynamixel AX (e-Manual AX-12A, "Compliance"): no torque within the compliance margin,
   then the output rises to full over the compliance slope [pulses]; cw and ccw averaged.
 - HiWonder/LewanSoul LX: no gain registers and no published position law; assumed is what
@@ -44,6 +49,7 @@ X_KPD_DIVISOR = 16.0        # e-Manual: KPD = D / 16
 X_PROFILE_RPM = 0.229       # e-Manual: Profile Velocity unit [rev/min]
 MX_DUTY_PER_P = 0.158       # Rhoban/bam oscilloscope, MX-64/106 [duty / (P unit rad)]
 STS_DUTY_PER_P = 0.166      # Rhoban/bam oscilloscope, STS3215 [duty / (P unit rad)]
+XL320_DUTY_PER_P = 0.05048199   # Rhoban/bam oscilloscope, XL-320 [duty / (P unit rad)]
 CYCLE_S = 0.001             # assumed firmware cycle of the D and I terms [s]
 LX_FULL_DUTY_RAD = 0.05     # assumed error at full duty of the LX firmware [rad]
 LX_D_S = 0.03               # assumed kd / kp of the LX firmware [s]
@@ -77,8 +83,19 @@ def _x(model: ServoModel, physics: ServoPhysics, gains: Mapping[str, int]) -> La
 
 
 def _mx(model: ServoModel, physics: ServoPhysics, gains: Mapping[str, int]) -> LawTerms:
+    return _byte_pid(MX_DUTY_PER_P, model, physics, gains)
+
+
+def _xl320(model: ServoModel, physics: ServoPhysics, gains: Mapping[str, int]) -> LawTerms:
+    return _byte_pid(XL320_DUTY_PER_P, model, physics, gains)
+
+
+def _byte_pid(duty_per_p: float, model: ServoModel, physics: ServoPhysics,
+              gains: Mapping[str, int]) -> LawTerms:
+    """The MX (Protocol 1.0) and XL-320 PID: one-byte D/I/P Gain registers, KP = P / 8,
+    KI = I * 1000 / 2048, KD = D * 4 / 1000, ``duty_per_p`` duty per P unit and radian."""
     p = _p(gains, "p_gain", model)
-    per_kp = MX_DUTY_PER_P * physics.gain_scale * 8.0   # duty per (KP unit rad)
+    per_kp = duty_per_p * physics.gain_scale * 8.0   # duty per (KP unit rad)
     kd = gains.get("d_gain", 0) * 4 / 1000 * per_kp * CYCLE_S * physics.kd_scale
     ki = gains.get("i_gain", 0) * 1000 / 2048 * per_kp / CYCLE_S
     return LawTerms(p / 8 * per_kp, kd, ki, 0.0, physics.max_velocity)
@@ -107,7 +124,10 @@ def _lx(model: ServoModel, physics: ServoPhysics, gains: Mapping[str, int]) -> L
 
 LAWS: dict[str, Callable[[ServoModel, ServoPhysics, Mapping[str, int]], LawTerms]] = {
     "dynamixel_x": _x, "dynamixel_mx1": _mx, "feetech_sts": _sts, "dynamixel_ax": _ax,
-    "lx": _lx,
+    "lx": _lx, "dynamixel_xl320": _xl320,
+    # Feetech SCS: the STS coefficients at the same addresses; no oscilloscope figure for
+    # an SCS: the STS3215's scale is assumed (its source says so).
+    "feetech_scs": _sts,
 }
 
 
@@ -126,6 +146,7 @@ LOG_GAIN_REGISTERS: dict[str, tuple[str, ...]] = {
     "dynamixel_x": ("position_p_gain",), "dynamixel_mx1": ("p_gain",),
     "feetech_sts": ("p_coefficient",),
     "dynamixel_ax": ("cw_compliance_slope", "ccw_compliance_slope"), "lx": (),
+    "dynamixel_xl320": ("p_gain",), "feetech_scs": ("p_coefficient",),
 }
 
 

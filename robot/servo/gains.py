@@ -65,6 +65,9 @@ _X = "ROBOTIS e-Manual, XL430-W250 / XM430-W350 / XC430-W150, Control Table of R
 _X_PID = f"{_X}; Position PID Gain(84, 82, 80)"
 _AX = "ROBOTIS e-Manual, AX-12A, Control Table of RAM Area"
 _MX = "ROBOTIS e-Manual, MX-28 (Protocol 1.0), Control Table of RAM Area; PID Gains(26, 27, 28)"
+_XL320 = "ROBOTIS e-Manual, XL-320, Control Table of RAM Area; PID Gains(27, 28, 29)"
+_SCS = ("Feetech SCSCL memory table (SCS15 manual v1.02), EEPROM, saved only with "
+        "Lock(48) = 0")
 _STS = ("Feetech STS/SMS memory table (FT-SMS-STS-emanual), EPROM area, saved only with "
         "Lock(55) = 0")
 
@@ -116,6 +119,24 @@ GAIN_SETS: dict[str, GainSet] = {
              f"{_STS}; D coefficient(22)"),
         Gain("i_coefficient", 0, 254, "eeprom", "position loop integral coefficient",
              f"{_STS}; I coefficient(23)"),
+    ),
+    # XL-320 (Protocol 2.0, its own table): the MX-style PID, RAM, 0 ~ 254 (the page's PID
+    # section is the MX one: Kp = P / 8, Ki = I * 1000 / 2048, Kd = D * 4 / 1000).
+    "dynamixel_xl320": _set(
+        "dynamixel_xl320", "dynamixel_xl320",
+        Gain("d_gain", 0, 254, "ram", "Kd = value * 4 / 1000", _XL320),
+        Gain("i_gain", 0, 254, "ram", "Ki = value * 1000 / 2048", _XL320),
+        Gain("p_gain", 0, 254, "ram", "Kp = value / 8", _XL320),
+    ),
+    # Feetech SCS (SCSCL): the STS's three coefficients at the same addresses, in EEPROM.
+    "feetech_scs": _set(
+        "feetech_scs", "feetech_scs",
+        Gain("p_coefficient", 0, 254, "eeprom", "position loop proportional coefficient",
+             f"{_SCS}; P(21)"),
+        Gain("d_coefficient", 0, 254, "eeprom", "position loop derivative coefficient",
+             f"{_SCS}; D(22)"),
+        Gain("i_coefficient", 0, 254, "eeprom", "position loop integral coefficient",
+             f"{_SCS}; I(23)"),
     ),
     # HiWonder/LewanSoul LX: the Bus Servo Communication Protocol has no gain command (a
     # position, a move time, limits, offset, load/unload, LED): nothing to set.

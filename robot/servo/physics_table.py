@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+from robot.servo import physics_bam
 from robot.servo.models import MODELS
 from robot.servo.physics import ServoPhysics, from_datasheet
 
@@ -90,6 +91,12 @@ _XL330 = ServoPhysics(
              "stribeck": "none (bam M1)", "stribeck_speed": "unused",
              "load_friction": "none (bam M1)", "max_velocity": "none: Profile Velocity 0"})
 
+def _xl330_scale(physics: ServoPhysics) -> ServoPhysics:
+    return physics.with_values(
+        {"gain_scale": _XL330.gain_scale},
+        source="the XL330-M288 recordings' Present PWM (P / 256), carried to the same firmware")
+
+
 PHYSICS: dict[str, ServoPhysics] = {
     "XL430-W250": _sheet("XL430-W250", X_SHARES),
     "XM430-W350": _sheet("XM430-W350", X_SHARES),
@@ -106,4 +113,27 @@ PHYSICS: dict[str, ServoPhysics] = {
     "LX-16A": _sheet("LX-16A", STS_SHARES),
     "LX-224": _sheet("LX-224", STS_SHARES),
     "LX-224HV": _sheet("LX-224HV", STS_SHARES),
+    # --- issue 21's servos -------------------------------------------------------------
+    # Identified by Rhoban/bam (robot/servo/physics_bam.py).
+    "XL-320": physics_bam.XL320,
+    "MX-64": physics_bam.MX64,
+    "MX-106": physics_bam.MX106,
+    "MX-64(2.0)": physics_bam.MX64_2,
+    "MX-106(2.0)": physics_bam.MX106_2,
+    "STS3215-12V": physics_bam.STS3215_12V,
+    # Datasheet + register scale. The XL330-M077 shares the XL330-M288's firmware and its
+    # recordings' scale (Present PWM = P / 256); the XC330s, of the same MCU and table
+    # generation, are given it too (an assumption: no XC330 recordings).
+    "XL330-M077": _xl330_scale(_sheet("XL330-M077", X_SHARES)),
+    "XC330-M181": _xl330_scale(_sheet("XC330-M181", X_SHARES)),
+    "XC330-M288": _xl330_scale(_sheet("XC330-M288", X_SHARES)),
+    "XC330-T181": _xl330_scale(_sheet("XC330-T181", X_SHARES)),
+    "XC330-T288": _xl330_scale(_sheet("XC330-T288", X_SHARES)),
+    **{name: _sheet(name, X_SHARES) for name in (
+        "XM430-W210", "XH430-W210", "XH430-W350", "XH430-V210", "XH430-V350", "XM540-W150",
+        "XM540-W270", "2XL430-W250", "2XC430-W250")},
+    "MX-28(2.0)": _sheet("MX-28(2.0)", MX_SHARES),
+    "STS3046": _sheet("STS3046", STS_SHARES, max_duty=0.97),
+    # Feetech SCS (potentiometer, carbon-brush motors): the STS3215's gearbox shares.
+    **{name: _sheet(name, STS_SHARES) for name in ("SCS0009", "SCS15", "SCS40")},
 }

@@ -22,21 +22,19 @@ from dataclasses import dataclass
 
 from robot.bus.lx import LxBus
 from robot.bus.sdk_bus import SdkBus
-from robot.bus.tables import RETURN_DELAY_UNIT_S
+from robot.bus.tables import EEPROM_LOCK, RETURN_DELAY_UNIT_S
 from robot.config.robot import SERVO_ID, JointConfig, RobotConfig
 from robot.errors import BusError, ConfigError
-from robot.servo.models import BAUD_CODES, BUS_FAMILIES, FIXED_BAUD, model_name
+from robot.servo.models import BAUD_CODES, BUS_FAMILIES, FACTORY_BAUD, lookup, model_name
 
 log = logging.getLogger(__name__)
 
 FACTORY_ID = 1
-#: Baud rate [bit/s] as shipped: ROBOTIS X series 57600 (Baud Rate(8) = 1), Feetech STS
-#: 1 Mbps (Baud Rate(6) = 0).
-# AX-12A / MX-28 (Protocol 1.0) ship at 1 Mbps (e-Manual AX-12A, Baud Rate(4) initial 1).
-# LX servos have one rate (no Baud Rate register) and find a lone servo by a broadcast
-# ID read (robot/bus/lx.py).
-FACTORY_BAUD = {"dynamixel_x": 57_600, "dynamixel_p1": 1_000_000, "feetech_sts": 1_000_000,
-                **FIXED_BAUD}
+# Baud rates as shipped: robot.servo.models.FACTORY_BAUD (per family; a model may differ:
+# the MX series on Protocol 1.0 ships at 57600 where the AX ships at 1 Mbps). LX servos
+# have one rate (no Baud Rate register) and find a lone servo by a broadcast ID read
+# (robot/bus/lx.py).
+__all__ = ["FACTORY_BAUD", "find_servo", "assign"]
 #: The buses setup-motors drives (LX: the same calls, on its own protocol).
 SetupBus = SdkBus | LxBus
 ALL_IDS = range(int(SERVO_ID.lo), int(SERVO_ID.hi) + 1)
@@ -116,19 +114,29 @@ def find_servo(bus: SetupBus, robot: RobotConfig, *,
                progress: Callable[[str], None] = log.info) -> Found:
     """The one servo on ``bus`` (open; left at its original baud). SetupRefused when none,
     or more than one, answers."""
-    family = BUS_FAMILIES[robot.bus.kind]
+    return find_servos(bus, robot, 1, progress=progress)[0]
+
+
+def find_servos(bus: SetupBus, robot: RobotConfig, count: int, *,
+                progress: Callable[[str], None] = log.info) -> list[Found]:
+    """The ``count`` servos on ``bus`` (one case: 1, or 2 for a dual-axis servo, which ships
+    at ids 1 and 2); left at its original baud. SetupRefused when none, or another number,
+    answers."""
+    family = robot.bus.servo.family
     original = bus.baud
     try:
         bauds = [b for b in baud_order(family, robot.bus.baud) if _try_baud(bus, b)]
         skipped = sorted(set(BAUD_CODES.get(family, {}).values()) - set(bauds))
-        progress(f"looking for id {FACTORY_ID} at {', '.join(map(str, bauds))} baud"
+        factory_ids = list(range(FACTORY_ID, FACTORY_ID + count))
+        progress(f"looking for id {', '.join(map(str, factory_ids))} at "
+                 f"{', '.join(map(str, bauds))} baud"
                  + (f" ({', '.join(map(str, skipped))}: the SDK cannot set it)" if skipped
                     else ""))
         found: list[Found] = []
         for baud in bauds:
             bus.set_baud(baud)
-            ids = [FACTORY_ID] + ([i for i in robot.ids if i != FACTORY_ID]
-                                  if baud == robot.bus.baud else [])
+            ids = factory_ids + ([i for i in robot.ids if i not in factory_ids]
+                                 if baud == robot.bus.baud else [])
             found += _ping_all(bus, ids)
         if not found:
             for baud in bauds:
@@ -143,23 +151,33 @@ def find_servo(bus: SetupBus, robot: RobotConfig, *,
         raise SetupRefused(f"no servo answered on {bus.port_name} at any id "
                            f"({ALL_IDS.start}-{ALL_IDS.stop - 1}) and baud ({rates}); check "
                            "its power (the LED flashes at power-up), its cable and --port")
-    if len(found) > 1:
-        who = ", ".join(f"id {f.id} at {f.baud} baud" for f in found)
+    who = ", ".join(f"id {f.id} at {f.baud} baud" for f in found)
+    if count == 1 and len(found) > 1:
         raise SetupRefused(f"{len(found)} servos answer on {bus.port_name} ({who}); nothing "
                            "was written: connect only the servo to set up")
-    return found[0]
+    if count > 1 and (len(found) != count or len({(f.baud, f.model) for f in found}) != 1):
+        raise SetupRefused(f"{len(found)} servo(s) answer on {bus.port_name} ({who}); a "
+                           f"dual-axis case answers at {count} ids of one model and baud; "
+                           "nothing was written: connect only the case to set up")
+    return found
 
 
-def check_model(found: Found, robot: RobotConfig, joint: JointConfig) -> None:
-    """SetupRefused unless the found servo is the robot's model."""
-    want = robot.bus.servo
-    if found.model != want.number:
-        family = BUS_FAMILIES[robot.bus.kind]
-        raise SetupRefused(
-            f"the servo at id {found.id}, {found.baud} baud is a "
-            f"{model_name(family, found.model)} (model {found.model}), but {robot.name} uses "
-            f"{want.name} (model {want.number}) for {joint.name}; nothing was written: connect "
-            f"a {want.name}, or fix bus.model in {robot.source}")
+def check_model(found: Found, robot: RobotConfig, joint: JointConfig) -> str | None:
+    """SetupRefused unless the found servo is the joint's model; a note (returned) when the
+    model's number is unverified and the servo reports a number no known model has."""
+    want = robot.servo(joint)
+    if found.model == want.number:
+        return None
+    families = BUS_FAMILIES[robot.bus.kind]
+    if not want.number_verified and lookup(families, found.model) is None:
+        return (f"the servo reports model number {found.model}, which no page at hand names; "
+                f"{want.name}'s own number is unverified: taken as the {want.name} the robot "
+                "file names")
+    raise SetupRefused(
+        f"the servo at id {found.id}, {found.baud} baud is a "
+        f"{model_name(families, found.model)} (model {found.model}), but {robot.name} uses "
+        f"{want.name} (model {want.number}) for {joint.name}; nothing was written: connect "
+        f"a {want.name}, or fix bus.model in {robot.source}")
 
 
 def _write_tolerant(bus: SetupBus, sid: int, name: str, value: int,
@@ -177,7 +195,7 @@ def assign(bus: SetupBus, found: Found, joint: JointConfig, robot: RobotConfig) 
     """Give the one servo ``found`` the joint's id, the robot's baud and return delay 0;
     verify at the new baud. Returns what changed, in words. ``bus`` is open; it ends at the
     robot's baud."""
-    family = BUS_FAMILIES[robot.bus.kind]
+    family = robot.bus.servo.family
     codes = {b: c for c, b in BAUD_CODES.get(family, {}).items()}
     new_id, new_baud = joint.servo_id, robot.bus.baud
     bus.set_baud(found.baud)
@@ -185,9 +203,9 @@ def assign(bus: SetupBus, found: Found, joint: JointConfig, robot: RobotConfig) 
     bus.set_torque([sid], enabled=False)
     # Feetech: unlock the EEPROM so the writes survive a power cycle. (The AX's Lock(47)
     # means the opposite: 1 locks the EEPROM until power-off, so it is never written.)
-    lock = "lock" in bus.table and family == "feetech_sts"
+    lock = EEPROM_LOCK.get(family)
     if lock:
-        bus.write_register(sid, "lock", 0)
+        bus.write_register(sid, lock[0], lock[1])
     changes: list[str] = []
     delay = bus.read_register(sid, "return_delay_time") if "return_delay_time" in bus.table else 0
     if delay:
@@ -212,7 +230,7 @@ def assign(bus: SetupBus, found: Found, joint: JointConfig, robot: RobotConfig) 
                        f"at {new_baud} baud on {bus.port_name} (got {model}); power-cycle it "
                        f"and rerun `biped setup-motors --joint {joint.name}`")
     if lock:
-        bus.write_register(sid, "lock", 1)
+        bus.write_register(sid, lock[0], lock[2])
     return changes
 
 

@@ -2,7 +2,6 @@
 
 The real vendor SDKs open the pty's slave path like a USB adapter and talk their protocol
 to it; the test process drives faults and reads the log through a pipe while the child serves.
-
 - Time: ``time.monotonic()`` [s] (system-wide on Linux); motion is lazy, at each packet.
 - Baud: a pty carries no baud rate, but pyserial stores the requested speed in the slave's
   termios; the child holds the slave open and reads that speed (``TCGETS2``) at every
@@ -19,12 +18,12 @@ to it; the test process drives faults and reads the log through a pipe while the
   (goal := present), the register reads -1 and goal writes get a Data Range Error until
   0 is written; torque stays on. Evaluated lazily like motion, so ``registers()`` after a
   silent gap shows the trip. Feetech STS has no such register (see ``servo_status.BUS_WATCHDOG``).
-- Log: one :class:`Packet` per valid instruction packet a servo heard (broadcast: id
-  254); written values little-endian, signed where Dynamixel says; bulk reads: id → address.
-- Servos move by their model (``servo_dynamics``; ``loads``: id → a weight on its arm;
-  ``motion="travel"``: at constant speed onto the goal) from the joint's ``zero_ticks``
-  (2048 without a robot); position limits: the joint limits in ticks (rounded outward).
-  Sync/bulk reads answer in packet order; a missing servo silences the rest. A chain
+- Log: one :class:`Packet` per heard instruction packet with a valid checksum (broadcast:
+  id 254); values in the servo's byte order, signed per the X table; bulk reads: id → address.
+- Servos travel at constant speed onto the goal, or move by the servo model
+  (``motion="model"``: ``servo_dynamics``; ``loads``: id → a weight on its arm), from the
+  joint's ``zero_ticks`` (2048 without a robot), limits: the joint's in ticks (outward).
+  Sync/bulk reads answer in packet order; a missing servo silences the rest; a chain
   built from a robot is already set up (return delay 0).
 - Factory-new servos (:meth:`Emulator.factory_new`): id 1, factory baud and return delay,
   unplugged until :meth:`Emulator.plug` / :meth:`Emulator.plug_all`. Unplugging powers a
@@ -55,10 +54,10 @@ from typing import Any
 
 from robot.config.robot import RobotConfig
 from robot.servo.bench_load import BenchLoad
-from sim.emulator.chain_specs import FACTORY_BAUD, FACTORY_ID, factory_servos, plan_chain
+from sim.emulator.chain_specs import FACTORY_BAUD, FACTORY_ID, factory_baud, factory_servos, plan_chain
 from sim.emulator.control_tables import BAUD_CODES, TABLES
 from sim.emulator.records import ChainSpec, EmulatorError, Packet
-from sim.emulator.servo_models import MODELS, PROTOCOL_FAMILY
+from sim.emulator.servo_models import MODELS
 from sim.emulator.servo_status import ERROR_BITS
 
 __all__ = ["ChainSpec", "Emulator", "EmulatorError", "Packet"]
@@ -80,7 +79,7 @@ class Emulator:
         choice = plan_chain(protocol, robot, ids=ids, model=model, baud=baud, loads=loads,
                             motion=motion)
         self.protocol = protocol
-        self.family = PROTOCOL_FAMILY[protocol]
+        self.family = MODELS[choice.model].family     # the chain's table family
         self.model, self.baud, self.ids = choice.model, choice.baud, choice.ids
         self.spec = ChainSpec(protocol, choice.servos, seed, dynamics=choice.dynamics)
         self._proc: subprocess.Popen[bytes] | None = None
@@ -101,8 +100,9 @@ class Emulator:
         if count < 1:
             raise EmulatorError(f"count: expected at least 1 servo, got {count}")
         emu = cls(protocol, ids=[FACTORY_ID] * count, model=model,
-                  baud=FACTORY_BAUD[protocol])
+                  baud=factory_baud(protocol, model))
         emu.spec = replace(emu.spec, plugged=(), servos=factory_servos(protocol, emu.spec.servos))
+        emu.ids = tuple(s.servo_id for s in emu.spec.servos)   # a dual-axis case: 1 and 2
         return emu
 
     # ------------------------------------------------------------------ lifecycle

@@ -14,12 +14,12 @@ from robot.config.robot import RobotConfig
 from robot.config.servo_file import physics_for
 from robot.servo.bench_load import NONE, BenchLoad
 from robot.servo.models import MODELS as DRIVER_MODELS
-from sim.emulator.control_tables import BAUD_CODES
+from sim.emulator.control_tables import BAUD_CODES, TABLES
 from sim.emulator.lx_commands import BAUD as LX_BAUD
 from sim.emulator.records import EmulatorError
 from sim.emulator.servo import ServoSpec
 from sim.emulator.servo_dynamics import DynamicsSpec
-from sim.emulator.servo_models import MODELS, PROTOCOL_FAMILY
+from sim.emulator.servo_models import MODELS, PROTOCOL_FAMILIES, PROTOCOL_FAMILY
 
 DEFAULT_MODEL = {"dynamixel": "XL430-W250", "dynamixel1": "AX-12A", "feetech": "STS3215",
                  "lx": "LX-16A"}
@@ -75,14 +75,14 @@ def plan_chain(protocol: str, robot: RobotConfig | None, *, ids: Sequence[int] |
     if protocol not in PROTOCOL_FAMILY:
         raise EmulatorError(f"protocol: expected one of {', '.join(PROTOCOL_FAMILY)}, "
                             f"got {protocol!r}")
-    family = PROTOCOL_FAMILY[protocol]
     same_kind = robot is not None and robot.bus.kind == protocol
     model = model or (robot.bus.model if robot is not None and same_kind
                       else DEFAULT_MODEL[protocol])
-    if model not in MODELS or MODELS[model].family != family:
-        valid = [m for m, s in MODELS.items() if s.family == family]
+    if model not in MODELS or MODELS[model].family not in PROTOCOL_FAMILIES[protocol]:
+        valid = [m for m, s in MODELS.items() if s.family in PROTOCOL_FAMILIES[protocol]]
         raise EmulatorError(f"model: {model!r} is not a {protocol} servo; valid: "
                             f"{', '.join(valid)}")
+    family = MODELS[model].family              # one table family a chain (as the driver's bus)
     if ids is None:
         if robot is None:
             raise EmulatorError("Emulator needs a robot config or ids=[...]")
@@ -92,19 +92,40 @@ def plan_chain(protocol: str, robot: RobotConfig | None, *, ids: Sequence[int] |
     if baud not in RATES[family]:
         raise EmulatorError(f"baud: {baud} is not a {protocol} rate; valid: {RATES[family]}")
     specs = []
+    cases: dict[str, int] = {}          # a dual-axis case's name -> its number (1, 2, ...)
     for sid in ids:
         joint = robot.joint_by_id(sid) if robot is not None and same_kind else None
         own = joint.model if joint is not None and joint.model else model  # mixed models
         zero, lo, hi = _limits(robot, sid, own)
-        specs.append(ServoSpec(sid, own, zero, lo, hi, baud))
+        case = cases.setdefault(joint.case, len(cases) + 1) if joint and joint.case else 0
+        specs.append(ServoSpec(sid, own, zero, lo, hi, baud, case=case))
     return ChainChoice(model, baud, tuple(ids), tuple(specs),
                        plan_dynamics(protocol, robot, specs, loads or {}, motion=motion))
 
 
 def factory_servos(protocol: str, servos: Sequence[ServoSpec]) -> tuple[ServoSpec, ...]:
-    """The same servos with the factory return delay (new out of the box)."""
-    delay = FACTORY_RETURN_DELAY[protocol]
-    return tuple(replace(s, return_delay=delay) for s in servos)
+    """The same servos with the factory return delay (new out of the box): the manual's
+    initial Return Delay Time of each one's table (LX: none). A dual-axis model
+    (2XL430-W250) is a case of two axes, at ids 1 and 2."""
+    servos = [replace(s, servo_id=s.servo_id + axis, case=n + 1) if MODELS[s.model].axes == 2
+              else s for n, s in enumerate(servos)
+              for axis in range(MODELS[s.model].axes)]
+
+    def delay(model: str) -> int:
+        entry = TABLES.get(MODELS[model].layout, {}).get("return_delay_time")
+        return entry.initial or 0 if entry is not None else FACTORY_RETURN_DELAY[protocol]
+    return tuple(replace(s, return_delay=delay(s.model)) for s in servos)
+
+
+def factory_baud(protocol: str, model: str | None) -> int:
+    """The rate a new ``model`` servo (default: the protocol's) listens at [bit/s]: its
+    table's initial Baud Rate (an MX-28 on Protocol 1.0 ships at 57600 where an AX-12A
+    ships at 1 Mbps; the XL-320 at 1 Mbps where the X series ships at 57600)."""
+    m = MODELS[model or DEFAULT_MODEL[protocol]]
+    entry = TABLES.get(m.layout, {}).get("baud_rate")
+    if entry is None or entry.initial is None:
+        return FACTORY_BAUD[protocol]
+    return BAUD_CODES[m.family][entry.initial]
 
 
 def plan_dynamics(protocol: str, robot: RobotConfig | None, servos: Sequence[ServoSpec],
@@ -132,6 +153,10 @@ def plan_dynamics(protocol: str, robot: RobotConfig | None, servos: Sequence[Ser
     out: list[DynamicsSpec | None] = []
     for s in servos:
         joint = robot.joint_by_id(s.servo_id) if robot is not None and same_kind else None
+        driver = DRIVER_MODELS.get(s.model)
+        if driver is None or not driver.gain_set:
+            out.append(None)       # no firmware law for it: it travels
+            continue
         if robot is not None and joint is not None and robot.servo(joint).name == s.model:
             physics, voltage = robot.servo_physics(joint), robot.voltage(joint)
         else:

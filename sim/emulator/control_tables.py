@@ -23,6 +23,14 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+from sim.emulator.control_tables_more import (
+    BAUD_CODES_MORE,
+    EEPROM_END_MORE,
+    OWN_TABLES,
+    UNPRINTED_MORE,
+    VARIANTS,
+)
+
 
 class Entry(NamedTuple):
     """One control-table row: address, size [bytes], "R"/"RW", initial value (or None)."""
@@ -234,8 +242,13 @@ TABLES: dict[str, dict[str, Entry]] = {
     "dynamixel_x": DYNAMIXEL_X, "dynamixel_p1": DYNAMIXEL_AX, "feetech_sts": FEETECH_STS,
     "dynamixel_mx1": DYNAMIXEL_MX1,
 }
+TABLES.update({layout: {n: Entry(*row) for n, row in rows.items()}
+               for layout, rows in OWN_TABLES.items()})
+for _layout, _v in VARIANTS.items():       # XL-320, SCS, the X / MX variants (more tables)
+    TABLES[_layout] = {**{n: e for n, e in TABLES[_v.base].items() if n not in _v.drop},
+                       **{n: Entry(*row) for n, row in _v.add.items()}}
 EEPROM_END: dict[str, int] = {"dynamixel_x": 64, "dynamixel_p1": 24, "feetech_sts": 40,
-                              "dynamixel_mx1": 24}
+                              "dynamixel_mx1": 24, **EEPROM_END_MORE}
 
 #: Values where the manual prints "-" (firmware, sensors, tuning the factory sets per
 #: unit): what this emulator reports. The manual's initial values are in the tables.
@@ -249,6 +262,7 @@ UNPRINTED: dict[str, dict[str, int]] = {
     "feetech_sts": {"firmware_major": 3, "firmware_minor": 10, "max_voltage_limit": 140,
                     "p_coefficient": 32, "d_coefficient": 32, "present_voltage": 74,
                     "present_temperature": 35},
+    **UNPRINTED_MORE,
 }
 
 #: Registers the X manual gives in two's complement.
@@ -272,6 +286,7 @@ BAUD_CODES: dict[str, dict[int, int]] = {
     # AX-12A "Baud Rate(4)": 2000000 / (value + 1); the manual's table of usual values.
     "dynamixel_p1": {1: 1_000_000, 3: 500_000, 4: 400_000, 7: 250_000, 9: 200_000,
                      16: 115_200, 34: 57_600, 103: 19_200, 207: 9_600},
+    **BAUD_CODES_MORE,
 }
 
 #: Profile Velocity(112) / Present Velocity(128) unit on X: 0.229 rev/min.

@@ -110,7 +110,7 @@ def handle(p: Protocol, servo_id: int, inst: int, params: bytes,
     elif inst in (WRITE, REG_WRITE) and len(params) > w:
         address, data = _word(params[:w]), params[w:]
         length = len(data)
-        values[servo_id] = decode_value(p.family, address, data)
+        values[servo_id] = decode_value(servo.family if servo else p.family, address, data)
         for s in targets:
             was = before(s)
             outcome = s.write(address, data) if inst == WRITE else s.reg_write(address, data)
@@ -146,7 +146,8 @@ def handle(p: Protocol, servo_id: int, inst: int, params: bytes,
         i = 0
         while i + 5 <= len(params):
             sid, a, n = params[i], _word(params[i + 1:i + 3]), _word(params[i + 3:i + 5])
-            values[sid] = decode_value(p.family, a, params[i + 5:i + 5 + n])
+            values[sid] = decode_value(hearing[sid].family if sid in hearing else p.family, a,
+                                       params[i + 5:i + 5 + n])
             if sid in hearing:
                 hearing[sid].write(a, params[i + 5:i + 5 + n])
             i += 5 + n

@@ -21,6 +21,7 @@ from types import ModuleType
 from typing import Any
 
 from sim.emulator import dxl1_protocol, dxl_protocol, lx_protocol, sts_protocol
+from sim.emulator.dual_axis import case_mates, link_cases
 from sim.emulator.line import Line, Outbox, pty_speed
 from sim.emulator.records import ChainSpec, EmulatorError, Packet
 from sim.emulator.servo import EmulatedServo
@@ -56,6 +57,7 @@ class _ChainServer:
         self.servos = [servo_class(s, now) for s in spec.servos]
         for servo, model in zip(self.servos, spec.dynamics, strict=False):
             servo.dynamics = None if model is None else ServoDynamics(model)
+        link_cases(self.servos)     # the two axes of a dual-axis case (2XL430-W250)
         self.plugged: set[int] = set(range(len(self.servos)) if spec.plugged is None
                                      else spec.plugged)
         self.rng = random.Random(spec.seed)
@@ -214,6 +216,7 @@ class _ChainServer:
     def plug(self, indices: list[int] | None) -> None:
         """Connect exactly ``indices`` (None: every servo); a newly connected servo powers on."""
         wanted = set(range(len(self.servos))) if indices is None else set(indices)
+        wanted |= {j for i in wanted for j in case_mates(self.servos, i)}   # a whole case
         now = time.monotonic()
         for i in self.plugged - wanted:
             self.servos[i].power_off(now)

@@ -14,38 +14,23 @@ sync/bulk packet); :meth:`update` trips it (goal := present where the gap ran ou
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from sim.emulator import servo_frame, servo_indirect, servo_motion, servo_write
 from sim.emulator.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, UNPRINTED, Entry
 from sim.emulator.servo_models import MODELS
-from sim.emulator.servo_state import ServoDynamics, WriteError
+from sim.emulator.servo_spec import ServoSpec
+from sim.emulator.servo_state import PROTOCOL_2, ServoDynamics, WriteError, byteorder
 from sim.emulator.servo_status import BUS_WATCHDOG, ERROR_BITS, RETURN_DELAY_UNIT_S
+
+__all__ = ["EmulatedServo", "ServoSpec"]
 
 #: The registers that hold a family's position limits (low, high).
 POSITION_LIMITS: dict[str, tuple[str, str]] = {
     "dynamixel_x": ("min_position_limit", "max_position_limit"),
     "dynamixel_p1": ("cw_angle_limit", "ccw_angle_limit"),
     "feetech_sts": ("min_angle_limit", "max_angle_limit"),
+    "dynamixel_xl320": ("cw_angle_limit", "ccw_angle_limit"),
+    "feetech_scs": ("min_angle_limit", "max_angle_limit"),
 }
-
-
-@dataclass(frozen=True)
-class ServoSpec:
-    """What the emulator needs to build one servo.
-
-    servo_id: bus id; model: key of ``servo_models.MODELS``; zero_ticks: initial present
-    position [ticks]; min_ticks/max_ticks: position limits [ticks]; baud: [bit/s];
-    return_delay: Return Delay Time register [raw steps] (0: a chain already set up).
-    """
-
-    servo_id: int
-    model: str
-    zero_ticks: int
-    min_ticks: int
-    max_ticks: int
-    baud: int
-    return_delay: int = 0
 
 
 class EmulatedServo:
@@ -56,6 +41,7 @@ class EmulatedServo:
         self.spec = spec
         self.model = MODELS[spec.model]
         self.family = self.model.family
+        self.byteorder = byteorder(self.family)
         layout = self.model.layout                      # its control table's key
         self.table: dict[str, Entry] = TABLES[layout]
         self.mem = bytearray(max(r.address + r.size for r in self.table.values()))
@@ -93,19 +79,20 @@ class EmulatedServo:
         self._saved = bytes(self.mem[:self.eeprom_end])   # EEPROM as kept over power-off
         self._ram_at_power_on = bytes(self.mem[self.eeprom_end:])
         self.pending: tuple[int, bytes] | None = None     # a Reg Write waiting for Action
-        self._registered = {"dynamixel_x": "registered_instruction",
-                            "dynamixel_p1": "registered"}.get(self.family, "async_write_flag")
+        self._registered = {"dynamixel_x": "registered_instruction", "dynamixel_p1": "registered",
+                            "dynamixel_xl320": "registered"}.get(self.family, "async_write_flag")
         self._indirect = servo_indirect.indirect_map(self.table)   # X only
+        self.partner: EmulatedServo | None = None   # the other axis of a dual-axis case
 
     def get(self, name: str) -> int:
         """Value of a register by name (signed where the Dynamixel table says so)."""
         start, end, signed, _ = self._slots[name]
-        return int.from_bytes(self.mem[start:end], "little", signed=signed)
+        return int.from_bytes(self.mem[start:end], self.byteorder, signed=signed)
 
     def set_raw(self, name: str, value: int) -> None:
         """Store a register by name, leaving the position model alone."""
         start, end, _, modulus = self._slots[name]
-        self.mem[start:end] = (value % modulus).to_bytes(end - start, "little")
+        self.mem[start:end] = (value % modulus).to_bytes(end - start, self.byteorder)
 
     def set(self, name: str, value: int) -> None:
         """Store a register by name without any check (the emulator's back door).
@@ -143,7 +130,7 @@ class EmulatedServo:
 
     @property
     def error_register(self) -> str:
-        return "hardware_error_status" if self.family == "dynamixel_x" else "status"
+        return "hardware_error_status" if "hardware_error_status" in self.table else "status"
 
     # ------------------------------------------------------------------ behaviour
     def hear(self, now: float) -> None:
@@ -191,8 +178,8 @@ class EmulatedServo:
         value = 0
         for name in self.conditions:
             value |= 1 << bits[name]
-        if self.family == "dynamixel_x":
-            # X series latch hardware errors until reboot and drop torque (shutdown).
+        if self.family in PROTOCOL_2:
+            # X series (and the XL-320) latch hardware errors until reboot and drop torque.
             value |= self.get("hardware_error_status")
             if value:
                 self.set("torque_enable", 0)
@@ -276,12 +263,19 @@ class EmulatedServo:
     def _keeps_eeprom(self) -> bool:
         """Whether an EEPROM write survives power-off: always on Dynamixel X; on Feetech
         STS only with the Lock flag (55) at 0 (1 = changes not saved, the factory value)."""
-        return self.family == "dynamixel_x" or self.get("lock") == 0
+        return self.family in PROTOCOL_2 or self.get("lock") == 0
 
     def power_off(self, now: float) -> None:
         """Unplugged: the horn stops where it is and torque is gone."""
         self.update(now)
         self.set("torque_enable", 0)
+
+    def follow(self, name: str, value: int) -> None:
+        """The other axis of this case was given ``name`` = ``value`` (a setting the case
+        shares): take it, in EEPROM too."""
+        self.set(name, value)
+        if self.table[name].address < self.eeprom_end and self._keeps_eeprom():
+            self._saved = bytes(self.mem[:self.eeprom_end])
 
     def power_on(self, now: float) -> None:
         """Plugged in again: EEPROM as saved, RAM at its power-on values, horn unmoved."""

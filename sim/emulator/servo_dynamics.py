@@ -42,9 +42,8 @@ STEP_S = 0.002                 # integration step [s]: the MuJoCo robot's physic
 P1_SPEED_UNIT_RPM = 0.111      # AX-12A / MX-28 Moving Speed(32) unit [rev/min]
 STS_SPEED_MASK = 0x7FFF        # STS Goal Speed(46): bit 15 is the direction
 P1_SPEED_MASK = 0x3FF
-#: The supply read-back (0.1 V) per register family.
-VOLTAGE_REGISTER = {"dynamixel_x": "present_input_voltage", "dynamixel_p1": "present_voltage",
-                    "feetech_sts": "present_voltage"}
+#: The supply read-back (0.1 V): X series / Protocol 1.0 and Feetech names.
+VOLTAGE_REGISTERS = ("present_input_voltage", "present_voltage")
 
 
 class ServoRegisters(Protocol):
@@ -90,6 +89,7 @@ class ServoDynamics:
         self._law_key = b""
         self._law: servo_law.Law | None = None
         self._span = (0, 0)
+        self._speed_register: str | None = None    # the host's speed register, "" if none
 
     @property
     def torque_share(self) -> float:
@@ -126,10 +126,15 @@ class ServoDynamics:
 
     def _slew_limit(self, servo: ServoRegisters, law: servo_law.Law) -> float:
         """The goal slew [rad/s]: the firmware's, and the host's speed register."""
-        if servo.family == "feetech_sts":
+        if self._speed_register is None:
+            names = {n for n, _ in servo.regs}
+            self._speed_register = ("goal_speed" if servo.family.startswith("feetech")
+                                    and "goal_speed" in names else
+                                    "moving_speed" if "moving_speed" in names else "")
+        if self._speed_register == "goal_speed":
             steps = servo.get("goal_speed") & STS_SPEED_MASK
             host = steps / self.ticks_per_rad if steps else math.inf
-        elif servo.family == "dynamixel_p1":
+        elif self._speed_register == "moving_speed":
             units = servo.get("moving_speed") & P1_SPEED_MASK
             host = units * P1_SPEED_UNIT_RPM * 2 * math.pi / 60 if units else math.inf
         else:

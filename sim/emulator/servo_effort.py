@@ -31,7 +31,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from sim.emulator.servo_frame import to_sign_magnitude
-from sim.emulator.servo_state import ServoState
+from sim.emulator.servo_state import ServoState, kin
 
 #: Register scales.
 X_PWM_FULL = 885
@@ -45,6 +45,7 @@ P1_LOAD_CW_BIT = 10
 X_KPP_DIVISOR = 128.0
 STS_DUTY_PER_P_RAD = 0.166
 MX_DUTY_PER_P_RAD = 0.158
+XL320_DUTY_PER_P_RAD = 0.0505     # Rhoban/bam, XL-320 (oscilloscope)
 #: Stall (locked-rotor) current at the nominal voltage [A], where a datasheet gives one:
 #: Feetech STS3215 (7.4 V): 2.7 A; ROBOTIS e-Manual XM430-W350 (12 V): 2.3 A.
 STALL_CURRENT_A: dict[str, float] = {"STS3215": 2.7, "XM430-W350": 2.3}
@@ -70,7 +71,8 @@ def holding_duty(servo: ServoState, error_ticks: float) -> float:
     if "position_p_gain" in t:
         return _clip(servo.get("position_p_gain") / X_KPP_DIVISOR * error_ticks / X_PWM_FULL)
     if "p_gain" in t:               # MX on Protocol 1.0: 0.158 duty per P unit and radian
-        per_tick = MX_DUTY_PER_P_RAD / servo.model.ticks_per_rad
+        per_p = XL320_DUTY_PER_P_RAD if servo.family == "dynamixel_xl320" else MX_DUTY_PER_P_RAD
+        per_tick = per_p / servo.model.ticks_per_rad
         return _clip(servo.get("p_gain") * per_tick * error_ticks)
     if "p_coefficient" in t:
         per_tick = STS_DUTY_PER_P_RAD / servo.model.ticks_per_rad
@@ -114,7 +116,7 @@ def write_effort(servo: ServoState, effort: Effort) -> None:
             servo.set_raw("present_current", sign * round(effort.current_a / X_CURRENT_UNIT_A))
         elif "present_load" in t:
             servo.set_raw("present_load", round(effort.torque / LOAD_UNIT))
-    elif servo.family == "feetech_sts":
+    elif kin(servo.family) == "feetech_sts":
         servo.set_raw("present_load", to_sign_magnitude(
             round(effort.duty / LOAD_UNIT), STS_LOAD_SIGN_BIT))
         if "present_current" in t and effort.current_a is not None:

@@ -8,53 +8,22 @@ resolution and the angle it spans, and the no-load speed the horn travels at.
 
 from __future__ import annotations
 
-import math
-from collections.abc import Mapping
-from dataclasses import dataclass, field
+from sim.emulator.servo_model import ServoModel, per_60deg, rpm
+from sim.emulator.servo_models_more import MORE, XL330_INITIAL, XM_INITIAL
 
-#: ``Emulator(protocol)`` -> control-table family.
-PROTOCOL_FAMILY: dict[str, str] = {
-    "dynamixel": "dynamixel_x", "dynamixel1": "dynamixel_p1", "feetech": "feetech_sts",
-    "lx": "lx",
+__all__ = ["MODELS", "ServoModel"]
+
+#: ``Emulator(protocol)`` -> the control-table families its protocol speaks (the first is
+#: the default chain's): Protocol 2.0 the X tables and the XL-320's, Feetech's the STS and
+#: SCS tables.
+PROTOCOL_FAMILIES: dict[str, tuple[str, ...]] = {
+    "dynamixel": ("dynamixel_x", "dynamixel_xl320"), "dynamixel1": ("dynamixel_p1",),
+    "feetech": ("feetech_sts", "feetech_scs"), "lx": ("lx",),
 }
+#: ``Emulator(protocol)`` -> its default control-table family.
+PROTOCOL_FAMILY: dict[str, str] = {p: fams[0] for p, fams in PROTOCOL_FAMILIES.items()}
 
-
-@dataclass(frozen=True)
-class ServoModel:
-    """name; number: Model Number register / ping; family: the protocol family (baud
-    codes, error bits, watchdog); resolution: positions (0..resolution-1); span_deg: angle
-    they cover [deg]; no_load_speed: at the nominal voltage [rad/s]; table: its control
-    table's key in ``control_tables.TABLES`` when not the family's own; initial: the
-    model's own initial values where its manual differs from the family's table."""
-
-    name: str
-    number: int
-    family: str
-    resolution: int
-    no_load_speed: float
-    span_deg: float = 360.0
-    table: str = ""
-    initial: Mapping[str, int] = field(default_factory=dict)
-
-    @property
-    def layout(self) -> str:
-        """Key of its control table in ``control_tables.TABLES``."""
-        return self.table or self.family
-
-    @property
-    def ticks_per_rad(self) -> float:
-        return self.resolution / math.radians(self.span_deg)
-
-
-def _rpm(rev_per_min: float) -> float:
-    """rev/min -> rad/s."""
-    return rev_per_min * 2.0 * math.pi / 60.0
-
-
-def _per_60deg(seconds: float) -> float:
-    """Feetech's "s/60 deg" -> rad/s."""
-    return math.radians(60.0) / seconds
-
+_rpm, _per_60deg = rpm, per_60deg
 
 MODELS: dict[str, ServoModel] = {
     # ROBOTIS e-Manual XL430-W250: Model Number 1060; 4096 pulses/rev; no-load speed
@@ -63,17 +32,23 @@ MODELS: dict[str, ServoModel] = {
     # ROBOTIS e-Manual XM430-W350: Model Number 1020; 4096 pulses/rev; 46 rev/min at 12 V;
     # RAM initial values Velocity I Gain(76) 1,920, Position D Gain(80) 0, Position P
     # Gain(84) 800 (the XL430 table's are 1,000 / 4,000 / 640).
-    "XM430-W350": ServoModel("XM430-W350", 1020, "dynamixel_x", 4096, _rpm(46), initial={
-        "velocity_i_gain": 1920, "position_d_gain": 0, "position_p_gain": 800}),
-    # ROBOTIS e-Manual XC430-W150: Model Number 1070; 4096 pulses/rev; 70 rev/min at 12 V
-    # (as the driver lists it; the XC430-W150 page prints 106 rev/min at 12 V, the
-    # XC430-W240 70); RAM initial values Velocity I Gain 1,920, Position D 0, Position P 460.
-    "XC430-W150": ServoModel("XC430-W150", 1070, "dynamixel_x", 4096, _rpm(70), initial={
+    # Its table is the current-sensing X one (Current Limit(38) 1,193 [2.69 mA], Goal /
+    # Present Current); Velocity Limit(44) 350, Temperature Limit 80, Max / Min Voltage
+    # Limit 160 / 95.
+    "XM430-W350": ServoModel("XM430-W350", 1020, "dynamixel_x", 4096, _rpm(46),
+                             table="dynamixel_xm", initial=XM_INITIAL),
+    # ROBOTIS e-Manual XC430-W150: Model Number 1070; 4096 pulses/rev; 106 rev/min at 12 V
+    # (_data/dxl_x_info.yml; 70 is the XC430-W240's); RAM initial values Velocity I Gain
+    # 1,920, Position D 0, Position P 460.
+    "XC430-W150": ServoModel("XC430-W150", 1070, "dynamixel_x", 4096, _rpm(106), initial={
         "velocity_i_gain": 1920, "position_d_gain": 0, "position_p_gain": 460}),
     # ROBOTIS e-Manual XL330-M288-T: Model Number 1200; 4096 pulses/rev; 103 rev/min at 5 V;
-    # RAM initial values Position D Gain 0, Position P Gain 400.
-    "XL330-M288": ServoModel("XL330-M288", 1200, "dynamixel_x", 4096, _rpm(103), initial={
-        "position_d_gain": 0, "position_p_gain": 400}),
+    # its own table (control_tables_more: current sensing, PWM Slope, 20 indirect entries);
+    # initial values Velocity I / P Gain 1,600 / 180, Position D 0 / I 0 / P 400, Current
+    # Limit 1,750 [mA], Velocity Limit 445, Temperature Limit 70, Max / Min Voltage 70 / 35,
+    # Shutdown 53.
+    "XL330-M288": ServoModel("XL330-M288", 1200, "dynamixel_x", 4096, _rpm(103),
+                             table="dynamixel_xl330", initial=XL330_INITIAL),
     # ROBOTIS e-Manual AX-12A: Model Number 12; 0..1023 over 0..300 deg (0.29 deg);
     # 59 rev/min at 12 V.
     "AX-12A": ServoModel("AX-12A", 12, "dynamixel_p1", 1024, _rpm(59), 300.0),
@@ -100,4 +75,5 @@ MODELS: dict[str, ServoModel] = {
     "LX-16A": ServoModel("LX-16A", 16, "lx", 1001, _per_60deg(0.16), 240.24),
     "LX-224": ServoModel("LX-224", 224, "lx", 1001, _per_60deg(0.20), 240.24),
     "LX-224HV": ServoModel("LX-224HV", 2240, "lx", 1001, _per_60deg(0.18), 240.24),
+    **MORE,
 }

@@ -24,7 +24,7 @@ import enum
 from typing import NamedTuple
 
 from sim.emulator.servo_frame import sign_magnitude
-from sim.emulator.servo_state import ServoState
+from sim.emulator.servo_state import ServoState, kin
 
 
 class Mode(enum.Enum):
@@ -48,6 +48,18 @@ MODE_SELECT: dict[str, ModeSelect] = {
     "feetech_sts": ModeSelect("operating_mode", {0: Mode.POSITION, 1: Mode.VELOCITY,
                                                  2: Mode.PWM, 3: Mode.STEP}),
     "dynamixel_p1": ModeSelect(None, {}),     # wheel by angle limits (see module doc)
+    # e-Manual XL-320 "Control Mode(11)": 1 wheel mode (Moving Speed(32) the output, bit 10
+    # the direction, as the AX's wheel), 2 joint mode.
+    "dynamixel_xl320": ModeSelect("control_mode", {1: Mode.PWM, 2: Mode.POSITION}),
+    # Feetech SCS15 manual: both angle limits 0 is motor (wheel) mode; SCSCL.h's PWMMode
+    # sets them so and WritePWM drives Goal Time(44), BIT10 the direction, as the STS's
+    # PWM mode.
+    "feetech_scs": ModeSelect(None, {}),
+}
+#: The two angle limits that, both 0, mean wheel mode, for tables without a mode register.
+WHEEL_BY_LIMITS: dict[str, tuple[str, str]] = {
+    "dynamixel_p1": ("cw_angle_limit", "ccw_angle_limit"),
+    "feetech_scs": ("min_angle_limit", "max_angle_limit"),
 }
 # Keyed by family: every table of a family selects its mode the same way (the MX-28 on
 # Protocol 1.0 as the AX; its both-4095 multi-turn setting is not modelled).
@@ -73,7 +85,8 @@ def mode(servo: ServoState) -> Mode:
     """The servo's operating mode now (an unknown value behaves as position control)."""
     sel = MODE_SELECT[servo.family]
     if sel.register is None:
-        wheel = servo.get("cw_angle_limit") == 0 and servo.get("ccw_angle_limit") == 0
+        low, high = WHEEL_BY_LIMITS[servo.family]
+        wheel = servo.get(low) == 0 and servo.get(high) == 0
         return Mode.PWM if wheel else Mode.POSITION
     return sel.modes.get(servo.get(sel.register), Mode.POSITION)
 
@@ -106,7 +119,7 @@ def duty_command(servo: ServoState) -> float:
     """PWM / wheel mode: the commanded duty [-1..1]."""
     if servo.family == "dynamixel_x":
         return servo.get("goal_pwm") / X_PWM_FULL
-    if servo.family == "feetech_sts":
+    if kin(servo.family) == "feetech_sts":
         return sign_magnitude(servo.get("goal_time"), STS_PWM_SIGN_BIT) / STS_PWM_FULL
     raw = servo.get("moving_speed")
     magnitude = (raw & ((1 << P1_WHEEL_CW_BIT) - 1)) / P1_WHEEL_FULL

@@ -26,9 +26,9 @@ import math
 
 from sim.emulator import servo_effort, servo_frame, servo_modes
 from sim.emulator.control_tables import STS_SPEED_UNIT_TICKS_S
-from sim.emulator.servo_dynamics import VOLTAGE_REGISTER
+from sim.emulator.servo_dynamics import VOLTAGE_REGISTERS
 from sim.emulator.servo_modes import Mode
-from sim.emulator.servo_state import ServoState
+from sim.emulator.servo_state import ServoState, kin
 
 STS_DIRECTION_BIT = 0x8000
 STS_POSITION_SIGN_BIT = 15
@@ -60,7 +60,7 @@ def speed_ticks_s(servo: ServoState) -> float:
         if pv > 0:
             return min(top, pv * dxl_velocity_unit_ticks_s(servo.model.resolution))
         return top
-    if servo.family == "dynamixel_p1":
+    if kin(servo.family) == "dynamixel_p1":
         ms = servo.get("moving_speed") & P1_SPEED_MASK    # 0: as fast as it can
         per_rpm = servo.model.ticks_per_rad * 2 * math.pi / 60.0
         return min(top, ms * P1_SPEED_UNIT_RPM * per_rpm) if ms > 0 else top
@@ -73,7 +73,7 @@ def target(servo: ServoState, mode: Mode) -> float:
     if mode is Mode.STEP:
         return servo.step_target
     goal = servo_frame.actual_goal(servo, servo.get("goal_position"))
-    if mode is Mode.POSITION and servo.family == "feetech_sts":
+    if mode is Mode.POSITION and kin(servo.family) == "feetech_sts":
         return float(goal % servo.model.resolution)
     return float(goal)
 
@@ -93,7 +93,9 @@ def advance(servo: ServoState, pos: float, dt: float) -> float:
         _feedback(servo, mode, pos, velocity, moving=moving, torque=torque)
         servo_effort.write_effort(servo, servo_effort.Effort(
             dynamics.duty, dynamics.torque_share, dynamics.current_a))
-        servo.set_raw(VOLTAGE_REGISTER[servo.family], dynamics.voltage_tenths)
+        for name in VOLTAGE_REGISTERS:
+            if name in servo.table:
+                servo.set_raw(name, dynamics.voltage_tenths)
         return pos
     if mode in POSITION_MODES:
         goal = target(servo, mode)
@@ -132,9 +134,9 @@ def _feedback(servo: ServoState, mode: Mode, pos: float, velocity: float, *,
               moving: bool, torque: bool) -> None:
     single = servo_modes.single_turn(servo, mode)
     present = servo_frame.present(servo, pos, single_turn=single)
-    if servo.family == "feetech_sts":
+    if kin(servo.family) == "feetech_sts":
         present = servo_frame.to_sign_magnitude(present, STS_POSITION_SIGN_BIT)
-    elif servo.family == "dynamixel_p1":
+    elif kin(servo.family) == "dynamixel_p1":
         turn = servo.model.resolution * 360.0 / servo.model.span_deg
         present = min(servo.model.resolution - 1, int(pos % turn)) if not single else present
     servo.set_raw("present_position", present)
@@ -144,7 +146,7 @@ def _feedback(servo: ServoState, mode: Mode, pos: float, velocity: float, *,
                       round(velocity / dxl_velocity_unit_ticks_s(servo.model.resolution)))
         servo.set_raw("moving_status", 0 if not torque else (
             MOVING_PROFILE_ONGOING if moving else MOVING_IN_POSITION))
-    elif servo.family == "dynamixel_p1":
+    elif kin(servo.family) == "dynamixel_p1":
         # Joint mode: 0.111 rev/min a unit; wheel mode: the output share, 0-1023 (AX-12A
         # e-Manual, Present Speed(38)).
         per_unit = (servo.speed_tps / P1_SPEED_MASK if mode is Mode.PWM else

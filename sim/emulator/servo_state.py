@@ -7,11 +7,11 @@ imports ``servo`` back. :class:`ServoState` is the part of ``EmulatedServo`` the
 from __future__ import annotations
 
 import enum
-from typing import Protocol
+from typing import Literal, Protocol
 
 from sim.emulator.control_tables import DXL_SIGNED, TABLES, Entry
 from sim.emulator.servo_dynamics import ServoDynamics
-from sim.emulator.servo_models import ServoModel
+from sim.emulator.servo_model import ServoModel
 from sim.emulator.servo_status import BusWatchdog
 
 
@@ -62,11 +62,38 @@ class ServoState(Protocol):
 
     def hold(self) -> None: ...
 
+    @property
+    def partner(self) -> ServoState | None:
+        """The other axis of a dual-axis case (2XL430-W250), else None."""
+
+    def follow(self, name: str, value: int) -> None:
+        """Take a setting the other axis of the case was given (kept in EEPROM)."""
+
+
+#: Where a family has no rule of its own it behaves as its kin: the XL-320 as the AX
+#: (CW/CCW Angle Limits, Moving Speed in 0.111 rev/min, bit-10 directions), the Feetech SCS
+#: as the STS (goals clamped to the angle limits, a goal write energises, sign-magnitude
+#: feedback). What Protocol 2.0 brings (latched hardware errors, the alert bit, EEPROM
+#: locked while torque is on) goes by ``PROTOCOL_2``.
+KIN: dict[str, str] = {"dynamixel_xl320": "dynamixel_p1", "feetech_scs": "feetech_sts"}
+PROTOCOL_2 = frozenset({"dynamixel_x", "dynamixel_xl320"})
+#: Byte order of multi-byte registers: the SCSCL table is big-endian (its END(2) reads 1).
+BYTE_ORDER: dict[str, Literal["little", "big"]] = {"feetech_scs": "big"}
+
+
+def kin(family: str) -> str:
+    """The family whose behaviour ``family`` shares where it has none of its own."""
+    return KIN.get(family, family)
+
+
+def byteorder(family: str) -> Literal["little", "big"]:
+    return BYTE_ORDER.get(family, "little")
+
 
 def decode_value(family: str, address: int, data: bytes) -> int:
-    """A written value as the log shows it: little-endian, signed for signed registers
-    (only the X table has any)."""
+    """A written value as the log shows it: in the family's byte order, signed for signed
+    registers (only the X table has any)."""
     signed = family == "dynamixel_x" and any(
         reg.address == address and reg.size == len(data) and name in DXL_SIGNED
         for name, reg in TABLES[family].items())
-    return int.from_bytes(data, "little", signed=signed)
+    return int.from_bytes(data, byteorder(family), signed=signed)

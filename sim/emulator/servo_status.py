@@ -30,6 +30,13 @@ ERROR_BITS: dict[str, dict[int, str]] = {
     # LewanSoul Bus Servo Communication Protocol, Table 3 (LED alarm codes): 1 over
     # temperature, 2 over voltage, 4 locked rotor. No packet carries them (the LED does).
     "lx": {0: "overheating", 1: "voltage", 2: "overload"},
+    # ROBOTIS e-Manual XL-320, "Shutdown(18)" (whose bits Hardware Error Status(50) holds):
+    # bit 0 Overload Error, bit 1 OverHeating Error, bit 2 Input Voltage Error.
+    "dynamixel_xl320": {0: "overload", 1: "overheating", 2: "voltage"},
+    # Feetech SCSCL memory table, "Servo Status": BIT0 voltage, BIT2 temperature, BIT5 load
+    # (the SCS15 manual's "Current status byte": bit 0 over/under voltage, 2 over
+    # temperature, 5 over load).
+    "feetech_scs": {0: "voltage", 2: "overheating", 5: "overload"},
 }
 
 #: One step of the Return Delay Time register [s], per family.
@@ -40,6 +47,10 @@ RETURN_DELAY_UNIT_S: dict[str, float] = {
     "dynamixel_p1": 2e-6,
     # STS memory table "Return delay time(7)": 2 us per unit (initial 0).
     "feetech_sts": 2e-6,
+    # XL-320 "Return Delay Time(5)": the X series' include, 2 us per unit (initial 250).
+    "dynamixel_xl320": 2e-6,
+    # SCS15 manual "Return delay time(7)": 2 us per unit (initial 0), as the STS.
+    "feetech_scs": 2e-6,
 }
 
 
@@ -91,4 +102,6 @@ BUS_WATCHDOG: dict[str, BusWatchdog | None] = {
     "dynamixel_x": BusWatchdog("bus_watchdog", 0.020, (1, 127), 0, -1, 38),
     "dynamixel_p1": None,
     "feetech_sts": None,
+    "dynamixel_xl320": None,     # the XL-320 table has no Bus Watchdog
+    "feetech_scs": None,         # nor the SCSCL table
 }

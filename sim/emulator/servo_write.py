@@ -31,7 +31,7 @@ from __future__ import annotations
 from sim.emulator import servo_frame, servo_modes
 from sim.emulator.control_tables import BAUD_CODES, INDIRECT_TARGET_RANGE, Entry
 from sim.emulator.servo_modes import Mode
-from sim.emulator.servo_state import ServoState, WriteError, decode_value
+from sim.emulator.servo_state import PROTOCOL_2, ServoState, WriteError, decode_value, kin
 
 #: Allowed raw values of a few registers [inclusive range]; others accept any value.
 VALID_RANGE: dict[str, tuple[int, int]] = {
@@ -47,6 +47,8 @@ STS_CENTRE_COMMAND = 128
 #: Registers that take a set of values rather than a range, per family.
 VALID_VALUES: dict[str, dict[str, frozenset[int]]] = {
     "feetech_sts": {"torque_enable": frozenset({0, 1, STS_CENTRE_COMMAND})},
+    # e-Manual XL-320 LED(25): 0-7, three colour bits.
+    "dynamixel_xl320": {"led": frozenset(range(8))},
 }
 #: X: limit registers a goal must stay within (value, its limit register) and the mode.
 X_LIMITS: dict[str, tuple[str, Mode]] = {
@@ -59,6 +61,8 @@ STS_ENERGISING: dict[str, frozenset[Mode]] = {
     "goal_speed": frozenset({Mode.VELOCITY}), "goal_time": frozenset({Mode.PWM}),
 }
 STS_STEP_SIGN_BIT = 15
+#: A dual-axis case's settings both axes hold as one (sim/emulator/dual_axis.py).
+CASE_SHARED = frozenset({"baud_rate", "protocol_type"})
 
 
 def plan(servo: ServoState, address: int, data: bytes) -> tuple[WriteError, dict[str, int]]:
@@ -76,7 +80,7 @@ def plan(servo: ServoState, address: int, data: bytes) -> tuple[WriteError, dict
             touched.append((name, reg))
     if touched[0][1].address < address or touched[-1][1].address + touched[-1][1].size > end:
         return WriteError.LENGTH, {}
-    dxl = servo.family == "dynamixel_x"
+    dxl = servo.family in PROTOCOL_2
     torque = bool(servo.get("torque_enable"))
     values: dict[str, int] = {}
     for name, reg in touched:
@@ -90,7 +94,7 @@ def plan(servo: ServoState, address: int, data: bytes) -> tuple[WriteError, dict
         err = check(servo, name, values[name])
         if err is not WriteError.NONE:
             return err, {}
-        if (name == "goal_position" and servo.family == "feetech_sts"
+        if (name == "goal_position" and kin(servo.family) == "feetech_sts"
                 and servo_modes.mode(servo) is Mode.POSITION):
             values[name] = min(max(values[name], servo.get("min_angle_limit")),
                                servo.get("max_angle_limit"))
@@ -114,11 +118,14 @@ def check(servo: ServoState, name: str, value: int) -> WriteError:
     wd = servo.watchdog
     if wd is not None and name == wd.register and not wd.accepts(value):
         return WriteError.RANGE
+    partner = servo.partner
+    if name == "id" and partner is not None and value == partner.get("id"):
+        return WriteError.LIMIT     # 2XL430: both axes one id is a Data Limit Error
     if servo.watchdog_tripped and name in ("goal_position", "goal_velocity", "goal_pwm"):
         return WriteError.RANGE     # goals are read-only until the watchdog is cleared
     if servo.family == "dynamixel_x":
         return _check_x(servo, name, value)
-    if (name == "goal_position" and servo.family == "dynamixel_p1"
+    if (name == "goal_position" and kin(servo.family) == "dynamixel_p1"
             and servo_modes.mode(servo) is Mode.POSITION
             and not servo.get("cw_angle_limit") <= value <= servo.get("ccw_angle_limit")):
         return WriteError.LIMIT     # AX: Angle Limit Error, the goal is not taken
@@ -141,8 +148,8 @@ def _check_x(servo: ServoState, name: str, value: int) -> WriteError:
 def apply(servo: ServoState, values: dict[str, int]) -> None:
     """Store planned values and do what they set off (module doc). Torque stays off while
     an X servo is in shutdown; registers in ``servo.frozen`` keep their value."""
-    shutdown = servo.family == "dynamixel_x" and servo.get("hardware_error_status") != 0
-    sts = servo.family == "feetech_sts"
+    shutdown = servo.family in PROTOCOL_2 and servo.get("hardware_error_status") != 0
+    sts = kin(servo.family) == "feetech_sts"
     mode_before = servo_modes.mode(servo)
     for name, v in values.items():
         if name == "torque_enable" and shutdown:
@@ -154,6 +161,8 @@ def apply(servo: ServoState, values: dict[str, int]) -> None:
             servo.hold()
             continue
         servo.set(name, v)
+        if name in CASE_SHARED and servo.partner is not None:
+            servo.partner.follow(name, v)     # one communication module: both axes
     mode = servo_modes.mode(servo)
     if mode is not mode_before:
         if mode is Mode.POSITION:

@@ -55,7 +55,8 @@ def sync_write(family: str, address: int, length: int, chunk: bytes,
     step = 1 + length
     for i in range(0, len(chunk) - step + 1, step):
         sid, data = chunk[i], chunk[i + 1:i + step]
-        values[sid] = decode_value(family, address, data)
+        values[sid] = decode_value(hearing[sid].family if sid in hearing else family, address,
+                                   data)   # the servo's byte order (an SCS: big-endian)
         if sid in hearing:
             hearing[sid].write(address, data)
     return values

@@ -12,9 +12,9 @@ file's gains, physics and supply:
   first read-back position at rest. What ``biped emulate`` serves: its servos move by the
   same model, each on its own, so a take recorded on the emulator is replayed here.
 
-Times: the take's ``t`` [s] (the loop's clock). Positions [rad, joint angles] at tick k
-are the state at t_k, the command of tick k not yet applied (as a read-back in the same
-tick sees it).
+Times: the take's ``t`` [s] (the loop's clock): command k holds from t_k to t_k+1.
+Positions [rad, joint angles] at tick k are the state when tick k's read-back was in
+(``present_t``; t_k in a take without it), command k applied since t_k.
 """
 
 from __future__ import annotations
@@ -67,14 +67,16 @@ def replay(robot: RobotConfig, take: Take, *, world: str = "robot",
     start, q0 = first_read(take)
     out = np.full_like(take.q, np.nan)
     t = take.t[start:] - take.t[start]
+    read = (take.t if take.present_t is None else take.present_t)[start:] - take.t[start]
+    read = np.maximum(read, t)
     cmd = take.q[start:]
-    sim = (_robot(robot, t, cmd, q0) if world == "robot"
-           else _bench(robot, t, cmd, q0, loads or {}))
+    sim = (_robot(robot, t, read, cmd, q0) if world == "robot"
+           else _bench(robot, t, read, cmd, q0, loads or {}))
     out[start:] = sim
     return out
 
 
-def _robot(robot: RobotConfig, t: Floats, cmd: Floats, q0: Floats) -> Floats:
+def _robot(robot: RobotConfig, t: Floats, read: Floats, cmd: Floats, q0: Floats) -> Floats:
     bus = MujocoBus(robot, pose=dict(zip(robot.joint_names, q0.tolist(), strict=True)))
     bus.open()
     try:
@@ -83,14 +85,15 @@ def _robot(robot: RobotConfig, t: Floats, cmd: Floats, q0: Floats) -> Floats:
         out = np.empty_like(cmd)
         for k in range(len(t)):
             bus.advance(float(t[k]))
-            out[k] = sm.to_rad(bus.present_ticks())
             bus.write_goals(sm.goals(cmd[k].tolist()))
+            bus.advance(float(read[k]))
+            out[k] = sm.to_rad(bus.present_ticks())
         return out
     finally:
         bus.close()
 
 
-def _bench(robot: RobotConfig, t: Floats, cmd: Floats, q0: Floats,
+def _bench(robot: RobotConfig, t: Floats, read: Floats, cmd: Floats, q0: Floats,
            loads: Mapping[str, BenchLoad]) -> Floats:
     unknown = sorted(set(loads) - set(robot.joint_names))
     if unknown:
@@ -102,16 +105,17 @@ def _bench(robot: RobotConfig, t: Floats, cmd: Floats, q0: Floats,
         joint = robot.joint(name)
         key = f"{robot.servo(joint).name}/{robot.voltage(joint)}/{robot.servo_physics(joint)!r}"
         groups.setdefault(key, []).append(j)      # one bench per model, supply and physics
-    grid = np.arange(0.0, t[-1], DT)
+    grid = np.arange(0.0, max(t[-1], read[-1]) + DT, DT)
+    held = cmd[np.searchsorted(t, grid, side="right") - 1]   # each command holds until the next
     for columns in groups.values():
         joints = [robot.joint(robot.joint_names[j]) for j in columns]
         model, physics = robot.servo(joints[0]), robot.servo_physics(joints[0])
-        logs = [_log(robot, jt.name, t, cmd[:, j], q0[j], loads.get(jt.name, NONE))
+        logs = [_log(robot, jt.name, grid, held[:, j], q0[j], loads.get(jt.name, NONE))
                 for j, jt in zip(columns, joints, strict=True)]
         bench = PendulumBench(logs, model)
         simulated = bench.replay(physics)
         for row, j in enumerate(columns):
-            out[:, j] = np.interp(t, grid[:bench.steps], simulated[row, :len(grid)])
+            out[:, j] = np.interp(read, grid[:bench.steps], simulated[row, :len(grid)])
     return out
 
 

@@ -129,13 +129,15 @@ def record(bus: Bus, robot: RobotConfig, traj: Trajectory, *, seconds: float,
 
 
 def _ticks(seconds: float, stop: _Stop, step: Callable[[float], None]) -> None:
-    """Call ``step(t)`` every PERIOD_S on absolute deadlines for ``seconds`` [s]."""
+    """Call ``step(t)`` every PERIOD_S on absolute deadlines for ``seconds`` [s]; ``t`` is
+    the time since the first call when this one starts (a late tick carries its own time,
+    and the ticks it overran are skipped)."""
     t0 = time.monotonic()
     n = 0
     while n * PERIOD_S <= seconds:
         if stop.reason is not None:
             raise _Stopped(stop.reason)
-        step(n * PERIOD_S)
+        step(time.monotonic() - t0)
         n += 1
         delay = t0 + n * PERIOD_S - time.monotonic()
         if delay > 0:

@@ -10,7 +10,8 @@ runs the Blender half in its own interpreter, so this project needs no bpy:
 Blender: File > Import > Motion Capture (.bvh), then File > Export > Motion Capture
 (defaults: rotation "Native", so each bone's own Euler order, six channels on every joint,
 Blender's Z up); File > Import > glTF 2.0, then File > Export > glTF 2.0 (defaults: +Y up,
-every frame sampled; the scene set to the export's 30 fps first, as a designer would). Prints the largest difference per format and the joint it is on.
+every frame sampled; the scene set to the export's 30 fps first, as a designer would).
+Prints the largest difference per format and the joint it is on.
 """
 
 from __future__ import annotations

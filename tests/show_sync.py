@@ -1,14 +1,16 @@
 """Measuring a show's audio sync in the panel (headless Chromium): a show take with a
 soundtrack (an arm show imported from a BVH, a tone), the panel serving it, and reads of
-the page's <audio> clock against the take's time (the engine's, asked of the panel's loop
-process just before and after each read of the page). Used by tests/test_panel_show.py (a short run, a
-loose bound that catches a broken follower) and docs/show_sync.py (the 30 s measurement)."""
+the page's <audio> clock against the take's time at the same instant (the loop process
+stamps each tick's take time with its wall clock; the page says when it read). Used by
+tests/test_panel_show.py (a short run, a loose bound that catches a broken follower)
+and docs/show_sync.py (the 30 s measurement)."""
 
 from __future__ import annotations
 
 import math
 import time
 import wave
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -46,35 +48,69 @@ def write_show(folder: Path, seconds: float) -> None:
                      "--audio", "song.wav", "--audio-offset", str(OFFSET)]) == 0
 
 
+@dataclass(frozen=True)
+class Sync:
+    """Per read while the audio plays [ms]: ``audio`` the audio's clock less the take's
+    time at the instant of the read; ``estimate`` the page's own estimate of the take's
+    time less the take's time (what the follower steers to); the reads' page wall times
+    [s]; the audio's playback rate and the seeks the page had made by then; ``span`` [s]
+    of take time covered."""
+
+    audio: list[float]
+    estimate: list[float]
+    at: list[float]
+    rate: list[float]
+    seeks: list[int]
+    span: float
+
+
 def measure(controller: PanelController, base: str, browser: Browser, seconds: float,
-            wait: float = 20.0) -> tuple[list[float], float]:
-    """Play the show from the page; (audio - take time [ms] per read while the audio
-    plays, seconds of take time covered). Leaves the page open until the take ends."""
+            wait: float = 20.0, tune: dict[str, float] | None = None) -> Sync:
+    """Play the show from the page and compare, read by read, the page's <audio> clock
+    with the take's time at the same instant: the page says when (its wall clock) it read
+    the audio; the loop process stamps each tick's take time with its wall clock (the same
+    machine's clock); the take's time at the read is interpolated between the stamped
+    ticks fetched just before and just after the read. ``tune``: the page's follower
+    settings to change (robot/panel/static/studio.js ``showTune``). Leaves the page open
+    until the take ends."""
     page = browser.new_page()
     page.goto(base)
+    if tune:
+        page.evaluate("(t) => Object.assign(window.showTune, t)", tune)
     page.wait_for_selector("#takes option[value=show]", state="attached")
     page.select_option("#takes", "show")
     page.click("#play")
 
-    def take_time() -> float | None:
-        s = controller.loop_state(max_age=0.0)      # asked of the loop process now
-        return s.get("engine_t") if s["running"] else None
+    def stamped() -> tuple[float, float] | None:
+        """(take time [s], wall time of its tick [s]), asked of the loop process now."""
+        s = controller.loop_state(max_age=0.0)
+        show = s.get("show") if s["running"] else None
+        if not show or not show["playing"] or show["at"] is None:
+            return None
+        return float(show["t"]), float(show["at"])
     end = time.monotonic() + wait
     while not page.evaluate("showClock().playing") and time.monotonic() < end:
         time.sleep(0.05)
-    first = take_time() or 0.0
-    errors: list[float] = []
-    while (now := take_time()) is not None and now < first + seconds:
-        t0 = take_time()
+    first = stamped() or (0.0, 0.0)
+    audio: list[float] = []
+    estimate: list[float] = []
+    at: list[float] = []
+    rate: list[float] = []
+    seeks: list[int] = []
+    while (a := stamped()) is not None and a[0] < first[0] + seconds:
         clock = page.evaluate("showClock()")
-        t1 = take_time()
-        if t0 is None or t1 is None:
+        b = stamped()
+        if b is None:
             break
-        # A read within a few ticks: the take's time is asked of the loop process (a
-        # round trip each), so the bracket is wider than a tick on a busy machine.
-        if clock["playing"] and t1 - t0 <= 0.03:
-            errors.append(1000 * (clock["audio"] + OFFSET - (t0 + t1) / 2))
+        w = clock["at"] / 1000.0
+        if clock["playing"] and b[1] > a[1]:
+            take = a[0] + (w - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
+            audio.append(1000 * (clock["audio"] + OFFSET - take))
+            estimate.append(1000 * (clock["show"] - take))
+            at.append(w)
+            rate.append(float(clock["rate"]))
+            seeks.append(int(clock["seeks"]))
         time.sleep(0.1)
-    span = (take_time() or first + seconds) - first
+    span = (stamped() or (first[0] + seconds, 0.0))[0] - first[0]
     page.close()
-    return errors, span
+    return Sync(audio, estimate, at, rate, seeks, span)

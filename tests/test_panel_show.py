@@ -7,6 +7,9 @@ docs/show_sync.py, not asserted in a test on a shared machine."""
 
 from __future__ import annotations
 
+import json
+import re
+import urllib.request
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -41,11 +44,54 @@ def test_byte_ranges_by_rfc_9110() -> None:
 def test_the_page_plays_the_take_s_audio_in_step(tmp_path: Path, browser: Browser) -> None:
     write_show(tmp_path, seconds=8.0)
     with served_panel(studio_dir=tmp_path) as (controller, base):
-        errors, span = measure(controller, base, browser, seconds=6.0)
-        assert span >= 5.5 and len(errors) >= 10, (span, len(errors))
-        held = np.abs(errors[5:])
-        assert float(np.median(held)) < 100.0, errors
+        got = measure(controller, base, browser, seconds=6.0)
+        assert got.span >= 5.5 and len(got.audio) >= 10, (got.span, len(got.audio))
+        held = np.abs(got.audio[5:])
+        assert float(np.median(held)) < 100.0, got.audio
         assert wait_for(lambda: not controller.running, timeout=15.0)
+
+
+def _with_cues(take: Path, cues: list[tuple[float, str]]) -> None:
+    """Give the take's show cue markers (its header's ``show.cue``, robot/motion/show.py)."""
+    lines = take.read_text().splitlines()
+    header = json.loads(lines[0])
+    header["show"]["cue"] = [{"t": t, "name": name} for t, name in cues]
+    take.write_text("\n".join([json.dumps(header), *lines[1:]]) + "\n")
+
+
+def test_the_state_says_what_the_show_is_doing(tmp_path: Path) -> None:
+    """While a show take plays, the panel's state (from the loop process) is "playing"
+    with the take's name, its time of its duration and the next cue; before and after,
+    not; the time it reports runs with the show."""
+    write_show(tmp_path, seconds=4.0)
+    _with_cues(tmp_path / "takes" / "show.take.jsonl", [(1.0, "lights up"), (3.0, "bow")])
+    doing = re.compile(r"playing take show (\d+\.\d) / 4\.0 s(, next cue '([a-z ]+)' at "
+                       r"(\d\.\d) s)?$")
+    with served_panel(studio_dir=tmp_path) as (controller, base):
+        req = urllib.request.Request(base + "api/play", method="POST",
+                                     data=json.dumps({"name": "show"}).encode(),
+                                     headers={"Content-Type": "application/json"})
+        with urllib.request.urlopen(req, timeout=10) as r:
+            assert r.status == 200
+        seen: list[tuple[float, str | None]] = []
+
+        def read() -> bool:
+            s = controller.state()
+            if s["state"] == "playing":
+                m = doing.match(s["doing"] or "")
+                assert m is not None, s["doing"]
+                seen.append((float(m.group(1)), m.group(3)))
+            else:
+                assert s["doing"] is None, s
+            return not controller.running and len(seen) > 0
+        assert wait_for(read, timeout=30.0)
+        times = [t for t, _ in seen]
+        assert times == sorted(times) and times[0] < 1.0 and times[-1] > 3.0, times
+        # The next cue by the time shown (rounded to 0.1 s: at a cue's time, either).
+        assert all(cue in {("lights up" if x < 1.0 else "bow" if x < 3.0 else None)
+                           for x in (t - 0.05, t + 0.05)} for t, cue in seen), seen
+        assert {cue for _, cue in seen} == {"lights up", "bow", None}
+        assert controller.state()["state"] != "playing"
 
 
 def test_arrows_steer_with_a_slider_focused_and_the_status_line_says_what_happened(

@@ -4,8 +4,11 @@
 Bones map to joints by name (the skeleton `biped export` writes), or through ``--map
 MAP.toml`` (bone, axis, sign, offset per joint: robot/previs/bone_map.py). Every joint-limit,
 speed and acceleration violation is listed with its time and joint, then clamped
-(``--strict``: refused, exit 2, nothing written). ``--audio`` names the soundtrack in the
-take (robot/motion/show.py).
+(``--strict``: refused, exit 2, nothing written). Where the animation walks (feet planted
+in turn while the root travels: robot/previs/walk_spans.py), the root's motion becomes the
+gait's travel: the take's timeline has the gait walk the legs there with speed, turn and
+side step from the root's (robot/previs/travel.py; ``--no-root-travel``: the legs play as
+authored everywhere). ``--audio`` names the soundtrack in the take (robot/motion/show.py).
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ from robot.motion.takes import SUFFIX, is_take
 from robot.previs.bone_map import by_name, load_map
 from robot.previs.importing import SUFFIXES, import_animation, write_stream_take
 from robot.previs.rig import UPS
+from robot.previs.travel import Efficiency
 
 #: Violations listed in full; the rest are counted.
 SHOWN = 40
@@ -56,6 +60,15 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                                                      what="an acceleration"),
                    default=None, help="acceleration limit [rad/s^2] (default: each joint's "
                                       "max speed reached in 50 ms)")
+    p.add_argument("--no-root-travel", action="store_true",
+                   help="play the legs as authored everywhere (default: where the animation "
+                        "walks, the gait walks the legs at the root's speed and turn)")
+    p.add_argument("--travel-efficiency", type=bounded_float(0.2, 1.0, "",
+                                                             what="a share"),
+                   default=Efficiency().forward, metavar="SHARE",
+                   help="share of the gait's no-slip stride speed the robot walks (default: "
+                        "%(default)s, measured in MuJoCo on biped18-dynamixel; docs/"
+                        "animatronics.md says how to measure yours)")
     p.add_argument("--audio", default=None, metavar="SOUND",
                    help="soundtrack of the show (a path relative to the take)")
     p.add_argument("--audio-offset", type=float, default=0.0, metavar="SECONDS",
@@ -76,9 +89,15 @@ def run(args: argparse.Namespace) -> int:
         else by_name(robot)
     _, params = params_from(args, robot)
     hold = np.asarray(GaitEngine(robot, params).start_pose())
+    efficiency = None if args.no_root_travel else Efficiency(forward=args.travel_efficiency)
     got = import_animation(args.file, robot, bone_map, hold, up=args.up,
-                           min_rate=args.rate, max_accel=args.max_accel)
+                           min_rate=args.rate, max_accel=args.max_accel, params=params,
+                           efficiency=efficiency)
     frames = got.frames
+    for w in got.walks:
+        print(w.line())
+        for line in w.clamped:
+            print(f"  clamped: {line}")
     for v in got.violations[:SHOWN]:
         print(f"violation: {v.line()}")
     if len(got.violations) > SHOWN:
@@ -98,6 +117,7 @@ def run(args: argparse.Namespace) -> int:
           f"{got.rate_hz:g} Hz on {robot.name}; up {frames.up}; "
           f"{len(frames.animated)} joints animated"
           + (f", {len(held)} held ({', '.join(held)})" if held else "")
-          + f"; root travel {fwd:+.3f} m forward, {left:+.3f} m left; "
+          + f"; root travel {fwd:+.3f} m forward, {left:+.3f} m left"
+          + ("" if args.no_root_travel else f", {len(got.walks)} walks by the gait") + "; "
           f"{len(got.violations)} violations" + (" clamped" if got.violations else ""))
     return 0

@@ -3,9 +3,11 @@
 
 A take replays its parameter timeline on the take's robot at the take's rate (with the
 balance feedback if it was on), so in the simulation it reproduces the recorded joint
-stream. A keyframe sequence plays on its own: the joints it names follow it, the others
-hold the standing pose. Either way: ramp in from the present pose, clamp, slew, then ramp
-to rest and torque off (``--hold``: stay on). Ctrl-C / SIGTERM as for `biped walk`.
+stream. A show take (`biped import`) streams its joints as authored, and where its timeline
+has the gait walk, the gait walks the legs (robot/motion/show_walk.py; ``--no-root-travel``:
+the authored legs everywhere). A keyframe sequence plays on its own: the joints it names
+follow it, the others hold the standing pose. Either way: ramp in from the present pose,
+clamp, slew, then ramp to rest and torque off (``--hold``: stay on). Ctrl-C / SIGTERM as for `biped walk`.
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ from robot.motion.keyframes import SUFFIXES, load_sequence, parse_sequence
 from robot.motion.layered import LayeredEngine
 from robot.motion.scripted import PlaybackEngine
 from robot.motion.show import Cue, Show, show_of, show_of_sequence, stream_sequence
+from robot.motion.show_walk import ShowEngine, Travel
 from robot.motion.takes import SUFFIX, Take, TakeHeader, is_take, read_take
 from robot.previs.show_check import plot_check
 from robot.run.run import Run
@@ -79,6 +82,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--check-plot", default=None, type=output_file, metavar="FILE.png",
                    help="sim bus: plot the physics check (support margin, torque by limb, "
                         "headroom per joint)")
+    p.add_argument("--no-root-travel", action="store_true",
+                   help="an imported take: play the legs as authored where the gait would "
+                        "walk them")
     add_balance_args(p)
     p.add_argument("--balance", action="store_true", help="an imported take (biped import): "
                    "the balance stage corrects the legs while the arms and head perform as "
@@ -118,8 +124,11 @@ def run(args: argparse.Namespace) -> int:
         stop = take.stop_tick if take.stop_tick is not None else len(take.t)
         show = show_of(h.show, take.source)
         if show.stream:   # an imported animation: its joints as they are (--balance: legs)
-            engine = LayeredEngine(robot, h.params, keyframes=stream_sequence(take),
-                                   walk=False)
+            travel = Travel() if args.no_root_travel else Travel.of_take(take)
+            engine = (ShowEngine(robot, h.params, stream=stream_sequence(take), travel=travel)
+                      if travel.walks else
+                      LayeredEngine(robot, h.params, keyframes=stream_sequence(take),
+                                    walk=False))
             args.no_balance = not args.balance
         else:
             args.no_balance = args.no_balance or not h.balance
@@ -189,6 +198,10 @@ def run(args: argparse.Namespace) -> int:
         result["audio"] = {"file": str(soundtrack.show.audio_path()),
                            "started_at_show_s": soundtrack.started_at,
                            "warning": soundtrack.warning}
+    metrics = done.metrics or {}
+    if "distance_m" in metrics:      # the sim: where the robot went (a show that walks)
+        result["walked"] = {k: metrics[k] for k in ("distance_m", "lateral_drift_m",
+                                                      "heading_change_deg")}
     check = physics_check(watch, robot, done.metrics)
     if check is not None and check.fell_at is not None:
         code = result["exit_code"] = max(code, 1)   # the show did not hold up: incomplete
@@ -202,6 +215,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"played {args.file} on {robot.name} ({kind} bus): {stats.ticks} ticks at "
               f"{rate:g} Hz, {engine.time:.2f} s of motion, {stats.overruns} overruns; "
               f"stopped: {stats.stop_reason}; servos {servo_words(stats.torque)}")
+        if "walked" in result:
+            w = result["walked"]
+            print(f"walked {w['distance_m']:+.3f} m forward, {w['lateral_drift_m']:+.3f} m "
+                  f"left, heading {w['heading_change_deg']:+.1f} deg")
         if record_error:
             print(f"record FAILED: {record_error}")
         if check is not None:

@@ -10,6 +10,8 @@ everything up to the last line written); plain text that ``jq`` or pandas read:
       a parameter change, applied just before gait tick k (t = k / rate_hz [s] of gait
       time); every change made live (panel, gamepad, keyboard) is one such line
   {"gait_tick": k, "t": ..., "stop": true}     the gait told to ramp out before tick k
+  {"gait_tick": k, "t": ..., "start": true}    the gait told to start before tick k (a show
+      whose legs walk in spans, robot/motion/show_walk.py; a recorded walk starts at 0)
   {"tick": n, "t": ..., "state": "walking", "q": [...], "present": [...]}
       one streamed tick: the commanded joint angles [rad] as they went to the bus (after
       balance, clamp and slew), ``t`` [s] on the loop's clock since the first tick;
@@ -79,10 +81,11 @@ class TakeHeader:
 
 @dataclass(frozen=True)
 class Take:
-    """A take read back: header, timeline (gait tick → changes; the tick of the stop, or
-    None) and the joint stream (``q``: ticks x joints [rad]; ``t`` [s]; ``states``;
-    ``present``: ticks x joints read back [rad], NaN on ticks without a read-back;
-    ``present_t``: when each was read [s, the clock of ``t``; ``t`` if not recorded])."""
+    """A take read back: header, timeline (gait tick → changes; the tick of the first
+    stop, or None; every start and stop in order) and the joint stream (``q``: ticks x
+    joints [rad]; ``t`` [s]; ``states``; ``present``: ticks x joints read back [rad], NaN
+    on ticks without a read-back; ``present_t``: when each was read [s, the clock of
+    ``t``; ``t`` if not recorded])."""
 
     header: TakeHeader
     changes: Mapping[int, Mapping[str, float]]
@@ -91,6 +94,8 @@ class Take:
     q: npt.NDArray[np.float64]
     states: tuple[str, ...] = field(default=())
     source: str = "<memory>"
+    starts: tuple[int, ...] = ()
+    stops: tuple[int, ...] = ()
     present: npt.NDArray[np.float64] | None = None
     present_t: npt.NDArray[np.float64] | None = None
 
@@ -191,6 +196,8 @@ def read_take(path: str | Path) -> Take:
     header = _header(*rows[0])
     n = len(header.joints)
     stop: int | None = None
+    starts: list[int] = []
+    stops: list[int] = []
     changes: dict[int, dict[str, float]] = {}
     last_gait = -1
     t: list[float] = []
@@ -210,13 +217,17 @@ def read_take(path: str | Path) -> Take:
             new = row.get("set")
             if row.get("stop") is True:
                 stop = k if stop is None else stop
+                stops.append(k)
+            elif row.get("start") is True:
+                starts.append(k)
             elif isinstance(new, dict) and new:
                 w = f"{where}: set"
                 step = {canonical_name(m, where=w): check_value(m, v, where=w)
                         for m, v in new.items()}
                 changes.setdefault(k, {}).update(step)
             else:
-                raise _fail(where, "expected \"set\": {name: value} or \"stop\": true")
+                raise _fail(where, "expected \"set\": {name: value}, \"start\": true or "
+                                   "\"stop\": true")
         elif "tick" in row:
             q.append(_angles(where, row.get("q"), n))
             t.append(number(where, "t", row.get("t", len(t) / header.rate_hz)))
@@ -232,5 +243,6 @@ def read_take(path: str | Path) -> Take:
     q_arr = np.asarray(q, dtype=float).reshape(len(q), n)
     read = np.asarray(present, dtype=float).reshape(len(q), n)
     return Take(header, changes, stop, np.asarray(t, dtype=float), q_arr, tuple(states),
-                source=str(p), present=read if np.isfinite(read).any() else None,
+                source=str(p), starts=tuple(starts), stops=tuple(stops),
+                present=read if np.isfinite(read).any() else None,
                 present_t=np.asarray(read_t, dtype=float))

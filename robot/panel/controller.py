@@ -231,7 +231,7 @@ class PanelController:
         s = self.loop_state()
         out = state_snapshot(self.robot, s.get("tel", {}), s.get("sim") or {},
                              running=bool(s["running"]), rate_hz=self.options.rate_hz,
-                             loop_hz=float(s.get("loop_hz", 0.0)))
+                             loop_hz=float(s.get("loop_hz", 0.0)), show=s.get("show"))
         out["fault"] = s.get("fault")
         if out["fault"] and out["running"]:
             out["state"] = "late"                 # never a silent "walking"

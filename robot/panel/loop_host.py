@@ -160,7 +160,8 @@ class LoopHost:
         o = self.options
         run: Run[Any] = Run(RunSpec(
             robot=self.robot, source=built.engine, bus=session, feedback=feedback,
-            recorder=built.recorder, observer=self.watch.observer(self._verdict),
+            recorder=built.recorder, observer=self.watch.observer(
+                self._verdict, show_time=lambda: built.engine.time),
             options=RunOptions(rate_hz=o.rate_hz, read_every=o.read_every, hold=o.hold,
                                close_bus=False, watch=False)))
         run.open()                     # the take file first: unwritable, nothing moves

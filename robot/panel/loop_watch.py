@@ -16,6 +16,7 @@ from robot.config.robot import RobotConfig
 from robot.loop.telemetry import LoopStats, Telemetry, TickObserver
 from robot.panel.rate_guard import RateGuard
 from robot.panel.runs import Play, Record, RunKind, ShowTake
+from robot.panel.show_clock import ShowClock
 from robot.panel.snapshot import TickRate, telemetry_snapshot
 
 RATE_WINDOW = 50  # ticks over which the loop rate is measured
@@ -46,11 +47,14 @@ class LoopWatch:
         self.last_stats: LoopStats | None = None
         self.record_error: str | None = None
         self.holding = False
+        self._clock: ShowClock | None = None
 
     # -- the loop thread -----------------------------------------------------------------
-    def observer(self, verdict: OnVerdict) -> TickObserver:
+    def observer(self, verdict: OnVerdict, *, show_time: Callable[[], float] | None = None
+                 ) -> TickObserver:
         """The tick observer of one run: copy the telemetry, measure the rate, watch it
-        (``verdict`` when the guard wants a stop), the sim's metrics."""
+        (``verdict`` when the guard wants a stop), the sim's metrics, a show's clock
+        (``show_time``: the engine's time [s])."""
         monitor = self.monitor_factory() if self.monitor_factory is not None else None
         guard = RateGuard(self.rate_hz, stall_s=self.stall_s)
         stopped = [False]
@@ -62,6 +66,10 @@ class LoopWatch:
             sim = monitor(tel) if monitor is not None else None
             with self._lock:
                 self._tel = snap
+                if self._clock is None and isinstance(self.kind, ShowTake) and show_time:
+                    self._clock = ShowClock(self.kind, show_time)
+                if self._clock is not None:
+                    self._clock.tick(tel.state)
                 self.fault = v.alarm or (self.fault if stopped[0] else None)
                 if sim is not None:
                     self._sim = sim
@@ -77,6 +85,7 @@ class LoopWatch:
             self._tel = {"state": "starting"}
             self.runs += 1
             self.kind, self.driver, self.released = kind, driver, None
+            self._clock = None
             self.fault, self.record_error, self.holding = None, None, False
 
     def end(self, stats: LoopStats | None, *, holding: bool, record_error: str | None,
@@ -87,6 +96,7 @@ class LoopWatch:
                 self._tel = telemetry_snapshot(telemetry)
             self.last_stats, self.holding = stats, holding
             self.kind = self.driver = None
+            self._clock = None
             self.record_error = record_error
             if stats is None:
                 return
@@ -132,7 +142,7 @@ class LoopWatch:
                     "loop_hz": self._rate.hz(), "runs": self.runs, "driver": self.driver,
                     "recording": kind.take if isinstance(kind, Record) else None,
                     "playing": kind.take if isinstance(kind, (Play, ShowTake)) else None,
-                    "show": isinstance(kind, ShowTake),
+                    "show": self._clock.progress() if self._clock is not None else None,
                     "released": self.released, "holding": self.holding,
                     "fault": self.fault, "record_error": self.record_error,
                     "last_stats": stats.as_dict() if stats is not None else None}

@@ -19,6 +19,8 @@ from robot.loop.take_writer import TakeWriter
 from robot.motion.keyframes import Sequence, parse_sequence
 from robot.motion.layered import LayeredEngine
 from robot.motion.scripted import PlaybackEngine, RecordingEngine
+from robot.motion.show import Cue
+from robot.motion.show_walk import ShowEngine, Travel
 from robot.motion.takes import TakeHeader, read_take
 
 
@@ -71,10 +73,15 @@ class Keyframes:
 @dataclass(frozen=True)
 class ShowTake:
     """A show take (an imported animation, robot.motion.show) streamed as recorded: its
-    joint stream as a keyframe sequence, at any rate; the panel plays its audio."""
+    joint stream as a keyframe sequence, at any rate, the gait walking the legs where
+    ``travel`` says (robot.motion.show_walk, with the take's ``params``); the panel plays
+    its audio; ``cues`` say what comes next."""
 
     take: str
     sequence: Sequence
+    travel: Travel = Travel()
+    params: GaitParams | None = None
+    cues: tuple[Cue, ...] = ()
 
     @property
     def owner(self) -> str:
@@ -113,6 +120,9 @@ def build(kind: RunKind, robot: RobotConfig, params: GaitParams) -> Built:
         return Built(PlaybackEngine(robot, h.params, changes=take.changes, stop_tick=stop,
                                     keyframes=layer), driver=kind.owner)
     if isinstance(kind, ShowTake):
+        if kind.travel.walks:
+            return Built(ShowEngine(robot, kind.params or params, stream=kind.sequence,
+                                    travel=kind.travel), driver=kind.owner)
         return Built(LayeredEngine(robot, params, keyframes=kind.sequence, walk=False),
                      driver=kind.owner)
     engine = LayeredEngine(robot, params, keyframes=kind.sequence, walk=kind.walk)

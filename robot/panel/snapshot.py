@@ -44,9 +44,20 @@ def telemetry_snapshot(tel: Telemetry) -> dict[str, Any]:
             "amplitude": tel.amplitude, "stop_reason": tel.stop_reason}
 
 
+def show_doing(show: Mapping[str, Any]) -> str:
+    """What a playing show is doing, in words: "playing take NAME 3.2 / 30.0 s, next cue
+    'lights up' at 5.0 s" (robot.panel.show_clock's progress)."""
+    cue = show.get("next_cue")
+    return (f"playing take {show['take']} {show['t']:.1f} / {show['duration']:.1f} s"
+            + (f", next cue '{cue['name']}' at {cue['t']:.1f} s" if cue else ""))
+
+
 def state_snapshot(robot: RobotConfig, tel: Mapping[str, Any], sim: Mapping[str, Any], *,
-                   running: bool, rate_hz: float, loop_hz: float) -> dict[str, Any]:
-    """A JSON-ready snapshot: loop state and timing, servos, sim metrics, stick figure."""
+                   running: bool, rate_hz: float, loop_hz: float,
+                   show: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """A JSON-ready snapshot: loop state and timing, servos, sim metrics, stick figure;
+    while a show plays (``show``: its progress), the state "playing" and ``doing``, what
+    it is doing in words."""
     names = robot.joint_names
     servos = [{"id": j.servo_id, "joint": j.name,
                "temperature": s.temperature if s else None,
@@ -58,8 +69,11 @@ def state_snapshot(robot: RobotConfig, tel: Mapping[str, Any], sim: Mapping[str,
     figure = {"cmd": views(robot, q_cmd) if len(q_cmd) == len(names) else None,
               "present": views(robot, q_present)
               if q_present and len(q_present) == len(names) else None}
+    state = tel.get("state", "idle")
+    playing = bool(running and show and show.get("playing") and state == "walking")
     return {
-        "running": running, "state": tel.get("state", "idle"), "t": tel.get("t", 0.0),
+        "running": running, "state": "playing" if playing else state,
+        "doing": show_doing(show) if playing and show else None, "t": tel.get("t", 0.0),
         "tick": tel.get("tick", 0), "rate_hz": rate_hz,
         "loop_hz": loop_hz, "period_error_ms": tel.get("period_error_ms", 0.0),
         "overruns": tel.get("overruns", 0), "amplitude": tel.get("amplitude", 0.0),

@@ -26,6 +26,7 @@ from robot.motion.keyframes import Sequence, load_sequence, parse_sequence, sequ
 from robot.motion.layered import LayeredEngine
 from robot.motion.posing import limb_joints, limbs
 from robot.motion.show import Show, show_of, stream_sequence
+from robot.motion.show_walk import Travel
 from robot.motion.takes import SUFFIX, TakeHeader, read_take
 from robot.panel.controller import PanelController
 from robot.panel.runs import Keyframes, Play, Record, ShowTake
@@ -101,7 +102,8 @@ class Studio:
         show = show_of(h.show, str(path))
         if show.stream:   # an imported show: its joints as they are, at any rate
             seq = stream_sequence(take)
-            self.c.start(run=ShowTake(take_name, seq), received=received)
+            self.c.start(run=ShowTake(take_name, seq, Travel.of_take(take), h.params,
+                                      show.cues), received=received)
             self.show = show
             return {"take": take_name, "seconds": seq.duration}
         if h.rate_hz != self.c.options.rate_hz:
@@ -111,14 +113,16 @@ class Studio:
         return {"take": take_name, "seconds": take.gait_seconds}
 
     def show_status(self) -> dict[str, Any] | None:
-        """The playing show's audio fields and its time [s] (the engine's: 0 at the first
-        tick after the ramp in, as the loop last reported it), for the page that plays the
-        audio; None: no show playing."""
+        """The playing show's audio fields and its time ``t`` [s] (the engine's: 0 at the
+        first tick after the ramp in) at the loop process's wall time ``at`` [s] of that
+        tick, and the show's measured ``rate`` (show seconds per wall second), for the
+        page that plays the audio; None: no show playing."""
         show, s = self.show, self.c.loop_state()
-        playing = s.get("playing")
-        if show is None or playing is None or not s.get("show"):
+        playing, now = s.get("playing"), s.get("show")
+        if show is None or playing is None or not now:
             return None
-        return {"take": playing, "t": float(s.get("engine_t") or 0.0),
+        return {"take": playing, "t": now["t"], "at": now["at"], "rate": now["rate"],
+                "playing": now["playing"],
                 "audio": f"/api/show/audio?take={playing}" if show.audio else None,
                 "audio_offset_s": show.audio_offset_s,
                 "cues": [{"t": c.t, "name": c.name} for c in show.cues]}

@@ -4,7 +4,9 @@ joint stream at the control rate, its violations, and the take that `biped play`
 The stream's rate is the smallest whole multiple of the animation's frame rate at or
 above ``min_rate`` (every frame is a tick: a round trip compares frame for frame);
 between frames the joints follow the monotone cubic through them (robot/motion/interp.py
-``smooth``: no overshoot, so no limit is crossed that the frames do not cross).
+``smooth``: no overshoot, so no limit is crossed that the frames do not cross). Where the
+animation walks, the gait's travel is planned from the root's motion (robot/previs/
+travel.py) and written as the take's parameter timeline (robot/motion/show_walk.py).
 """
 
 from __future__ import annotations
@@ -24,10 +26,13 @@ from robot.motion.show import Show
 from robot.motion.takes import TakeHeader
 from robot.previs.bone_map import BoneMap
 from robot.previs.bvh_read import read_bvh
+from robot.previs.feet import rig_motion
 from robot.previs.gltf_read import read_gltf
-from robot.previs.retarget import Retargeted, retarget
+from robot.previs.retarget import Retargeted, retarget, robot_leg, robot_scale
 from robot.previs.rig import Array, Rig
+from robot.previs.travel import Efficiency, WalkPlan, plan_walk, travel
 from robot.previs.violations import Violation, check, clamp
+from robot.previs.walk_spans import walks
 
 SUFFIXES = (".bvh", ".glb", ".gltf")
 #: Highest take rate [Hz] (robot.motion.takes accepts up to 2000).
@@ -44,7 +49,8 @@ def read_rig(path: str | Path) -> Rig:
 @dataclass(frozen=True)
 class Imported:
     """The frames as retargeted (``frames``), the stream at ``rate_hz`` before (``raw``)
-    and after the clamp (``q``) at times ``t`` [s], and the violations of ``raw``."""
+    and after the clamp (``q``) at times ``t`` [s], the violations of ``raw``, and where
+    the gait walks the legs (``walks``; none without root travel)."""
 
     frames: Retargeted
     rate_hz: float
@@ -52,6 +58,7 @@ class Imported:
     raw: Array
     q: Array
     violations: tuple[Violation, ...]
+    walks: tuple[WalkPlan, ...] = ()
 
 
 def stream_rate(frame_s: float, min_rate: float) -> float:
@@ -65,7 +72,9 @@ def stream_rate(frame_s: float, min_rate: float) -> float:
 
 def import_animation(path: str | Path, robot: RobotConfig, bone_map: BoneMap, hold: Array,
                      *, up: str | None = None, min_rate: float = 200.0,
-                     max_accel: float | None = None) -> Imported:
+                     max_accel: float | None = None, params: GaitParams | None = None,
+                     efficiency: Efficiency | None = None) -> Imported:
+    """``params`` and ``efficiency`` given: the walks become the gait's travel."""
     rig = read_rig(path)
     frames = retarget(rig, robot, bone_map, hold, up=up)
     rate = stream_rate(rig.frame_s, min_rate)
@@ -74,17 +83,25 @@ def import_animation(path: str | Path, robot: RobotConfig, bone_map: BoneMap, ho
     raw = smooth(frames.t, frames.q, t) if len(frames.t) > 1 else frames.q[:1].copy()
     found = check(robot, t, raw, max_accel=max_accel, joints=frames.animated)
     q = clamp(robot, t, raw, max_accel=max_accel) if found else raw
-    return Imported(frames, rate, t, raw, q, tuple(found))
+    plans: tuple[WalkPlan, ...] = ()
+    if params is not None and efficiency is not None:
+        c = rig.orient(up or bone_map.up)
+        motion = rig_motion(rig, c, robot_scale(rig, c, robot))
+        plans = tuple(plan_walk(w, motion, robot, params, efficiency)
+                      for w in walks(motion, robot_leg(robot)))
+    return Imported(frames, rate, t, raw, q, tuple(found), plans)
 
 
 def write_stream_take(path: str | Path, robot: RobotConfig, params: GaitParams,
                       imported: Imported, show: Show, *, note: str = "") -> None:
-    """The take: a header with the show (``stream``: play the joint angles as they are)
-    and one stream line per tick [rad, 8 decimals]."""
+    """The take: a header with the show (``stream``: play the joint angles as they are),
+    the walks' timeline (robot/motion/show_walk.py) and one stream line per tick [rad, 8
+    decimals]."""
     header = TakeHeader(robot=robot.name, robot_file=robot.source,
                         joints=robot.joint_names, rate_hz=imported.rate_hz, read_every=10,
                         gait="import", params=params, note=note, show=show.as_json())
     lines = [json.dumps(header.as_json())]
+    lines += [json.dumps(e) for e in travel(imported.walks).timeline(imported.rate_hz)]
     for k, (t, row) in enumerate(zip(imported.t.tolist(), imported.q.tolist(), strict=True)):
         lines.append(json.dumps({"tick": k, "t": round(t, 9), "state": "show",
                                  "q": [round(v, 8) for v in row]}))

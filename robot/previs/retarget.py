@@ -41,6 +41,23 @@ def _find(rig: Rig, bone: str) -> int | None:
     return folded.get(bone.casefold())
 
 
+def robot_leg(robot: RobotConfig) -> float:
+    """The robot's leg [m]: hip to sole with straight knees."""
+    g = robot.geometry
+    return g.thigh + g.shin + g.ankle_height
+
+
+def robot_scale(rig: Rig, c: Array, robot: RobotConfig) -> float:
+    """Robot metres per file unit: the ratio of the two legs' lengths (the rig's: the
+    root's height above its lowest chain end at rest, along up ``c[2]``)."""
+    pos, _ = rig.rest_positions()
+    leaves = rig.leaves()
+    rig_leg = float((pos[0] - leaves.min(axis=0)) @ c[2]) if len(leaves) else 0.0
+    if rig_leg <= 0:
+        rig_leg = float(np.ptp(np.vstack([pos, leaves]) @ c[2]))
+    return robot_leg(robot) / rig_leg if rig_leg > 0 else 1.0
+
+
 def retarget(rig: Rig, robot: RobotConfig, bone_map: BoneMap, hold: Array, *,
              up: str | None = None) -> Retargeted:
     c = rig.orient(up or bone_map.up)
@@ -68,14 +85,7 @@ def retarget(rig: Rig, robot: RobotConfig, bone_map: BoneMap, hold: Array, *,
         raise ConfigError(f"{rig.source}: no bone of the map ({bone_map.source}) is in the "
                           f"file (missing: {', '.join(missing[:6])}); bones in the file: "
                           f"{', '.join(rig.names[:12])}; give --map MAP.toml")
-    pos, _ = rig.rest_positions()
-    leaves = rig.leaves()
-    rig_leg = float((pos[0] - leaves.min(axis=0)) @ c[2]) if len(leaves) else 0.0
-    if rig_leg <= 0:
-        rig_leg = float(np.ptp(np.vstack([pos, leaves]) @ c[2]))
-    g = robot.geometry
-    robot_leg = g.thigh + g.shin + g.ankle_height
-    travel = (rig.root - rig.root[0]) @ c.T * (robot_leg / rig_leg if rig_leg > 0 else 1.0)
+    travel = (rig.root - rig.root[0]) @ c.T * robot_scale(rig, c, robot)
     axis = int(np.argmax(np.abs(c[2])))
     sign = "+" if c[2, axis] > 0 else "-"
     driven = tuple(n for n in names if n in animated)

@@ -146,7 +146,7 @@ function esc(t) { const d = document.createElement("div"); d.textContent = t; re
 function showState(s) {
   last = s;
   const st = $("state");
-  st.textContent = s.state + (s.running ? "" : " (not running)");
+  st.textContent = (s.doing || s.state) + (s.running ? "" : " (not running)");
   st.className = "state " + s.state;
   const f = s.figure || {};
   drawView($("side"), f.cmd && f.cmd.side, f.present && f.present.side, "x forward →");

@@ -33,6 +33,7 @@
   }
 
   let wasRecording = null;
+
   P.listeners.push((s) => {
     if (!s.studio) return;
     status(s.studio);
@@ -60,58 +61,112 @@
 })();
 
 // A show take with a soundtrack: the browser plays the sound (the robot's computer needs no
-// audio stack). Every live frame carries the show's time on the robot (the engine's, 0 at
-// its first tick after the ramp in) and the server's wall time when it was read. The page
-// dates each frame by that wall time, less the smallest delivery delay seen (so a frame that
-// arrives late does not shift the clock), and the audio element follows: started at the
-// audio's offset, steered by its playback rate (within +-10 %), re-seeked for a large drift.
+// audio stack). Every live frame carries the show's time t on the robot (the engine's, 0 at
+// its first tick after the ramp in), the robot's wall time `at` of that very tick, and the
+// rate at which show time runs (below 1 when the loop falls behind). The page maps the
+// robot's wall clock onto its own by the smallest (arrival - at) seen, so a frame that
+// arrives late, or was read from a cache, still says what the show time was when; the show
+// time now is t + rate * (now - at). The audio element follows: started at the audio's
+// offset, steered by its playback rate, re-seeked only for a large drift that holds (a
+// seek lands late by the time the element takes to seek: the page learns that lead from
+// the drift once the audio has settled after the seek, by halves, within 0..0.2 s).
+// The audio's clock moves in the renderer's chunks and stalls when the machine is busy, so
+// one read of the drift is noisy by tens of ms: the steering acts on the median of the
+// last tune.window reads (a stall or a jump of one chunk does not move it). And the audio
+// clock need not run at the playback rate asked: in headless Chromium on a loaded machine
+// it ran 3 % slow, so a proportional steering alone sat tens of ms behind. The page learns
+// that gain g (audio seconds per second of asked rate, over the last tune.gainS seconds,
+// counted once the audio has settled after the last seek) and divides it out. The
+// steering is then proportional with the show's rate fed forward: rate = show rate x
+// (1 - drift / TAU) / g, so the drift decays as exp(-t / TAU) without overshoot (no
+// integral term to wind up; TAU well above the window's delay); a playback rate is set
+// only when it changes by more than tune.step (each change costs the audio renderer a
+// re-buffer). The settings are window.showTune (docs/show_sync.py tries others).
 (() => {
   const P = window.panel;
   const $ = (id) => document.getElementById(id);
   const TOKEN = new URLSearchParams(location.search).get("token");
-  const SEEK_S = 0.15;      // drift [s] beyond which it seeks
-  const GAIN = 1.5, INTEGRAL = 0.6;   // rate change per s of drift, per s*s of it held
+  const tune = window.showTune = {
+    seek: 0.25,     // median drift [s] beyond which it seeks
+    tau: 1.0,       // [s] time constant of the steering
+    maxDev: 0.1,    // largest playback-rate change from the show's rate
+    step: 0.003,    // smallest playback-rate change made
+    window: 5,      // reads (one per FOLLOW_MS) whose median drift steers
+    gainS: 8.0,     // [s] of reads over which the audio clock's gain is measured
+  };
+  const FOLLOW_MS = 50;
   let show = null;          // the playing show's fields, or null
-  let heard = null;         // {t, at}: show time t [s] at performance.now() at [ms]
-  let delay = Infinity;     // smallest (arrival - server wall time) seen [ms]: clock offset
+  let heard = null;         // {t, at, rate}: show time t [s] at page time at [ms]
+  let offset = Infinity;    // smallest (arrival - robot wall time) seen [ms]: the clocks' offset
   let lead = 0.05;          // a seek lands this late [s] (learnt from the last one)
   let seeked = false;       // the last step was a seek: the next drift says how late
-  let held = 0, last = null;   // integral of the drift [s*s], when it was last updated
+  let drifts = [];          // the last tune.window drift reads [s]
+  let runs = [];            // since the last seek: {at [ms], audio [s], rate asked}
   let cue = 0;
+  let seeks = 0;            // seeks made (for the tests: a seek is a jump in the sound)
   let wasPlaying = null;    // the take playing at the last frame
 
-  function showTime() {     // the robot's show time now [s], by the page's clock
-    return heard ? heard.t + (performance.now() - heard.at) / 1000 : null;
+  const pageNow = () => performance.timeOrigin + performance.now();   // [ms]
+
+  function showTime(at) {   // the robot's show time [s] at page time at [ms]
+    return heard ? heard.t + heard.rate * (at - heard.at) / 1000 : null;
   }
 
-  function hear(t, wall) {  // a frame: show time t [s] read at server wall time [s]
-    const now = performance.now();
-    const arrival = performance.timeOrigin + now;
-    delay = Math.min(delay, arrival - 1000 * wall);
-    heard = { t, at: now - (arrival - 1000 * wall - delay) };   // when it was read, here
+  function hear(now) {      // a frame: show time now.t [s] at robot wall time now.at [s]
+    if (now.at === null || now.at === undefined) return;
+    offset = Math.min(offset, pageNow() - 1000 * now.at);
+    heard = { t: now.t, at: 1000 * now.at + offset,
+              rate: Math.min(1.2, Math.max(0.8, now.rate || 1)) };
+  }
+
+  function median(xs) {
+    const s = [...xs].sort((a, b) => a - b), m = s.length >> 1;
+    return s.length % 2 ? s[m] : (s[m - 1] + s[m]) / 2;
+  }
+
+  function seekTo(audio, want) {
+    audio.currentTime = want + lead;
+    seeked = true; seeks++; drifts = []; runs = [];
+  }
+
+  function gain(at, audio) {   // the audio clock's seconds per second of asked rate
+    runs.push({ at, audio: audio.currentTime, rate: audio.playbackRate });
+    while (runs.length > 2 && runs[0].at < at - 1000 * tune.gainS) runs.shift();
+    const a = runs[0], b = runs[runs.length - 1];
+    if (b.at - a.at < 1500) return 1;
+    let asked = 0;
+    for (let k = 1; k < runs.length; k++) {
+      asked += runs[k - 1].rate * (runs[k].at - runs[k - 1].at) / 1000;
+    }
+    return Math.min(1.2, Math.max(0.8, (b.audio - a.audio) / asked));
   }
 
   function follow() {
     const audio = $("show-audio");
     if (!show || !show.audio || heard === null) return;
-    const want = showTime() - show.audio_offset_s;    // where the audio should be [s]
+    const at = pageNow();
+    const want = showTime(at) - show.audio_offset_s;   // where the audio should be [s]
     if (want < 0) return;
     if (audio.paused) {
-      audio.currentTime = want + lead;
-      seeked = true;
+      seekTo(audio, want);
       audio.play().catch((e) => P.say("audio: " + e.message + " (tap the page once)", true));
       return;
     }
-    const drift = audio.currentTime - want;
-    if (seeked) { lead = Math.min(0.3, Math.max(0, lead - drift)); seeked = false; }
-    const now = performance.now();
-    held = Math.min(0.05, Math.max(-0.05, held + drift * (last ? (now - last) / 1000 : 0)));
-    last = now;
-    if (Math.abs(drift) > SEEK_S) {
-      audio.currentTime = want + lead; audio.playbackRate = 1; seeked = true; held = 0;
-    } else {
-      audio.playbackRate = Math.min(1.1, Math.max(0.9, 1 - GAIN * drift - INTEGRAL * held));
+    drifts.push(audio.currentTime - want);
+    if (drifts.length > tune.window) drifts.shift();
+    const drift = median(drifts);
+    if (drifts.length < tune.window) return;   // just seeked: the audio is settling
+    if (seeked) {   // how far from where it was sent the seek landed, half learnt
+      lead = Math.min(0.2, Math.max(0, lead - 0.5 * drift)); seeked = false;
     }
+    if (Math.abs(drift) > tune.seek) {
+      seekTo(audio, want);
+      audio.playbackRate = heard.rate;
+      return;
+    }
+    const dev = Math.min(tune.maxDev, Math.max(-tune.maxDev, -drift / tune.tau));
+    const rate = heard.rate * (1 + dev) / gain(at, audio);
+    if (Math.abs(rate - audio.playbackRate) > tune.step) audio.playbackRate = rate;
   }
 
   function stop(why) {
@@ -120,7 +175,17 @@
     audio.removeAttribute("src");
     $("show-line").hidden = true;
     if (why) P.say(why);
-    show = null; heard = null; cue = 0; delay = Infinity; held = 0; last = null;
+    show = null; heard = null; cue = 0; offset = Infinity; drifts = [];
+  }
+
+  function prepare(now) {   // a new show: load its audio
+    if (show && show.take === now.take) return;
+    show = now; cue = 0;
+    const audio = $("show-audio");
+    if (now.audio) {
+      audio.src = now.audio + (TOKEN ? "&token=" + encodeURIComponent(TOKEN) : "");
+      audio.load();
+    }
   }
 
   P.listeners.push((s) => {
@@ -132,29 +197,31 @@
     const playing = s.studio ? s.studio.playing : null;
     if (wasPlaying && playing !== wasPlaying) P.say("take " + wasPlaying + " finished");
     wasPlaying = playing;
-    if (!now || s.state !== "walking") {
+    if (!now || !s.running) {
       if (show) stop(null);
       return;
     }
-    if (!show || show.take !== now.take) {
-      show = now; cue = 0;
-      const audio = $("show-audio");
-      if (now.audio) {
-        audio.src = now.audio + (TOKEN ? "&token=" + encodeURIComponent(TOKEN) : "");
-        audio.load();
-      }
+    if (!now.playing) {
+      if (heard) stop(null);                 // played to its end: ramping out
+      else if (now.at === null) prepare(now);   // ramping in: the audio loads
+      return;
     }
-    hear(now.t, s.wall_time);
+    prepare(now);
+    hear(now);
     while (cue < now.cues.length && now.cues[cue].t <= now.t) {
       const line = $("show-line");
       line.hidden = false;
       line.textContent = "cue " + now.cues[cue].t.toFixed(2) + " s: " + now.cues[cue].name;
       cue++;
     }
-    follow();
   });
-  setInterval(follow, 50);
-  // For the tests and the curious: the audio's clock and the show time it follows [s].
-  window.showClock = () => ({ audio: $("show-audio").currentTime, playing: !$("show-audio").paused,
-                              show: showTime(), offset: show ? show.audio_offset_s : null });
+  setInterval(follow, FOLLOW_MS);   // the only caller: one drift read per FOLLOW_MS
+  // For the tests and the curious: the audio's clock [s] and the page's wall time of that
+  // read [ms], and the show time the page follows then [s].
+  window.showClock = () => {
+    const audio = $("show-audio"), at = pageNow();
+    return { audio: audio.currentTime, at, playing: !audio.paused, show: showTime(at),
+             offset: show ? show.audio_offset_s : null, clockOffset: offset, seeks,
+             rate: audio.playbackRate };
+  };
 })();

@@ -5,9 +5,10 @@ gain registers into its terms).
 This is the reference implementation on plain floats, one servo at a time: the emulator's
 servos (``sim.emulator.servo_dynamics``) integrate it. The MuJoCo servo
 (``sim.mujoco.servo_law``) carries the same law as MuJoCo parameters (an actuator, joint
-damping, frictionloss, armature) so that the physics step runs it without Python; a test
-(``tests/test_servo_law.py``) holds the two to the same torque at random states, so the
-emulator and the sim cannot drift apart.
+damping, frictionloss, armature) so that the physics step runs it without Python;
+``tests/test_emulator_dynamics.py`` holds the two to the same pendulum motion (an emulated
+servo and the MuJoCo replay of its log: mean |difference| 0.001-0.002 rad on a sine, up
+to 0.037 on a fast chirp), so the emulator and the sim cannot drift apart unnoticed.
 
 The law, per servo (SI units: rad, rad/s, N m, V)::
 

@@ -9,10 +9,11 @@ unplugged), as a user connects one new servo at a time; the line ``all`` plugs i
 The servos are the robot's bus model unless ``--model`` names another; a dual-axis model
 (2XL430-W250) serves N cases, each a line plugs in whole (its two axes at ids 1 and 2).
 
-The servos move by the servo model (``sim.emulator.servo_dynamics``: the gains the driver
-wrote, the supply, gearbox friction; ``--motion travel``: at constant speed onto the goal);
-``--load ID=MASS@LENGTH`` hangs a weight [kg] on an arm [m] on servo ID (repeatable), q = 0
-hanging down at the joint's zero, so a loaded joint lags its goal as a real one does.
+A chain's servos move by the servo model (``sim.emulator.servo_dynamics``: the gains the
+driver wrote, the supply, gearbox friction; ``--motion travel``, LX servos and factory-new
+ones: at constant speed onto the goal); ``--load ID=MASS@LENGTH`` hangs a weight [kg] on
+an arm [m] on servo ID (repeatable), q = 0 hanging down at the joint's zero, so a loaded
+joint lags its goal as a real one does.
 """
 
 from __future__ import annotations

@@ -44,6 +44,7 @@ COMMANDS: tuple[str, ...] = (
     "robustness",
     "tune",
     "identify",
+    "sim_gap",
 )
 
 

@@ -8,6 +8,12 @@ plugged in: each line read on stdin plugs the next one in alone (the previous on
 unplugged), as a user connects one new servo at a time; the line ``all`` plugs in all.
 The servos are the robot's bus model unless ``--model`` names another; a dual-axis model
 (2XL430-W250) serves N cases, each a line plugs in whole (its two axes at ids 1 and 2).
+
+A chain's servos move by the servo model (``sim.emulator.servo_dynamics``: the gains the
+driver wrote, the supply, gearbox friction; ``--motion travel``, LX servos and factory-new
+ones: at constant speed onto the goal); ``--load ID=MASS@LENGTH`` hangs a weight [kg] on
+an arm [m] on servo ID (repeatable), q = 0 hanging down at the joint's zero, so a loaded
+joint lags its goal as a real one does.
 """
 
 from __future__ import annotations
@@ -20,11 +26,14 @@ from types import FrameType
 from typing import TYPE_CHECKING
 
 from robot.commands.common import add_robot_args, positive_int, robot_from
+from robot.errors import ConfigError
+from robot.servo.bench_load import BenchLoad, parse_load
 
 if TYPE_CHECKING:
     from sim.emulator.chain import Emulator
 
 PROTOCOLS = ("dynamixel", "dynamixel1", "feetech", "lx")
+MOTIONS = ("model", "travel")
 ALIVE_CHECK_S = 0.5          # how often the emulator process is checked [s]
 
 
@@ -43,10 +52,27 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p.add_argument("--factory-new", type=positive_int, default=None, metavar="N",
                    help="serve N servos as shipped (id 1, factory baud); each stdin line "
                         "plugs in the next one alone, the line 'all' plugs in all")
+    p.add_argument("--motion", choices=MOTIONS, default="model",
+                   help="model: the servo model moves the horns (default); travel: "
+                        "constant speed onto the goal")
+    p.add_argument("--load", action="append", default=[], metavar="ID=MASS@LENGTH",
+                   help="a weight [kg] on an arm [m] on servo ID, e.g. 3=0.5@0.1 "
+                        "(repeatable; --motion model)")
     p.add_argument("--model", default=None,
                    help="servo model of the --factory-new servos, e.g. 2XL430-W250 (a "
                         "dual-axis case a servo; default: the robot config's bus model)")
     return p
+
+
+def loads_from(texts: list[str]) -> dict[int, BenchLoad]:
+    """``ID=MASS@LENGTH`` texts → id → load; ConfigError naming the bad one."""
+    out: dict[int, BenchLoad] = {}
+    for text in texts:
+        sid, sep, rest = text.partition("=")
+        if not sep or not sid.strip().isdigit():
+            raise ConfigError(f"--load: expected ID=MASS@LENGTH (e.g. 3=0.5@0.1), got {text!r}")
+        out[int(sid)] = parse_load(rest, where=f"--load {text}")
+    return out
 
 
 def _plug_from_stdin(emu: Emulator, count: int, stop: threading.Event) -> None:
@@ -83,6 +109,8 @@ def run(args: argparse.Namespace) -> int:
         return 2
     robot = robot_from(args)
     protocol = args.protocol or robot.bus.kind
+    loads = loads_from(args.load)
+    motion = "travel" if protocol == "lx" and not loads else args.motion   # LX: no model
     stop = threading.Event()
 
     def on_signal(signum: int, frame: FrameType | None) -> None:
@@ -92,7 +120,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         model = args.model or (robot.bus.model if protocol == robot.bus.kind else None)
         emu = (Emulator.factory_new(protocol, args.factory_new, model=model) if args.factory_new
-               else Emulator(protocol, robot, baud=args.baud))
+               else Emulator(protocol, robot, baud=args.baud, loads=loads, motion=motion))
         with emu:
             print(emu.port, flush=True)
             if args.factory_new:

@@ -8,6 +8,10 @@
       replays each log closed loop from its first recorded state in the MuJoCo servo model
       and prints the mean |q_sim - q_log| per log and overall (logs resampled to 5 ms).
 
+  biped identify record --bus K --port P --id N --motor NAME --mass KG --length M --out DIR
+      runs a real servo with a weight on an arm through sines, a chirp, steps and a
+      lift-and-drop at each --kp and writes one log per run (robot/commands/identify_record.py).
+
 Logs are the public pendulum-log JSON format (robot/servo/pendulum_log.py; .json or
 .json.gz): a servo swinging a known weight on an arm (docs/servos.md says how to build one).
 """
@@ -19,6 +23,7 @@ import json
 from pathlib import Path
 
 from robot.commands.common import bounded_float, checked, input_file, one_line_errors, output_file
+from robot.commands.identify_record_cli import add_record_parser, run_record_command
 from robot.config.servo_file import load_servo_file, physics_for, servo_file_text
 from robot.errors import ConfigError
 from robot.servo.models import MODELS
@@ -55,6 +60,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     check.add_argument("--plot", default=None, metavar="PNG",
                        help="plot goal, recorded and simulated position per log")
     check.add_argument("--json", action="store_true", help="print one JSON object")
+    add_record_parser(sub)
     for q in (fit, check):
         q.add_argument("--offset", type=bounded_float(-0.5, 0.5, "rad", what="an offset"),
                        default=0.0, metavar="RAD",
@@ -147,4 +153,6 @@ def _fit(args: argparse.Namespace) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.action == "record":
+        return run_record_command(args)
     return _fit(args) if args.action == "fit" else _check(args)

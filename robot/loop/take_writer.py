@@ -4,6 +4,7 @@ of the loop, like the CSV/JSONL recorder (robot.loop.recorder)."""
 from __future__ import annotations
 
 import json
+import time
 from collections.abc import Mapping
 from pathlib import Path
 from typing import IO, Any
@@ -59,8 +60,12 @@ class TakeWriter:
         if self._t0 is None:
             self._t0 = tel.t
         self.ticks += 1
-        self._line({"tick": tel.tick, "t": tel.t - self._t0, "state": tel.state,
-                    "q": tel.q_cmd})
+        line: dict[str, Any] = {"tick": tel.tick, "t": tel.t - self._t0, "state": tel.state,
+                                "q": tel.q_cmd}
+        if tel.fresh and tel.q_present:         # read back this tick (biped sim-gap), and
+            line["present"] = tel.q_present     # when: the reply is in [s, the t clock]
+            line["present_t"] = time.monotonic() - self._t0
+        self._line(line)
 
     def close_quietly(self) -> str | None:
         """Close; the first failed write as one line, or None."""

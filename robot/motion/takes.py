@@ -12,9 +12,12 @@ everything up to the last line written); plain text that ``jq`` or pandas read:
   {"gait_tick": k, "t": ..., "stop": true}     the gait told to ramp out before tick k
   {"gait_tick": k, "t": ..., "start": true}    the gait told to start before tick k (a show
       whose legs walk in spans, robot/motion/show_walk.py; a recorded walk starts at 0)
-  {"tick": n, "t": ..., "state": "walking", "q": [...]}
+  {"tick": n, "t": ..., "state": "walking", "q": [...], "present": [...]}
       one streamed tick: the commanded joint angles [rad] as they went to the bus (after
-      balance, clamp and slew), ``t`` [s] on the loop's clock since the first tick
+      balance, clamp and slew), ``t`` [s] on the loop's clock since the first tick;
+      ``present``: on the ticks that read the servos back, the joint angles read [rad],
+      ``present_t`` [s] when the reply was in (``biped sim-gap`` compares them with the
+      commands and the simulation)
 
 The gait is a pure function of the parameter timeline, so replaying the timeline on the
 same robot and rate reproduces the stream (in the simulation with balance feedback too:
@@ -80,7 +83,9 @@ class TakeHeader:
 class Take:
     """A take read back: header, timeline (gait tick → changes; the tick of the first
     stop, or None; every start and stop in order) and the joint stream (``q``: ticks x
-    joints [rad]; ``t`` [s]; ``states``)."""
+    joints [rad]; ``t`` [s]; ``states``; ``present``: ticks x joints read back [rad], NaN
+    on ticks without a read-back; ``present_t``: when each was read [s, the clock of
+    ``t``; ``t`` if not recorded])."""
 
     header: TakeHeader
     changes: Mapping[int, Mapping[str, float]]
@@ -91,6 +96,8 @@ class Take:
     source: str = "<memory>"
     starts: tuple[int, ...] = ()
     stops: tuple[int, ...] = ()
+    present: npt.NDArray[np.float64] | None = None
+    present_t: npt.NDArray[np.float64] | None = None
 
     @property
     def gait_seconds(self) -> float:
@@ -196,6 +203,9 @@ def read_take(path: str | Path) -> Take:
     t: list[float] = []
     q: list[list[float]] = []
     states: list[str] = []
+    present: list[list[float]] = []
+    read_t: list[float] = []
+    nan = [math.nan] * n
     for where, row in rows[1:]:
         if not isinstance(row, dict):
             raise _fail(where, "expected a JSON object")
@@ -222,11 +232,17 @@ def read_take(path: str | Path) -> Take:
             q.append(_angles(where, row.get("q"), n))
             t.append(number(where, "t", row.get("t", len(t) / header.rate_hz)))
             states.append(str(row.get("state", "")))
+            seen = row.get("present")
+            present.append(nan if seen is None else _angles(f"{where}: present", seen, n))
+            read_t.append(number(where, "present_t", row.get("present_t", t[-1])))
         else:
             raise _fail(where, "expected a timeline line (gait_tick) or a stream line (tick)")
     if not q and not stop:
         raise ConfigError(f"{p}: a header only (no gait ticks, no stream lines): nothing to "
                           "replay; record a take with `biped walk --record NAME.take.jsonl`")
     q_arr = np.asarray(q, dtype=float).reshape(len(q), n)
+    read = np.asarray(present, dtype=float).reshape(len(q), n)
     return Take(header, changes, stop, np.asarray(t, dtype=float), q_arr, tuple(states),
-                source=str(p), starts=tuple(starts), stops=tuple(stops))
+                source=str(p), starts=tuple(starts), stops=tuple(stops),
+                present=read if np.isfinite(read).any() else None,
+                present_t=np.asarray(read_t, dtype=float))

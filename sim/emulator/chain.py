@@ -1,12 +1,8 @@
 """A chain of emulated servos on a pseudo-terminal, served from its own process.
 
-The real vendor SDKs (dynamixel_sdk, scservo_sdk) open the pty's slave path like a USB
-adapter and talk Dynamixel Protocol 2.0 (``sim.emulator.dxl_protocol``) or Feetech STS
-(``sim.emulator.sts_protocol``) to it. The test process drives faults and reads the log through a
-``multiprocessing`` pipe while the child serves.
-
-- Time: every time stamp is ``time.monotonic()`` [s] (system-wide on Linux, so comparable
-  between the test process and the child). Motion is evaluated lazily at each packet.
+The real vendor SDKs open the pty's slave path like a USB adapter and talk their protocol
+to it; the test process drives faults and reads the log through a pipe while the child serves.
+- Time: ``time.monotonic()`` [s] (system-wide on Linux); motion is lazy, at each packet.
 - Baud: a pty carries no baud rate, but pyserial stores the requested speed in the slave's
   termios; the child holds the slave open and reads that speed (``TCGETS2``) at every
   packet. A servo whose ``baud_rate`` register names another rate does not hear the packet
@@ -24,10 +20,11 @@ adapter and talk Dynamixel Protocol 2.0 (``sim.emulator.dxl_protocol``) or Feete
   silent gap shows the trip. Feetech STS has no such register (see ``servo_status.BUS_WATCHDOG``).
 - Log: one :class:`Packet` per heard instruction packet with a valid checksum (broadcast:
   id 254); values in the servo's byte order, signed per the X table; bulk reads: id → address.
-- Servos: present position starts at the joint's ``zero_ticks`` (2048 without a robot),
-  position limits are the joint limits in ticks (rounded outward). Sync/bulk reads answer
-  in the order the ids appear in the packet; a missing servo silences the rest. A chain
-  built from a robot is one already set up (return delay 0).
+- Servos travel at constant speed onto the goal, or move by the servo model
+  (``motion="model"``: ``servo_dynamics``; ``loads``: id → a weight on its arm), from the
+  joint's ``zero_ticks`` (2048 without a robot), limits: the joint's in ticks (outward).
+  Sync/bulk reads answer in packet order; a missing servo silences the rest; a chain
+  built from a robot is already set up (return delay 0).
 - Factory-new servos (:meth:`Emulator.factory_new`): id 1, factory baud and return delay,
   unplugged until :meth:`Emulator.plug` / :meth:`Emulator.plug_all`. Unplugging powers a
   servo off: it keeps its EEPROM (on STS only what was written with Lock 0), RAM restarts.
@@ -56,6 +53,7 @@ from types import TracebackType
 from typing import Any
 
 from robot.config.robot import RobotConfig
+from robot.servo.bench_load import BenchLoad
 from sim.emulator.chain_specs import FACTORY_BAUD, FACTORY_ID, factory_baud, factory_servos, plan_chain
 from sim.emulator.control_tables import BAUD_CODES, TABLES
 from sim.emulator.records import ChainSpec, EmulatorError, Packet
@@ -76,12 +74,14 @@ class Emulator:
 
     def __init__(self, protocol: str, robot: RobotConfig | None = None, *,
                  ids: Sequence[int] | None = None, model: str | None = None, seed: int = 0,
-                 baud: int | None = None) -> None:
-        choice = plan_chain(protocol, robot, ids=ids, model=model, baud=baud)
+                 baud: int | None = None, loads: Mapping[int, BenchLoad] | None = None,
+                 motion: str = "travel") -> None:
+        choice = plan_chain(protocol, robot, ids=ids, model=model, baud=baud, loads=loads,
+                            motion=motion)
         self.protocol = protocol
         self.family = MODELS[choice.model].family     # the chain's table family
         self.model, self.baud, self.ids = choice.model, choice.baud, choice.ids
-        self.spec = ChainSpec(protocol, choice.servos, seed)
+        self.spec = ChainSpec(protocol, choice.servos, seed, dynamics=choice.dynamics)
         self._proc: subprocess.Popen[bytes] | None = None
         self._conn: Connection | None = None
         self._port: str | None = None

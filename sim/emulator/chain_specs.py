@@ -7,14 +7,18 @@ or from explicit ids; checked against the emulator's own model list and baud cod
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 from robot.config.robot import RobotConfig
+from robot.config.servo_file import physics_for
+from robot.servo.bench_load import NONE, BenchLoad
+from robot.servo.models import MODELS as DRIVER_MODELS
 from sim.emulator.control_tables import BAUD_CODES, TABLES
 from sim.emulator.lx_commands import BAUD as LX_BAUD
 from sim.emulator.records import EmulatorError
 from sim.emulator.servo import ServoSpec
+from sim.emulator.servo_dynamics import DynamicsSpec
 from sim.emulator.servo_models import MODELS, PROTOCOL_FAMILIES, PROTOCOL_FAMILY
 
 DEFAULT_MODEL = {"dynamixel": "XL430-W250", "dynamixel1": "AX-12A", "feetech": "STS3215",
@@ -32,16 +36,20 @@ FACTORY_RETURN_DELAY = {"dynamixel": 250, "dynamixel1": 250, "feetech": 0, "lx":
 RATES: dict[str, list[int]] = {**{f: sorted(c.values()) for f, c in BAUD_CODES.items()},
                                "lx": [LX_BAUD]}
 FACTORY_ID = 1
+#: How emulated servos move: by the servo model, or constant-speed travel (plan_dynamics).
+MOTIONS = ("model", "travel")
 
 
 @dataclass(frozen=True)
 class ChainChoice:
-    """model: the chain's default model; baud [bit/s]; ids in bus order; one spec each."""
+    """model: the chain's default model; baud [bit/s]; ids in bus order; one spec each;
+    dynamics: each servo's model (``plan_dynamics``)."""
 
     model: str
     baud: int
     ids: tuple[int, ...]
     servos: tuple[ServoSpec, ...]
+    dynamics: tuple[DynamicsSpec | None, ...] = ()
 
 
 def _limits(robot: RobotConfig | None, servo_id: int, model: str) -> tuple[int, int, int]:
@@ -59,7 +67,9 @@ def _limits(robot: RobotConfig | None, servo_id: int, model: str) -> tuple[int, 
 
 
 def plan_chain(protocol: str, robot: RobotConfig | None, *, ids: Sequence[int] | None,
-               model: str | None, baud: int | None) -> ChainChoice:
+               model: str | None, baud: int | None,
+               loads: Mapping[int, BenchLoad] | None = None, motion: str = "travel"
+               ) -> ChainChoice:
     """The chain ``Emulator(protocol, robot, ids=, model=, baud=)`` serves; EmulatorError
     (one line, naming the argument and its valid values) when something does not fit."""
     if protocol not in PROTOCOL_FAMILY:
@@ -89,7 +99,8 @@ def plan_chain(protocol: str, robot: RobotConfig | None, *, ids: Sequence[int] |
         zero, lo, hi = _limits(robot, sid, own)
         case = cases.setdefault(joint.case, len(cases) + 1) if joint and joint.case else 0
         specs.append(ServoSpec(sid, own, zero, lo, hi, baud, case=case))
-    return ChainChoice(model, baud, tuple(ids), tuple(specs))
+    return ChainChoice(model, baud, tuple(ids), tuple(specs),
+                       plan_dynamics(protocol, robot, specs, loads or {}, motion=motion))
 
 
 def factory_servos(protocol: str, servos: Sequence[ServoSpec]) -> tuple[ServoSpec, ...]:
@@ -115,3 +126,42 @@ def factory_baud(protocol: str, model: str | None) -> int:
     if entry is None or entry.initial is None:
         return FACTORY_BAUD[protocol]
     return BAUD_CODES[m.family][entry.initial]
+
+
+def plan_dynamics(protocol: str, robot: RobotConfig | None, servos: Sequence[ServoSpec],
+                  loads: Mapping[int, BenchLoad], *, motion: str = "travel"
+                  ) -> tuple[DynamicsSpec | None, ...]:
+    """Each servo's model (``sim.emulator.servo_dynamics``): its physics and supply from the
+    robot file where a joint has its id (the model file it names, ``bus.voltage``), else its
+    model's bundled physics at the nominal voltage; ``loads``: id → what it carries.
+
+    ``motion="travel"``: no model, the horn travels to the goal at constant speed and stops
+    on it (for tests of register semantics that want exact positions). LX servos (no
+    control table) always travel."""
+    if motion not in MOTIONS:
+        raise EmulatorError(f"motion: expected one of {', '.join(MOTIONS)}, got {motion!r}")
+    unknown = sorted(set(loads) - {s.servo_id for s in servos})
+    if unknown:
+        raise EmulatorError(f"load: no servo with id {unknown[0]} in the chain; ids: "
+                            f"{sorted({s.servo_id for s in servos})}")
+    if PROTOCOL_FAMILY[protocol] == "lx" or motion == "travel":
+        if loads:
+            raise EmulatorError("load: only a servo that moves by its model carries a load "
+                                "(dynamixel, dynamixel1, feetech; motion 'model')")
+        return tuple(None for _ in servos)
+    same_kind = robot is not None and robot.bus.kind == protocol
+    out: list[DynamicsSpec | None] = []
+    for s in servos:
+        joint = robot.joint_by_id(s.servo_id) if robot is not None and same_kind else None
+        driver = DRIVER_MODELS.get(s.model)
+        if driver is None or not driver.gain_set:
+            out.append(None)       # no firmware law for it: it travels
+            continue
+        if robot is not None and joint is not None and robot.servo(joint).name == s.model:
+            physics, voltage = robot.servo_physics(joint), robot.voltage(joint)
+        else:
+            physics = physics_for(s.model)
+            voltage = DRIVER_MODELS[s.model].nominal_voltage
+        out.append(DynamicsSpec(s.model, physics, voltage, s.zero_ticks,
+                                loads.get(s.servo_id, NONE)))
+    return tuple(out)

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 from robot.errors import BipedError
 from sim.emulator.servo import ServoSpec
+from sim.emulator.servo_dynamics import DynamicsSpec
 
 
 class EmulatorError(BipedError):
@@ -34,9 +35,11 @@ class Packet:
 
 @dataclass(frozen=True)
 class ChainSpec:
-    """The chain to serve; ``plugged``: indices into ``servos`` on the bus (None: all)."""
+    """The chain to serve; ``plugged``: indices into ``servos`` on the bus (None: all);
+    ``dynamics``: each servo's model, in ``servos`` order (empty: constant-speed travel)."""
 
     protocol: str
     servos: tuple[ServoSpec, ...]
     seed: int = 0
     plugged: tuple[int, ...] | None = None
+    dynamics: tuple[DynamicsSpec | None, ...] = ()

@@ -25,6 +25,7 @@ from sim.emulator.dual_axis import case_mates, link_cases
 from sim.emulator.line import Line, Outbox, pty_speed
 from sim.emulator.records import ChainSpec, EmulatorError, Packet
 from sim.emulator.servo import EmulatedServo
+from sim.emulator.servo_dynamics import ServoDynamics
 
 __all__ = ["ChainSpec", "EmulatorError", "Packet", "child_main"]
 
@@ -54,6 +55,8 @@ class _ChainServer:
         now = time.monotonic()
         servo_class = getattr(self.codec, "SERVO", EmulatedServo)  # LX: no control table
         self.servos = [servo_class(s, now) for s in spec.servos]
+        for servo, model in zip(self.servos, spec.dynamics, strict=False):
+            servo.dynamics = None if model is None else ServoDynamics(model)
         link_cases(self.servos)     # the two axes of a dual-axis case (2XL430-W250)
         self.plugged: set[int] = set(range(len(self.servos)) if spec.plugged is None
                                      else spec.plugged)

@@ -1,12 +1,11 @@
 """One emulated servo: a control table (bytearray) laid out by ``sim.emulator.control_tables``
 (the manuals' tables, initial values included), and where its horn is (``horn`` [ticks]).
-
 Protocol-agnostic: ``sim.emulator.dispatch`` calls :meth:`EmulatedServo.read` / :meth:`write`
 (checked and applied in ``servo_write``) with raw addresses and bytes, and the instruction
 methods (reg write / action, reboot, factory reset, clear multi-turn). EEPROM (below
 ``EEPROM_END``) survives unplugging; RAM comes back at its power-on values (so does a
 reboot). Motion is lazy: :meth:`update` with the time [s] before touching the table moves
-the horn by its operating mode (``servo_motion``) and refreshes the read-back registers.
+the horn by its mode (``servo_motion``, ``servo_dynamics``) and refreshes the read-backs.
 Communication watchdog (``servo_status.BUS_WATCHDOG``): the chain calls :meth:`hear` for
 every instruction packet addressed to the servo (its id, broadcast, or listed in a
 sync/bulk packet); :meth:`update` trips it (goal := present where the gap ran out, register
@@ -19,7 +18,7 @@ from sim.emulator import servo_frame, servo_indirect, servo_motion, servo_write
 from sim.emulator.control_tables import BAUD_CODES, DXL_SIGNED, EEPROM_END, TABLES, UNPRINTED, Entry
 from sim.emulator.servo_models import MODELS
 from sim.emulator.servo_spec import ServoSpec
-from sim.emulator.servo_state import PROTOCOL_2, WriteError, byteorder
+from sim.emulator.servo_state import PROTOCOL_2, ServoDynamics, WriteError, byteorder
 from sim.emulator.servo_status import BUS_WATCHDOG, ERROR_BITS, RETURN_DELAY_UNIT_S
 
 __all__ = ["EmulatedServo", "ServoSpec"]
@@ -35,7 +34,8 @@ POSITION_LIMITS: dict[str, tuple[str, str]] = {
 
 
 class EmulatedServo:
-    """Control table plus the horn's motion model for one servo."""
+    """Control table plus the horn's motion model for one servo (``dynamics``: the chain's)."""
+    dynamics: ServoDynamics | None = None
 
     def __init__(self, spec: ServoSpec, now: float) -> None:
         self.spec = spec
@@ -165,7 +165,7 @@ class EmulatedServo:
         self.horn = servo_motion.advance(self, self.horn, dt)
         for name, value in self.pinned.items():
             self.set_raw(name, value)
-        self._idle = not self.get("moving")
+        self._idle = servo_motion.at_rest(self)
 
     def hold(self) -> None:
         """Goal := where the horn is (after a reset, power-on, mode change, multi-turn clear)."""

@@ -1,9 +1,13 @@
 """The emulated servo's motion: what the horn does in each operating mode while torque is on.
 
-- Position modes (X 3 / 4, STS 0, AX joint): constant-speed travel to the goal (through
-  the homing offset, ``servo_frame``). Speed: the model's no-load speed, or slower when
-  the host set one: X Profile Velocity(112) (0.229 rev/min, 0 = no limit), STS Goal
-  Speed(46) (1 step/s, 0 = maximum), AX Moving Speed(32) (0.111 rev/min, 0 = maximum).
+- Position modes (X 3 / 4, STS 0 / 3, AX joint) of a servo with a model
+  (``servo.dynamics``, ``sim.emulator.servo_dynamics``): the servo model moves it toward
+  the goal (through the homing offset, ``servo_frame``), torque on or off, and gives the
+  motor state the load / current / PWM registers report; it is "moving" while its speed
+  exceeds one position step per ``MOVING_WINDOW_S``.
+- Position modes without one: constant-speed travel to the goal. Speed: the model's
+  no-load speed, or slower when the host set one: X Profile Velocity(112) (0.229 rev/min,
+  0 = no limit), STS Goal Speed(46) (1 step/s, 0 = maximum), AX Moving Speed(32) (0.111 rev/min, 0 = maximum).
   STS step mode (3) travels to the target its last goal write set (relative steps).
 - Velocity mode (X 1, STS 1): the commanded speed, at most the no-load speed.
 - PWM / wheel (X 16, STS 2, AX wheel): the commanded duty x the no-load speed (no load).
@@ -22,6 +26,7 @@ import math
 
 from sim.emulator import servo_effort, servo_frame, servo_modes
 from sim.emulator.control_tables import STS_SPEED_UNIT_TICKS_S
+from sim.emulator.servo_dynamics import VOLTAGE_REGISTERS
 from sim.emulator.servo_modes import Mode
 from sim.emulator.servo_state import ServoState, kin
 
@@ -37,7 +42,9 @@ MOVING_PROFILE_ONGOING = 0x02
 POSITION_MODES = (Mode.POSITION, Mode.EXTENDED, Mode.STEP)
 #: Registers this module and ``servo_effort`` compute (a test may pin them, ``servo.pin``).
 COMPUTED = frozenset({"moving", "moving_status", "present_velocity", "present_speed",
-                      "present_pwm", "present_load", "present_current"})
+                      "present_pwm", "present_load", "present_current", "present_voltage",
+                      "present_input_voltage"})
+MOVING_WINDOW_S = 0.1          # [s] (see the module docstring)
 
 
 def dxl_velocity_unit_ticks_s(resolution: int) -> float:
@@ -78,6 +85,18 @@ def advance(servo: ServoState, pos: float, dt: float) -> float:
     torque = bool(servo.get("torque_enable"))
     free = torque and not servo.stuck     # the velocity read back does not depend on dt
     velocity, error, duty = 0.0, 0.0, None
+    dynamics = servo.dynamics
+    if dynamics is not None and mode in POSITION_MODES:
+        pos, velocity = dynamics.advance(servo, pos, target(servo, mode), dt, torque=torque,
+                                         stuck=servo.stuck)
+        moving = abs(velocity) * MOVING_WINDOW_S > 1.0
+        _feedback(servo, mode, pos, velocity, moving=moving, torque=torque)
+        servo_effort.write_effort(servo, servo_effort.Effort(
+            dynamics.duty, dynamics.torque_share, dynamics.current_a))
+        for name in VOLTAGE_REGISTERS:
+            if name in servo.table:
+                servo.set_raw(name, dynamics.voltage_tenths)
+        return pos
     if mode in POSITION_MODES:
         goal = target(servo, mode)
         speed = speed_ticks_s(servo)
@@ -103,6 +122,12 @@ def advance(servo: ServoState, pos: float, dt: float) -> float:
     servo_effort.write_effort(servo, servo_effort.estimate(
         servo, torque_on=torque, velocity=velocity, error_ticks=error, duty=duty))
     return pos
+
+
+def at_rest(servo: ServoState) -> bool:
+    """Not moving, and (with a model) held by friction with nothing left to change: its
+    registers hold until something is set."""
+    return not servo.get("moving") and (servo.dynamics is None or servo.dynamics.resting)
 
 
 def _feedback(servo: ServoState, mode: Mode, pos: float, velocity: float, *,

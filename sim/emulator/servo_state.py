@@ -10,6 +10,7 @@ import enum
 from typing import Literal, Protocol
 
 from sim.emulator.control_tables import DXL_SIGNED, TABLES, Entry
+from sim.emulator.servo_dynamics import ServoDynamics
 from sim.emulator.servo_model import ServoModel
 from sim.emulator.servo_status import BusWatchdog
 
@@ -47,6 +48,8 @@ class ServoState(Protocol):
     step_target: float
     eeprom_end: int
     watchdog: BusWatchdog | None
+    #: the servo model moving it in position modes (None: constant-speed travel)
+    dynamics: ServoDynamics | None
 
     @property
     def watchdog_tripped(self) -> bool: ...

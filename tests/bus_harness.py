@@ -101,7 +101,14 @@ def robot_toml(tmp_path: Path, protocol: str, request: pytest.FixtureRequest) ->
     """The bundled robot with a reply timeout that tolerates a busy test machine (the
     test module's ``REPLY_TIMEOUT_MS`` if it sets one, else ``TEST_TIMEOUT_MS``)."""
     timeout = getattr(request.module, "REPLY_TIMEOUT_MS", TEST_TIMEOUT_MS)
-    text = (ROBOTS_DIR / f"biped18-{protocol}.toml").read_text()
-    path = tmp_path / f"robot-{protocol}.toml"
-    path.write_text(text.replace("timeout_ms = 20.0", f"timeout_ms = {timeout}"))
+    return patient_copy(f"biped18-{protocol}", tmp_path / f"robot-{protocol}.toml",
+                        timeout_ms=timeout)
+
+
+def patient_copy(name: str, path: Path, *, timeout_ms: float = TEST_TIMEOUT_MS) -> Path:
+    """The bundled robot ``name`` written to ``path`` with a reply timeout a busy test
+    machine keeps (the bundled 20 ms is missed at load)."""
+    text = (ROBOTS_DIR / f"{name}.toml").read_text()
+    assert "timeout_ms = 20.0" in text, name
+    path.write_text(text.replace("timeout_ms = 20.0", f"timeout_ms = {timeout_ms}"))
     return path

@@ -34,6 +34,8 @@ from robot.gait.vectorised import spans
 
 BASE = load_robot().geometry          # upper_arm 0.08 < forearm 0.09, like both shipped
 EXACT = 1e-9                          # FK(IK(x)) == x on the workspace [m]
+FOLD_SIN = 1e-6                       # |sin(elbow)| below this: at a fold of the workspace
+FOLD_EXACT = 2 * math.sqrt(np.finfo(float).eps)   # there: per metre of arm
 SEARCH_TOL = 1e-4                     # accuracy of the brute-force search [m]
 
 geometries = st.builds(lambda u, f: dataclasses.replace(BASE, upper_arm=u, forearm=f),
@@ -149,7 +151,12 @@ def test_every_pose_is_reached_again(g: Geometry, pitch: float, roll: float, elb
     target = fk(g, (pitch, roll, elbow))
     hand, ok = ik_hand(g, target)
     assert ok
-    assert np.max(np.abs(hand - target)) < EXACT
+    # At a fold of the workspace (arm straight or folded: sin(elbow) ~ 0) the reach-to-
+    # elbow map has zero slope, so rounding in the reach moves the elbow by sqrt(eps) and
+    # the hand by up to the arm's length times that (hypothesis: elbow -6e-8, 1.3e-9 m).
+    fold = abs(math.sin(elbow)) < FOLD_SIN
+    assert np.max(np.abs(hand - target)) < (FOLD_EXACT * (g.upper_arm + g.forearm)
+                                            if fold else EXACT)
 
 
 shells = st.sampled_from(["any", "inner_mm", "singular_mm", "singular_circle"])

@@ -25,12 +25,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from bus_harness import TEST_TIMEOUT_MS
+from bus_harness import patient_copy
 from test_fault_matrix import goal_writes, rest_ticks, tick_window
 from test_keyframes import WAVE
 from waiting import sleep_until, wait_for
 
-from robot.config.bundled import ROBOTS_DIR
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from sim.emulator.chain import Emulator
@@ -459,9 +458,7 @@ def test_fix_return_delay_never_locks_an_ax12_eeprom(tmp_path: Path) -> None:
     Only Return Delay Time (5) may be written, and only where it is not 0 already."""
     import robot.cli as cli
 
-    ax12 = tmp_path / "biped18-ax12.toml"   # a reply timeout a busy test machine keeps
-    ax12.write_text((ROBOTS_DIR / "biped18-ax12.toml").read_text().replace(
-        "timeout_ms = 20.0", f"timeout_ms = {TEST_TIMEOUT_MS}"))
+    ax12 = patient_copy("biped18-ax12", tmp_path / "biped18-ax12.toml")
     with Emulator("dynamixel1", load_robot(ax12)) as emu:
         for sid in (3, 7):
             emu.set_register(sid, "return_delay_time", 250)

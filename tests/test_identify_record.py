@@ -17,6 +17,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from bus_harness import TEST_TIMEOUT_MS
 from waiting import PATIENCE_S, wait_for
 
 from robot import cli
@@ -45,7 +46,8 @@ def test_record_on_the_emulator_then_check(tmp_path: Path,
                   motion="model") as emu:
         code = cli.main(["identify", "record", "--bus", "dynamixel", "--port", emu.port,
                          "--id", "1", "--motor", MOTOR, "--mass", "0.3", "--length", "0.1",
-                         "--out", str(out), "--seconds", "2", "--kp", str(KP)])
+                         "--out", str(out), "--seconds", "2", "--kp", str(KP),
+                         "--timeout-ms", str(TEST_TIMEOUT_MS)])
         regs = emu.registers(1)
     assert code == 0
     assert regs["torque_enable"] == 0                      # left safe
@@ -88,7 +90,8 @@ def test_a_signal_mid_run_leaves_torque_off(tmp_path: Path, signum: int) -> None
         proc = subprocess.Popen(
             [sys.executable, "-m", "robot.cli", "identify", "record", "--bus", "dynamixel",
              "--port", emu.port, "--id", "1", "--motor", MOTOR, "--mass", "0.3", "--length",
-             "0.1", "--out", str(tmp_path), "--seconds", "20"], cwd=REPO,
+             "0.1", "--out", str(tmp_path), "--seconds", "20",
+             "--timeout-ms", str(TEST_TIMEOUT_MS)], cwd=REPO,
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         try:
             assert wait_for(lambda: emu.registers(1)["torque_enable"] == 1)

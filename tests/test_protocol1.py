@@ -13,6 +13,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from bus_harness import patient_copy
 from sdk_timeouts import allow_slow_replies
 
 from robot.bus.tables import TABLES
@@ -120,14 +121,19 @@ def ax_emu() -> Iterator[Emulator]:
         yield emu
 
 
-def _bus(emu: Emulator) -> list[str]:
-    return ["--bus", "dynamixel1", "--port", emu.port, "--robot", AX_TOML]
+@pytest.fixture
+def ax_bus(ax_emu: Emulator, tmp_path: Path) -> list[str]:
+    """The command-line bus options for ``ax_emu``: the AX robot with a reply timeout a
+    busy test machine keeps."""
+    toml = patient_copy(AX_TOML, tmp_path / f"{AX_TOML}.toml")
+    return ["--bus", "dynamixel1", "--port", ax_emu.port, "--robot", str(toml)]
 
 
-def test_scan_finds_18_ax12(ax_emu: Emulator, capsys: pytest.CaptureFixture[str]) -> None:
+def test_scan_finds_18_ax12(ax_emu: Emulator, ax_bus: list[str],
+                            capsys: pytest.CaptureFixture[str]) -> None:
     from robot.cli import main
 
-    assert main(["scan", *_bus(ax_emu), "--ids", "1-20", "--json"]) == 0
+    assert main(["scan", *ax_bus, "--ids", "1-20", "--json"]) == 0
     rows = json.loads(capsys.readouterr().out)
     assert [r["id"] for r in rows] == list(range(1, 19))
     assert {r["model"] for r in rows} == {12}                   # AX-12A
@@ -135,23 +141,24 @@ def test_scan_finds_18_ax12(ax_emu: Emulator, capsys: pytest.CaptureFixture[str]
     assert {p.instruction for p in ax_emu.log()} <= {"ping", "read", "write", "sync_write"}
 
 
-def test_torque_on_then_off_at_address_24(ax_emu: Emulator) -> None:
+def test_torque_on_then_off_at_address_24(ax_emu: Emulator, ax_bus: list[str]) -> None:
     from robot.cli import main
 
     ax_emu.log(clear=True)
-    assert main(["torque", "on", *_bus(ax_emu)]) == 0
+    assert main(["torque", "on", *ax_bus]) == 0
     assert {ax_emu.registers(i)["torque_enable"] for i in range(1, 19)} == {1}
     on = [p for p in ax_emu.log() if p.address == TORQUE_ENABLE and p.instruction == "write"]
     assert sorted(i for p in on for i in p.ids) == list(range(1, 19))
-    assert main(["torque", "off", *_bus(ax_emu)]) == 0
+    assert main(["torque", "off", *ax_bus]) == 0
     assert {ax_emu.registers(i)["torque_enable"] for i in range(1, 19)} == {0}
 
 
-def test_pose_rest_sync_writes_goals_inside_0_1023(ax_emu: Emulator) -> None:
+def test_pose_rest_sync_writes_goals_inside_0_1023(ax_emu: Emulator,
+                                                    ax_bus: list[str]) -> None:
     from robot.cli import main
 
     ax_emu.log(clear=True)
-    assert main(["pose", "rest", *_bus(ax_emu), "--speed", "5"]) == 0
+    assert main(["pose", "rest", *ax_bus, "--speed", "5"]) == 0
     goals = [p for p in ax_emu.log() if p.instruction == "sync_write"
              and p.address == GOAL_POSITION]
     assert goals and all(p.length == 2 for p in goals)
@@ -164,12 +171,12 @@ def test_pose_rest_sync_writes_goals_inside_0_1023(ax_emu: Emulator) -> None:
     assert not any(p.instruction.endswith("sync_read") for p in ax_emu.log())
 
 
-def test_a_short_walk_on_the_emulated_chain(ax_emu: Emulator,
+def test_a_short_walk_on_the_emulated_chain(ax_emu: Emulator, ax_bus: list[str],
                                             capsys: pytest.CaptureFixture[str]) -> None:
     from robot.cli import main
 
     ax_emu.log(clear=True)
-    code = main(["walk", *_bus(ax_emu), "--seconds", "1", "--rate", "50", "--json"])
+    code = main(["walk", *ax_bus, "--seconds", "1", "--rate", "50", "--json"])
     out = json.loads(capsys.readouterr().out)
     assert code == 0 and out["bus_errors"] == 0, out
     writes = [p for p in ax_emu.log() if p.instruction == "sync_write"
@@ -178,11 +185,11 @@ def test_a_short_walk_on_the_emulated_chain(ax_emu: Emulator,
 
 
 def test_a_missing_servo_is_one_line_naming_its_joint(
-        ax_emu: Emulator, capsys: pytest.CaptureFixture[str]) -> None:
+        ax_emu: Emulator, ax_bus: list[str], capsys: pytest.CaptureFixture[str]) -> None:
     from robot.cli import main
 
     ax_emu.set_faults(missing_ids=[10])
-    assert main(["torque", "on", *_bus(ax_emu)]) != 0
+    assert main(["torque", "on", *ax_bus]) != 0
     err = capsys.readouterr().err.strip()
     assert "id 10 (l_knee)" in err and len(err.splitlines()) == 1, err
 
@@ -202,7 +209,8 @@ def test_setup_motors_gives_a_factory_new_ax12_its_joint_id(
         assert regs["lock"] == 0      # AX Lock(47) = 1 would lock the EEPROM: never written
 
 
-def test_calibrate_zero_on_the_ax12_writes_no_goal(ax_emu: Emulator, tmp_path: Path,
+def test_calibrate_zero_on_the_ax12_writes_no_goal(ax_emu: Emulator, ax_bus: list[str],
+                                                   tmp_path: Path,
                                                    capsys: pytest.CaptureFixture[str]) -> None:
     from robot.cli import main
     from robot.config.robot_file import load_robot
@@ -212,7 +220,7 @@ def test_calibrate_zero_on_the_ax12_writes_no_goal(ax_emu: Emulator, tmp_path: P
         ax_emu.set_register(sid, "present_position", 500 + sid)
     ax_emu.log(clear=True)
     out = tmp_path / "ax.toml"
-    assert main(["calibrate", *_bus(ax_emu), "--out", str(out), "--zero", "--yes"]) == 0
+    assert main(["calibrate", *ax_bus, "--out", str(out), "--zero", "--yes"]) == 0
     assert f"wrote {out}" in capsys.readouterr().out
     new = load_robot(out)
     assert new.joint("r_knee").zero_ticks == 504 and new.joint("l_elbow").zero_ticks == 518

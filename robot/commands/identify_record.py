@@ -62,9 +62,10 @@ class _Stop:
 
 
 def bench_robot(kind: str, motor: str, sid: int, zero: int, span: float,
-                kp: int | None) -> RobotConfig:
+                kp: int | None, *, timeout_ms: float | None = None) -> RobotConfig:
     """A one-joint robot: servo ``sid`` of model ``motor`` on a ``kind`` bus, limits
-    ``zero`` ± ``span`` [rad], its P register at ``kp`` (None: factory)."""
+    ``zero`` ± ``span`` [rad], its P register at ``kp`` (None: factory); the reply timeout
+    ``timeout_ms`` [ms] (None: the bundled robot's)."""
     if kind not in BUNDLED:
         raise ConfigError(f"--bus: expected one of {', '.join(BUNDLED)}, got {kind!r}")
     base = load_robot(ROBOTS_DIR / f"{BUNDLED[kind]}.toml")
@@ -75,7 +76,9 @@ def bench_robot(kind: str, motor: str, sid: int, zero: int, span: float,
     gains = dict.fromkeys(registers, kp) if kp is not None else {}
     joint = JointConfig(JOINT, sid, 1, zero, -span, span, 2 * math.pi)
     return replace(base, name=f"{motor} bench", joints=(joint,), rest={}, physics={},
-                   bus=replace(base.bus, model=motor, gains=gains, servo_file=None),
+                   bus=replace(base.bus, model=motor, gains=gains, servo_file=None,
+                               timeout_ms=base.bus.timeout_ms if timeout_ms is None
+                               else timeout_ms),
                    imu=None)
 
 
@@ -152,7 +155,8 @@ class _Stopped(Exception):
 
 def run_record(kind: str, port: str | None, *, motor: str, sid: int, zero: int | None,
                span: float, mass: float, length: float, kps: list[int], seconds: float,
-               out: Path, amplitude: float) -> tuple[list[Path], str | None]:
+               out: Path, amplitude: float, timeout_ms: float | None = None
+               ) -> tuple[list[Path], str | None]:
     """Every trajectory at every gain; (logs written, the stop reason or None)."""
     zero = MODELS[motor].resolution // 2 if zero is None else zero
     if amplitude > span:
@@ -162,7 +166,7 @@ def run_record(kind: str, port: str | None, *, motor: str, sid: int, zero: int |
     stop = _Stop()
     with stop_on_signals(stop):
         for kp in kps:
-            robot = bench_robot(kind, motor, sid, zero, span, kp)
+            robot = bench_robot(kind, motor, sid, zero, span, kp, timeout_ms=timeout_ms)
             bus = make_bus(kind, robot=robot, port=port)
             bus.open()
             try:

@@ -40,6 +40,10 @@ def add_record_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[
     rec.add_argument("--amplitude", default=1.0, metavar="RAD",
                      type=bounded_float(0.05, 3.0, "rad", what="an amplitude"),
                      help="trajectory amplitude [rad] (default 1.0)")
+    rec.add_argument("--timeout-ms", default=None, metavar="MS",
+                     type=bounded_float(1.0, 1000.0, "ms", what="a reply timeout"),
+                     help="reply timeout [ms] (default: the bundled robot's for --bus; "
+                          "more for a USB adapter with a slow latency timer)")
     rec.add_argument("--seconds", default=6.0, metavar="S",
                      type=bounded_float(1.0, 60.0, "s", what="a duration"),
                      help="seconds per run (default 6)")
@@ -62,7 +66,8 @@ def run_record_command(args: argparse.Namespace) -> int:
     written, stopped = run_record(args.bus, args.port, motor=args.motor, sid=args.sid,
                                   zero=args.zero, span=args.span, mass=args.mass,
                                   length=args.length, kps=_kps(args.kp), seconds=args.seconds,
-                                  out=Path(args.out), amplitude=args.amplitude)
+                                  out=Path(args.out), amplitude=args.amplitude,
+                                  timeout_ms=args.timeout_ms)
     for path in written:
         print(f"wrote {path}")
     if stopped is not None:

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 from playwright.sync_api import Browser
+from waiting import sleep_until, wait_for
 
 import robot.cli as cli
 from robot.panel.controller import PanelController
@@ -22,6 +23,8 @@ from robot.panel.controller import PanelController
 FPS, OFFSET, RATE = 30.0, 0.5, 8000
 #: Chromium starts media without a click (a test has none).
 AUTOPLAY = "--autoplay-policy=no-user-gesture-required"
+#: Time between two reads of the page's audio clock [s] (five a second).
+READ_PERIOD_S = 0.2
 
 
 def write_show(folder: Path, seconds: float) -> None:
@@ -88,15 +91,14 @@ def measure(controller: PanelController, base: str, browser: Browser, seconds: f
         if not show or not show["playing"] or show["at"] is None:
             return None
         return float(show["t"]), float(show["at"])
-    end = time.monotonic() + wait
-    while not page.evaluate("showClock().playing") and time.monotonic() < end:
-        time.sleep(0.05)
+    wait_for(lambda: bool(page.evaluate("showClock().playing")), timeout_s=wait, every_s=0.05)
     first = stamped() or (0.0, 0.0)
     audio: list[float] = []
     estimate: list[float] = []
     at: list[float] = []
     rate: list[float] = []
     seeks: list[int] = []
+    next_read = time.monotonic()
     while (a := stamped()) is not None and a[0] < first[0] + seconds:
         clock = page.evaluate("showClock()")
         b = stamped()
@@ -110,7 +112,8 @@ def measure(controller: PanelController, base: str, browser: Browser, seconds: f
             at.append(w)
             rate.append(float(clock["rate"]))
             seeks.append(int(clock["seeks"]))
-        time.sleep(0.1)
+        next_read += READ_PERIOD_S          # reads on absolute deadlines: a late one is not
+        sleep_until(next_read)              # followed by a longer gap
     span = (stamped() or (first[0] + seconds, 0.0))[0] - first[0]
     page.close()
     return Sync(audio, estimate, at, rate, seeks, span)

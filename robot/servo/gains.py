@@ -61,6 +61,24 @@ def _set(name: str, family: str, *gains: Gain) -> GainSet:
     return GainSet(name, family, {g.name: g for g in gains})
 
 
+def _mx_pid(source: str) -> tuple[Gain, ...]:
+    """The MX-style PID (RAM, 0 ~ 254: Kp = P / 8, Ki = I * 1000 / 2048, Kd = D * 4 / 1000)."""
+    return (Gain("d_gain", 0, 254, "ram", "Kd = value * 4 / 1000", source),
+            Gain("i_gain", 0, 254, "ram", "Ki = value * 1000 / 2048", source),
+            Gain("p_gain", 0, 254, "ram", "Kp = value / 8", source))
+
+
+def _feetech_pid(source: str, label: str) -> tuple[Gain, ...]:
+    """Feetech's three position-loop coefficients at 21-23, in EEPROM, one byte each;
+    ``label`` names a register in ``source`` given its letter (e.g. "{} coefficient")."""
+    return tuple(Gain(f"{term}_coefficient", 0, 254, "eeprom",
+                      f"position loop {word} coefficient",
+                      f"{source}; {label.format(term.upper())}({address})")
+                 for term, word, address in (("p", "proportional", 21),
+                                             ("d", "derivative", 22),
+                                             ("i", "integral", 23)))
+
+
 _X = "ROBOTIS e-Manual, XL430-W250 / XM430-W350 / XC430-W150, Control Table of RAM Area"
 _X_PID = f"{_X}; Position PID Gain(84, 82, 80)"
 _AX = "ROBOTIS e-Manual, AX-12A, Control Table of RAM Area"
@@ -104,40 +122,18 @@ GAIN_SETS: dict[str, GainSet] = {
     ),
     # MX series on Protocol 1.0 firmware: PID, all RAM, 0 ~ 254.
     "dynamixel_mx1": _set(
-        "dynamixel_mx1", "dynamixel_p1",
-        Gain("d_gain", 0, 254, "ram", "Kd = value * 4 / 1000", _MX),
-        Gain("i_gain", 0, 254, "ram", "Ki = value * 1000 / 2048", _MX),
-        Gain("p_gain", 0, 254, "ram", "Kp = value / 8", _MX),
-    ),
+        "dynamixel_mx1", "dynamixel_p1", *_mx_pid(_MX)),
     # Feetech STS/SMS: the position loop's coefficients live in EEPROM (one byte each; 255
     # is left out as on the table's other one-byte settings, e.g. Return delay 0 ~ 254).
     "feetech_sts": _set(
-        "feetech_sts", "feetech_sts",
-        Gain("p_coefficient", 0, 254, "eeprom", "position loop proportional coefficient",
-             f"{_STS}; P coefficient(21)"),
-        Gain("d_coefficient", 0, 254, "eeprom", "position loop derivative coefficient",
-             f"{_STS}; D coefficient(22)"),
-        Gain("i_coefficient", 0, 254, "eeprom", "position loop integral coefficient",
-             f"{_STS}; I coefficient(23)"),
-    ),
+        "feetech_sts", "feetech_sts", *_feetech_pid(_STS, "{} coefficient")),
     # XL-320 (Protocol 2.0, its own table): the MX-style PID, RAM, 0 ~ 254 (the page's PID
     # section is the MX one: Kp = P / 8, Ki = I * 1000 / 2048, Kd = D * 4 / 1000).
     "dynamixel_xl320": _set(
-        "dynamixel_xl320", "dynamixel_xl320",
-        Gain("d_gain", 0, 254, "ram", "Kd = value * 4 / 1000", _XL320),
-        Gain("i_gain", 0, 254, "ram", "Ki = value * 1000 / 2048", _XL320),
-        Gain("p_gain", 0, 254, "ram", "Kp = value / 8", _XL320),
-    ),
+        "dynamixel_xl320", "dynamixel_xl320", *_mx_pid(_XL320)),
     # Feetech SCS (SCSCL): the STS's three coefficients at the same addresses, in EEPROM.
     "feetech_scs": _set(
-        "feetech_scs", "feetech_scs",
-        Gain("p_coefficient", 0, 254, "eeprom", "position loop proportional coefficient",
-             f"{_SCS}; P(21)"),
-        Gain("d_coefficient", 0, 254, "eeprom", "position loop derivative coefficient",
-             f"{_SCS}; D(22)"),
-        Gain("i_coefficient", 0, 254, "eeprom", "position loop integral coefficient",
-             f"{_SCS}; I(23)"),
-    ),
+        "feetech_scs", "feetech_scs", *_feetech_pid(_SCS, "{}")),
     # HiWonder/LewanSoul LX: the Bus Servo Communication Protocol has no gain command (a
     # position, a move time, limits, offset, load/unload, LED): nothing to set.
     "lx": _set("lx", "lx"),

@@ -180,7 +180,10 @@ def test_targets_sampled_in_the_workspace_are_reached(g: Geometry, shell: str, s
     target = np.array([rho * math.sin(azimuth), y, rho * math.cos(azimuth)])
     hand, ok = ik_hand(g, target)
     assert ok
-    assert np.max(np.abs(hand - target)) < EXACT
+    # At full or least reach the arm is at a fold (straight or folded): sqrt(eps) there
+    # (hypothesis: s = 1 - 1e-16 on a 0.165 m arm, 1.7e-9 m).
+    fold = min(hi - d, d - lo) < FOLD_SIN * hi
+    assert np.max(np.abs(hand - target)) < (FOLD_EXACT * hi if fold else EXACT)
 
 
 # ------------------------------------------------------------- outside the annulus

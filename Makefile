@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint typecheck unit bench clean system-deps wheel-check
+.PHONY: demo test lint typecheck unit bench clean system-deps wheel-check fuzz
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -34,6 +34,10 @@ system-deps:
 # process (two workers kept the load near 1.4: 615 s; three: 488 s, measured back to back).
 unit: $(STAMP) system-deps
 	MUJOCO_GL=egl $(BIN)/python -m pytest -n 3 --dist loadfile
+
+# Property tests with fresh random draws and 2000 examples each (make test repeats one draw).
+fuzz: $(STAMP)
+	BIPED_HYPOTHESIS=fuzz MUJOCO_GL=egl $(BIN)/python -m pytest -n 3 $$(grep -l 'from hypothesis' tests/test_*.py)
 
 # The wheel, installed (not editable) into a fresh venv and run from a directory outside
 # the checkout: proves the package ships everything it needs (configs, panel files, the

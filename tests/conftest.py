@@ -9,17 +9,17 @@ os.environ.setdefault("MUJOCO_GL", "egl")  # headless: before anything imports m
 import pytest
 from hypothesis import settings
 
+from robot.config.bundled import GAITS_DIR, ROBOTS_DIR
+from robot.config.gait_file import Gait, load_gait
+from robot.config.robot import RobotConfig
+from robot.config.robot_file import load_robot
+
 # `make test` draws the same hypothesis examples on every machine, so a pass is reproducible
 # and CI never fails on a draw nobody has seen; `make fuzz` draws fresh ones (and more) to
 # look for new failures, which then become explicit examples.
 settings.register_profile("repeatable", derandomize=True, print_blob=True)
 settings.register_profile("fuzz", max_examples=2000, print_blob=True)
 settings.load_profile(os.environ.get("BIPED_HYPOTHESIS", "repeatable"))
-
-from robot.config.bundled import GAITS_DIR, ROBOTS_DIR
-from robot.config.gait_file import Gait, load_gait
-from robot.config.robot import RobotConfig
-from robot.config.robot_file import load_robot
 
 ROBOT_FILES = sorted(p.name for p in ROBOTS_DIR.glob("*.toml"))
 GAIT_FILES = sorted(p.stem for p in GAITS_DIR.glob("*.toml"))

@@ -73,7 +73,9 @@ def measure(controller: PanelController, base: str, browser: Browser, seconds: f
     with the take's time at the same instant: the page says when (its wall clock) it read
     the audio; the loop process stamps each tick's take time with its wall clock (the same
     machine's clock); the take's time at the read is interpolated between the stamped
-    ticks fetched just before and just after the read. ``tune``: the page's follower
+    ticks fetched just before and just after the read. Reads count from the take time at
+    which the soundtrack begins (its offset; before it the audio's clock has nothing to
+    run on: the page may start the element a little early, its clock held at 0). ``tune``: the page's follower
     settings to change (robot/panel/static/studio.js ``showTune``). Leaves the page open
     until the take ends."""
     page = browser.new_page()
@@ -105,8 +107,8 @@ def measure(controller: PanelController, base: str, browser: Browser, seconds: f
         if b is None:
             break
         w = clock["at"] / 1000.0
-        if clock["playing"] and b[1] > a[1]:
-            take = a[0] + (w - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
+        take = a[0] + (w - a[1]) * (b[0] - a[0]) / (b[1] - a[1]) if b[1] > a[1] else -1.0
+        if clock["playing"] and take >= OFFSET:   # the soundtrack has begun
             audio.append(1000 * (clock["audio"] + OFFSET - take))
             estimate.append(1000 * (clock["show"] - take))
             at.append(w)

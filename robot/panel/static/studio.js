@@ -67,9 +67,14 @@
 // robot's wall clock onto its own by the smallest (arrival - at) seen, so a frame that
 // arrives late, or was read from a cache, still says what the show time was when; the show
 // time now is t + rate * (now - at). The audio element follows: started at the audio's
-// offset, steered by its playback rate, re-seeked only for a large drift that holds (a
-// seek lands late by the time the element takes to seek: the page learns that lead from
-// the drift once the audio has settled after the seek, by halves, within 0..0.2 s).
+// offset, steered by its playback rate, re-seeked only for a large drift that holds.
+// Starting is not instant: after a seek (or the first play) the element's clock stalls
+// before it runs, and runs as if it had started that lead later (headless Chromium:
+// 105-130 ms; a play without a seek, 7 ms). So while the robot ramps in, the page
+// rehearses the start muted (seek, play, fit a line to the clock's run, pause) and
+// measures that lead; the real start is then sent the lead early and ahead, so the clock
+// runs on the show's time from its first frame. Later seeks learn the lead again from the
+// drift once the audio has settled after the seek, by halves, within 0..0.3 s.
 // The audio's clock moves in the renderer's chunks and stalls when the machine is busy, so
 // one read of the drift is noisy by tens of ms: the steering acts on the median of the
 // last tune.window reads (a stall or a jump of one chunk does not move it). And the audio
@@ -93,12 +98,14 @@
     step: 0.003,    // smallest playback-rate change made
     window: 5,      // reads (one per FOLLOW_MS) whose median drift steers
     gainS: 8.0,     // [s] of reads over which the audio clock's gain is measured
+    keepPitch: false,   // time-stretch to keep the pitch (its clock stalls ~20 ms as it engages)
   };
   const FOLLOW_MS = 50;
   let show = null;          // the playing show's fields, or null
   let heard = null;         // {t, at, rate}: show time t [s] at page time at [ms]
   let offset = Infinity;    // smallest (arrival - robot wall time) seen [ms]: the clocks' offset
-  let lead = 0.05;          // a seek lands this late [s] (learnt from the last one)
+  let lead = 0.115;         // a seek lands this late [s] (rehearsed, then learnt)
+  let rehearsal = null;     // null: not yet; "running", "cut" or "done" (the loaded audio)
   let seeked = false;       // the last step was a seek: the next drift says how late
   let drifts = [];          // the last tune.window drift reads [s]
   let runs = [];            // since the last seek: {at [ms], audio [s], rate asked}
@@ -124,6 +131,37 @@
     return s.length % 2 ? s[m] : (s[m - 1] + s[m]) / 2;
   }
 
+  // Seek, play muted and fit a line to the clock's run from 180 to 300 ms after play():
+  // the lead is how long after play() that line passes the seek's position. A start due
+  // before it ends cuts it short (rehearsal "cut") and keeps the lead it had.
+  async function rehearse(audio) {
+    rehearsal = "running";
+    try {
+      const from = Math.min(1, 0.5 * (audio.duration || 0));
+      audio.volume = 0;
+      audio.currentTime = from;
+      const t0 = performance.now();
+      await audio.play();
+      const xs = [], ys = [];
+      while (performance.now() - t0 < 300 && rehearsal === "running") {
+        const dt = performance.now() - t0;
+        if (dt > 180) { xs.push(dt / 1000); ys.push(audio.currentTime); }
+        await new Promise((r) => setTimeout(r, 5));
+      }
+      audio.pause();
+      const n = xs.length, mx = xs.reduce((a, b) => a + b) / n;
+      const my = ys.reduce((a, b) => a + b) / n;
+      let sxy = 0, sxx = 0;
+      for (let k = 0; k < n; k++) { sxy += (xs[k] - mx) * (ys[k] - my); sxx += (xs[k] - mx) ** 2; }
+      const slope = sxy / sxx, lag = mx - (my - from) / slope;
+      if (n > 5 && slope > 0.5 && slope < 1.5) lead = Math.min(0.3, Math.max(0, lag));
+    } catch (e) {  // not allowed to play yet: the start keeps the lead it had
+    } finally {
+      audio.volume = 1;
+      rehearsal = "done";
+    }
+  }
+
   function seekTo(audio, want) {
     audio.currentTime = want + lead;
     seeked = true; seeks++; drifts = []; runs = [];
@@ -146,9 +184,12 @@
     if (!show || !show.audio || heard === null) return;
     const at = pageNow();
     const want = showTime(at) - show.audio_offset_s;   // where the audio should be [s]
-    if (want < 0) return;
-    if (audio.paused) {
+    // (cut two reads ahead, so the element is free when the start is due)
+    if (rehearsal === "running" && want + lead + 2 * FOLLOW_MS / 1000 >= 0) rehearsal = "cut";
+    if (rehearsal !== "done" || want + lead < 0) return;
+    if (audio.paused) {   // sent the lead early and ahead: the clock runs on time
       seekTo(audio, want);
+      audio.preservesPitch = tune.keepPitch;
       audio.play().catch((e) => P.say("audio: " + e.message + " (tap the page once)", true));
       return;
     }
@@ -157,7 +198,7 @@
     const drift = median(drifts);
     if (drifts.length < tune.window) return;   // just seeked: the audio is settling
     if (seeked) {   // how far from where it was sent the seek landed, half learnt
-      lead = Math.min(0.2, Math.max(0, lead - 0.5 * drift)); seeked = false;
+      lead = Math.min(0.3, Math.max(0, lead - 0.5 * drift)); seeked = false;
     }
     if (Math.abs(drift) > tune.seek) {
       seekTo(audio, want);
@@ -175,7 +216,7 @@
     audio.removeAttribute("src");
     $("show-line").hidden = true;
     if (why) P.say(why);
-    show = null; heard = null; cue = 0; offset = Infinity; drifts = [];
+    show = null; heard = null; cue = 0; offset = Infinity; drifts = []; rehearsal = null;
   }
 
   function prepare(now) {   // a new show: load its audio
@@ -184,6 +225,8 @@
     const audio = $("show-audio");
     if (now.audio) {
       audio.src = now.audio + (TOKEN ? "&token=" + encodeURIComponent(TOKEN) : "");
+      rehearsal = null;
+      audio.addEventListener("canplaythrough", () => rehearse(audio), { once: true });
       audio.load();
     }
   }
@@ -220,7 +263,8 @@
   // read [ms], and the show time the page follows then [s].
   window.showClock = () => {
     const audio = $("show-audio"), at = pageNow();
-    return { audio: audio.currentTime, at, playing: !audio.paused, show: showTime(at),
+    return { audio: audio.currentTime, at, playing: !audio.paused && rehearsal === "done",
+             show: showTime(at), lead,
              offset: show ? show.audio_offset_s : null, clockOffset: offset, seeks,
              rate: audio.playbackRate };
   };

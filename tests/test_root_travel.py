@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from walk_anim import RIG_LEG, WalkShape, write_walk_bvh
+from walk_anim import RIG_LEG, WalkShape, root_end, write_walk_bvh
 
 import robot.cli as cli
 from robot.config.joint_names import LEG_NAMES
@@ -21,13 +21,15 @@ from robot.motion.show import stream_sequence
 from robot.motion.show_walk import ShowEngine, Travel
 from robot.motion.takes import Take, read_take
 from robot.panel.runs import ShowTake, build
-from robot.previs.travel import Efficiency
+from robot.previs.travel import MEASURED, Efficiency
 
 #: The speed, turn and side step asked of the gait match the root's within this share.
 PARAM_TOL = 0.05
 #: The robot walks the root's distance within this share (MuJoCo, no balance: the gait's
 #: realized share of its stride, Efficiency, was measured on other speeds and presets).
 DISTANCE_TOL = 0.2
+#: The robot turns by the root's yaw within this share (the turn's Efficiency, likewise).
+TURN_TOL = 0.15
 
 
 def _import(tmp_path: Path, shape: WalkShape, *extra: str) -> Take:
@@ -74,6 +76,19 @@ def test_the_gait_walks_at_the_root_s_speed_and_turn(tmp_path: Path, turn: float
         v, rel=PARAM_TOL)
     assert first["turn"] * n == pytest.approx(turn, abs=PARAM_TOL * 0.2)
     assert first["side_step"] == pytest.approx(0.0, abs=1e-4)
+
+
+def test_a_share_by_speed_asks_the_speed_that_walks_the_root_s_speed() -> None:
+    """Where a robot's share changes with the speed (biped18-feetech without balance), the
+    speed asked is the measured one whose share times speed is the root's no-slip speed:
+    at each measured point, and between them (interpolated) with share x speed rising."""
+    eff = MEASURED["biped18-feetech"]
+    for speed, share in eff.forward_by_speed:
+        assert eff.speed_for(speed * share) == pytest.approx(speed, abs=0.006)
+        assert eff.speed_for(-speed * share) == pytest.approx(-speed, abs=0.006)
+    asked = [eff.speed_for(x) for x in np.linspace(0.25, 0.74, 20)]
+    assert all(b > a for a, b in zip(asked, asked[1:], strict=False))
+    assert Efficiency(forward=0.5).speed_for(0.3) == pytest.approx(0.6)
 
 
 def test_stepping_in_place_is_not_a_walk(tmp_path: Path,
@@ -124,6 +139,30 @@ def test_the_show_walks_the_root_s_distance_in_the_sim(tmp_path: Path,
     middle = (t > shape.stand_s + 1.0) & (t < shape.stand_s + shape.walk_s - 1.0)
     assert np.abs(cmd[middle] - authored[middle]).max() > 0.05
     assert math.isfinite(result["walked"]["heading_change_deg"])
+
+
+@pytest.mark.parametrize(("robot", "turn"), [("biped18-dynamixel", 0.2),
+                                           ("biped18-feetech", 0.0),
+                                           ("biped18-feetech", 0.2)])
+def test_the_show_walks_the_root_s_path_and_turn_in_the_sim(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], robot: str, turn: float) -> None:
+    """The root walks an arc (``turn`` [rad/s], 1.2 rad over the walk) or a line: in
+    MuJoCo the robot stays up, turns by the root's yaw and ends where the root ends, both
+    from the character's own geometry (tests/walk_anim.py), scaled to the robot."""
+    shape = WalkShape(turn=turn)
+    take = _import(tmp_path, shape, "--robot", robot)
+    capsys.readouterr()
+    code = cli.main(["play", str(tmp_path / "walk.take.jsonl"), "--json"])
+    result = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert code == 0 and result["physics"]["fell_at_s"] is None, result["physics"]
+    walked = result["walked"]
+    end, yaw = root_end(shape)
+    end = end * _scale(take)
+    got = np.array([walked["distance_m"], walked["lateral_drift_m"]])
+    path = shape.speed * shape.walk_s * _scale(take)
+    assert np.linalg.norm(got - end) < DISTANCE_TOL * path, (got, end)
+    assert math.radians(walked["heading_change_deg"]) == pytest.approx(
+        yaw, abs=max(TURN_TOL * abs(yaw), math.radians(5.0))), walked
 
 
 def test_the_panel_plays_a_walking_show_with_the_gait(tmp_path: Path) -> None:

@@ -62,6 +62,12 @@ def _root(shape: WalkShape, t: float) -> tuple[np.ndarray, float]:
     return np.array([r * math.sin(psi), r * (1 - math.cos(psi))]), psi
 
 
+def root_end(shape: WalkShape) -> tuple[np.ndarray, float]:
+    """Where the root ends its walk: floor position (x forward, y left) [m, the
+    character's] and heading [rad] from where it started."""
+    return _root(shape, shape.seconds)
+
+
 def _side(psi: float, foot: int) -> np.ndarray:
     sign = -1.0 if foot == 0 else 1.0
     return sign * HALF_HIPS * np.array([-math.sin(psi), math.cos(psi)])

@@ -14,6 +14,7 @@ authored everywhere). ``--audio`` names the soundtrack in the take (robot/motion
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -34,7 +35,7 @@ from robot.motion.takes import SUFFIX, is_take
 from robot.previs.bone_map import by_name, load_map
 from robot.previs.importing import SUFFIXES, import_animation, write_stream_take
 from robot.previs.rig import UPS
-from robot.previs.travel import Efficiency
+from robot.previs.travel import Efficiency, efficiency_for
 
 #: Violations listed in full; the rest are counted.
 SHOWN = 40
@@ -65,10 +66,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                         "walks, the gait walks the legs at the root's speed and turn)")
     p.add_argument("--travel-efficiency", type=bounded_float(0.2, 1.0, "",
                                                              what="a share"),
-                   default=Efficiency().forward, metavar="SHARE",
+                   default=None, metavar="SHARE",
                    help="share of the gait's no-slip stride speed the robot walks (default: "
-                        "%(default)s, measured in MuJoCo on biped18-dynamixel; docs/"
-                        "animatronics.md says how to measure yours)")
+                        "measured in MuJoCo for biped18-feetech, by speed; "
+                        f"{Efficiency().forward} for any other robot, as on biped18-"
+                        "dynamixel; docs/animatronics.md says how to measure yours)")
     p.add_argument("--audio", default=None, metavar="SOUND",
                    help="soundtrack of the show (a path relative to the take)")
     p.add_argument("--audio-offset", type=float, default=0.0, metavar="SECONDS",
@@ -89,7 +91,9 @@ def run(args: argparse.Namespace) -> int:
         else by_name(robot)
     _, params = params_from(args, robot)
     hold = np.asarray(GaitEngine(robot, params).start_pose())
-    efficiency = None if args.no_root_travel else Efficiency(forward=args.travel_efficiency)
+    efficiency = None if args.no_root_travel else efficiency_for(robot)
+    if efficiency is not None and args.travel_efficiency is not None:
+        efficiency = replace(efficiency, forward=args.travel_efficiency, forward_by_speed=())
     got = import_animation(args.file, robot, bone_map, hold, up=args.up,
                            min_rate=args.rate, max_accel=args.max_accel, params=params,
                            efficiency=efficiency)

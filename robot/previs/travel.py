@@ -19,10 +19,13 @@ MuJoCo with the ``walk`` preset over 20 s (``biped walk --set speed=... --json``
 plays without balance unless ``biped play --balance``): forward on biped18-dynamixel 0.66-
 0.80 at speed 0.25-1 without balance (0.75-0.84 with), on biped18-feetech 0.29-0.72
 without (0.58-0.76 with); side step 0.51-0.62 (dynamixel, 0.01-0.02 m/step; feetech 0.18
-at 0.01 without balance); turn 0.96-1.02 on both. The defaults are the dynamixel robot's
-without balance. The values are kept inside what the gait walks: ``speed`` in
-``SPEED_RANGE`` (1.5 walked less far than 1.0 on both bundled robots: it stumbles), turn
-and side step in their parameter ranges; each clamp is reported.
+at 0.01 without balance); turn 0.96-1.02 on both (feetech without balance: 0.93 at speed
+0.85). The defaults are the dynamixel robot's without balance. Where a robot's share
+differs, or changes much with the speed (biped18-feetech without balance), ``MEASURED``
+keeps its own, by speed; the speed asked is then the one whose share times speed walks
+the root's speed (``Efficiency.speed_for``). The values are kept inside what the gait
+walks: ``speed`` in ``SPEED_RANGE`` (1.5 walked less far than 1.0 on both bundled robots:
+it stumbles), turn and side step in their parameter ranges; each clamp is reported.
 
 The gait starts half its ramp-in time (``ramp_cycles`` x cycle) before the walk's first
 lift-off and is told to stop half its ramp-out time before the last touch-down, so its
@@ -35,7 +38,7 @@ last touch-down and blend over the half ramps outside it (robot/motion/show_walk
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -58,6 +61,34 @@ class Efficiency:
     forward: float = 0.75
     side: float = 0.55
     turn: float = 1.0
+    #: (speed, forward share) points, by speed; when given they replace ``forward``
+    #: (interpolated; the end points' shares beyond them).
+    forward_by_speed: tuple[tuple[float, float], ...] = ()
+
+    def speed_for(self, no_slip: float) -> float:
+        """The gait ``speed`` that walks ``no_slip`` units of the no-slip stride speed
+        (the root's speed over what ``speed`` 1 would walk if no foot slipped)."""
+        if not self.forward_by_speed:
+            return no_slip / self.forward
+        pts = np.asarray(self.forward_by_speed)
+        grid = np.linspace(0.0, 2.0, 401)
+        walked = grid * np.interp(grid, pts[:, 0], pts[:, 1])   # rises with the speed
+        return math.copysign(float(np.interp(abs(no_slip), walked, grid)), no_slip)
+
+
+#: What the bundled robots realize where it differs from ``Efficiency()``: MuJoCo, ``walk``
+#: preset, no balance; forward from the difference of a 20 s and a 10 s walk (``biped walk
+#: --robot R --no-balance --set speed=S --seconds 10|20 --json``, so the ramps cancel),
+#: turn likewise at speed 0.85, turn 0.087 rad/step (106 of 114 deg per 10 s).
+MEASURED = {
+    "biped18-feetech": Efficiency(forward=0.65, side=0.18, turn=0.93, forward_by_speed=(
+        (0.5, 0.48), (0.75, 0.65), (0.9, 0.71), (1.0, 0.75))),
+}
+
+
+def efficiency_for(robot: RobotConfig) -> Efficiency:
+    """The measured shares for ``robot`` (the dynamixel robot's for any other)."""
+    return MEASURED.get(robot.name, Efficiency())
 
 
 @dataclass(frozen=True)
@@ -118,7 +149,8 @@ def _clamp(name: str, v: float, lo: float, hi: float, t: float, out: list[str]) 
 
 def plan_walk(walk: Walk, m: RigMotion, robot: RobotConfig, params: GaitParams,
               eff: Efficiency) -> WalkPlan:
-    fwd, side, turn = unit_travel(robot, params, eff)
+    _, side, turn = unit_travel(robot, params, eff)
+    no_slip = unit_travel(robot, params, replace(eff, forward=1.0))[0]
     ramp = params.ramp_cycles * params.cycle_s
     half = ramp / 2 if math.isfinite(ramp) else 0.0
     start = max(0.0, walk.start - half)
@@ -132,7 +164,8 @@ def plan_walk(walk: Walk, m: RigMotion, robot: RobotConfig, params: GaitParams,
         when = start if i == 0 else t0
         if i and when >= stop:
             break       # the ramp out keeps the last speed: its distance is the ramp in's
-        speed = _clamp("speed", v / fwd if fwd else 0.0, *SPEED_RANGE, when, clamped)
+        speed = _clamp("speed", eff.speed_for(v / no_slip) if no_slip else 0.0,
+                       *SPEED_RANGE, when, clamped)
         yaw = w / turn if turn and robot.has_hip_yaw else 0.0
         yaw = _clamp("turn", yaw, SPECS["turn"].lo, SPECS["turn"].hi, when, clamped)
         lat = _clamp("side_step", u / side if side else 0.0, SPECS["side_step"].lo,

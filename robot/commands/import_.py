@@ -33,6 +33,7 @@ from robot.gait.engine import GaitEngine
 from robot.motion.show import Show
 from robot.motion.takes import SUFFIX, is_take
 from robot.previs.bone_map import by_name, load_map
+from robot.previs.cues import gltf_cues, sidecar_cues
 from robot.previs.importing import SUFFIXES, import_animation, write_stream_take
 from robot.previs.rig import UPS
 from robot.previs.travel import Efficiency, efficiency_for
@@ -71,6 +72,10 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                         "measured in MuJoCo for biped18-feetech, by speed; "
                         f"{Efficiency().forward} for any other robot, as on biped18-"
                         "dynamixel; docs/animatronics.md says how to measure yours)")
+    p.add_argument("--cues", default=None, metavar="CUES.toml",
+                   help="cue markers from a file of [[cue]] tables (t in seconds, name); "
+                        "a glTF's own come from its animation's or scene's extras.cue "
+                        "(docs/animatronics.md)")
     p.add_argument("--audio", default=None, metavar="SOUND",
                    help="soundtrack of the show (a path relative to the take)")
     p.add_argument("--audio-offset", type=float, default=0.0, metavar="SECONDS",
@@ -110,8 +115,15 @@ def run(args: argparse.Namespace) -> int:
         first = got.violations[0]
         raise ConfigError(f"{args.file}: {len(got.violations)} violations (--strict); first: "
                           f"{first.joint} {first.kind} at t={first.t_worst:.3f} s")
+    cues = gltf_cues(args.file) if Path(args.file).suffix.lower() != ".bvh" else ()
+    if args.cues:
+        cues += sidecar_cues(checked("--cues", input_file, args.cues))
+    if cues:
+        print(f"{len(cues)} cues: " + ", ".join(f"{c.t:g} s {c.name!r}" for c in cues[:5])
+              + (", ..." if len(cues) > 5 else ""))
     show = Show(stream=True, audio=args.audio, audio_offset_s=args.audio_offset,
-                up=frames.up, travel_m=tuple(float(v) for v in frames.travel[-1]))  # type: ignore[arg-type]
+                cues=tuple(sorted(cues, key=lambda c: c.t)), up=frames.up,
+                travel_m=tuple(float(v) for v in frames.travel[-1]))  # type: ignore[arg-type]
     write_stream_take(args.out, robot, params, got, show,
                       note=f"imported from {Path(args.file).name}")
     held = [n for n in robot.joint_names if n not in frames.animated]

@@ -87,6 +87,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
 def run(args: argparse.Namespace) -> int:
     checked("ANIM", input_file, args.file)
     checked("--out", output_file, args.out)
+    side = sidecar_cues(checked("--cues", input_file, args.cues)) if args.cues else ()
     if Path(args.file).suffix.lower() not in SUFFIXES:
         raise ConfigError(f"ANIM {args.file}: expected a {', '.join(SUFFIXES)} animation")
     if not is_take(args.out):
@@ -115,9 +116,7 @@ def run(args: argparse.Namespace) -> int:
         first = got.violations[0]
         raise ConfigError(f"{args.file}: {len(got.violations)} violations (--strict); first: "
                           f"{first.joint} {first.kind} at t={first.t_worst:.3f} s")
-    cues = gltf_cues(args.file) if Path(args.file).suffix.lower() != ".bvh" else ()
-    if args.cues:
-        cues += sidecar_cues(checked("--cues", input_file, args.cues))
+    cues = side + (gltf_cues(args.file) if Path(args.file).suffix.lower() != ".bvh" else ())
     if cues:
         print(f"{len(cues)} cues: " + ", ".join(f"{c.t:g} s {c.name!r}" for c in cues[:5])
               + (", ..." if len(cues) > 5 else ""))

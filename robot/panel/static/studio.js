@@ -71,7 +71,7 @@
 // Starting is not instant: after a seek (or the first play) the element's clock stalls
 // before it runs, and runs as if it had started that lead later (headless Chromium:
 // 105-130 ms; a play without a seek, 7 ms). So while the robot ramps in, the page
-// rehearses the start muted (seek, play, fit a line to the clock's run, pause) and
+// rehearses the start silently (seek, play, fit a line to the clock's run, pause) and
 // measures that lead; the real start is then sent the lead early and ahead, so the clock
 // runs on the show's time from its first frame. Later seeks learn the lead again from the
 // drift once the audio has settled after the seek, by halves, within 0..0.3 s.
@@ -131,13 +131,14 @@
     return s.length % 2 ? s[m] : (s[m - 1] + s[m]) / 2;
   }
 
-  // Seek, play muted and fit a line to the clock's run from 180 to 300 ms after play():
+  // Seek, play silently (muted, and volume 0) and fit a line to the clock's run from 180 to 300 ms after play():
   // the lead is how long after play() that line passes the seek's position. A start due
   // before it ends cuts it short (rehearsal "cut") and keeps the lead it had.
   async function rehearse(audio) {
     rehearsal = "running";
     try {
       const from = Math.min(1, 0.5 * (audio.duration || 0));
+      audio.muted = true;     // (a phone's browser may ignore the volume: muted it keeps)
       audio.volume = 0;
       audio.currentTime = from;
       const t0 = performance.now();
@@ -149,15 +150,18 @@
         await new Promise((r) => setTimeout(r, 5));
       }
       audio.pause();
-      const n = xs.length, mx = xs.reduce((a, b) => a + b) / n;
-      const my = ys.reduce((a, b) => a + b) / n;
-      let sxy = 0, sxx = 0;
-      for (let k = 0; k < n; k++) { sxy += (xs[k] - mx) * (ys[k] - my); sxx += (xs[k] - mx) ** 2; }
-      const slope = sxy / sxx, lag = mx - (my - from) / slope;
-      if (n > 5 && slope > 0.5 && slope < 1.5) lead = Math.min(0.3, Math.max(0, lag));
+      const n = xs.length;
+      if (n > 5) {
+        const mx = xs.reduce((a, b) => a + b) / n, my = ys.reduce((a, b) => a + b) / n;
+        let sxy = 0, sxx = 0;
+        for (let k = 0; k < n; k++) { sxy += (xs[k] - mx) * (ys[k] - my); sxx += (xs[k] - mx) ** 2; }
+        const slope = sxy / sxx, lag = mx - (my - from) / slope;
+        if (slope > 0.5 && slope < 1.5) lead = Math.min(0.3, Math.max(0, lag));
+      }
     } catch (e) {  // not allowed to play yet: the start keeps the lead it had
     } finally {
       audio.volume = 1;
+      audio.muted = false;
       rehearsal = "done";
     }
   }

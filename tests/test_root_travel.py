@@ -91,6 +91,28 @@ def test_a_share_by_speed_asks_the_speed_that_walks_the_root_s_speed() -> None:
     assert Efficiency(forward=0.5).speed_for(0.3) == pytest.approx(0.6)
 
 
+def test_a_walk_s_ramps_are_counted_at_their_smaller_share() -> None:
+    """The speed asked for a walk with ramps walks the root's distance when each instant
+    of the gait's envelope walks at the share of its own stride (a time loop through the
+    gait's start, full amplitude and stop, as robot/gait/engine.py ramps it: the linear
+    ramp variable r over ``ramp_s``, amplitude smoothstep(r))."""
+    eff = MEASURED["biped18-feetech"]
+    pts = np.asarray(eff.forward_by_speed)
+    walk_s, ramp_s, dt = 6.26, 2.6, 1e-3
+    for target in (0.3, 0.5, 0.6):
+        speed = eff.speed_for(target, walk_s=walk_s, ramp_s=ramp_s)
+        walked, t = 0.0, 0.0
+        while t < walk_s + ramp_s:      # started at 0, told to stop at walk_s
+            r = min(t / ramp_s, 1.0) if t < walk_s else max(0.0, 1.0 - (t - walk_s) / ramp_s)
+            a = r * r * (3.0 - 2.0 * r)
+            walked += speed * a * float(np.interp(speed * a, pts[:, 0], pts[:, 1])) * dt
+            t += dt
+        assert walked / walk_s == pytest.approx(target, rel=0.01)
+        assert speed > eff.speed_for(target)       # more than without ramps
+    assert Efficiency(forward=0.5).speed_for(0.3, walk_s=5.0, ramp_s=2.0) == \
+        pytest.approx(0.6)
+
+
 def test_stepping_in_place_is_not_a_walk(tmp_path: Path,
                                          capsys: pytest.CaptureFixture[str]) -> None:
     """Feet lift in turn but the root stays: the legs play as authored (no timeline)."""

@@ -23,7 +23,8 @@ at 0.01 without balance); turn 0.96-1.02 on both (feetech without balance: 0.93 
 0.85). The defaults are the dynamixel robot's without balance. Where a robot's share
 differs, or changes much with the speed (biped18-feetech without balance), ``MEASURED``
 keeps its own, by speed; the speed asked is then the one whose share times speed walks
-the root's speed (``Efficiency.speed_for``). The values are kept inside what the gait
+the root's speed over the walk, its ramps (a smaller stride, so a smaller share) counted
+(``Efficiency.speed_for``). The values are kept inside what the gait
 walks: ``speed`` in ``SPEED_RANGE`` (1.5 walked less far than 1.0 on both bundled robots:
 it stumbles), turn and side step in their parameter ranges; each clamp is reported.
 
@@ -65,14 +66,26 @@ class Efficiency:
     #: (interpolated; the end points' shares beyond them).
     forward_by_speed: tuple[tuple[float, float], ...] = ()
 
-    def speed_for(self, no_slip: float) -> float:
+    def speed_for(self, no_slip: float, *, walk_s: float = math.inf,
+                  ramp_s: float = 0.0) -> float:
         """The gait ``speed`` that walks ``no_slip`` units of the no-slip stride speed
-        (the root's speed over what ``speed`` 1 would walk if no foot slipped)."""
+        (the root's speed over what ``speed`` 1 would walk if no foot slipped) on average
+        over a walk of ``walk_s`` [s] whose ramps take ``ramp_s`` [s] each. In a ramp the
+        envelope A = smoothstep(r), r from 0 to 1, shrinks the stride as a speed x A
+        would, at that speed's share; the ramps in and out together walk ``ramp_s`` at
+        full amplitude's worth (the rest of the walk: ``walk_s - ramp_s``)."""
         if not self.forward_by_speed:
             return no_slip / self.forward
-        pts = np.asarray(self.forward_by_speed)
         grid = np.linspace(0.0, 2.0, 401)
-        walked = grid * np.interp(grid, pts[:, 0], pts[:, 1])   # rises with the speed
+        r = np.linspace(0.0, 1.0, 51)
+        amp = r * r * (3.0 - 2.0 * r)
+        pts = np.asarray(self.forward_by_speed)
+        at = np.interp(np.outer(grid, amp), pts[:, 0], pts[:, 1])    # share (speed, r)
+        ramp_share = (at * amp).mean(axis=1) / amp.mean()
+        full = max(walk_s - ramp_s, 0.0) if math.isfinite(walk_s) else 1.0
+        ramped = min(ramp_s, walk_s) if math.isfinite(walk_s) else 0.0
+        share = np.interp(grid, pts[:, 0], pts[:, 1])
+        walked = grid * (share * full + ramp_share * ramped) / (full + ramped)
         return math.copysign(float(np.interp(abs(no_slip), walked, grid)), no_slip)
 
 
@@ -164,7 +177,9 @@ def plan_walk(walk: Walk, m: RigMotion, robot: RobotConfig, params: GaitParams,
         when = start if i == 0 else t0
         if i and when >= stop:
             break       # the ramp out keeps the last speed: its distance is the ramp in's
-        speed = _clamp("speed", eff.speed_for(v / no_slip) if no_slip else 0.0,
+        asked = eff.speed_for(v / no_slip, walk_s=walk.end - walk.start, ramp_s=2 * half) \
+            if no_slip else 0.0
+        speed = _clamp("speed", asked,
                        *SPEED_RANGE, when, clamped)
         yaw = w / turn if turn and robot.has_hip_yaw else 0.0
         yaw = _clamp("turn", yaw, SPECS["turn"].lo, SPECS["turn"].hi, when, clamped)

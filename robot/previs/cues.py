@@ -3,7 +3,7 @@
 What an animator's file can carry (checked against the Khronos glTF exporter that ships
 with Blender, glTF-Blender-IO): with *Include > Custom Properties* on, an action's custom
 properties become its glTF animation's ``extras`` and the scene's become the scene's
-``extras``. Timeline markers and pose markers are not written (add-ons exist that write
+``extras`` (a collection's, exporting a collection). Timeline markers and pose markers are not written (add-ons exist that write
 them in extensions of their own), and BVH has no place for anything but the motion. So:
 
 - a custom property ``cue`` on the action (the glTF's first animation, the one imported)

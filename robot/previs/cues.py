@@ -3,8 +3,9 @@
 What an animator's file can carry (checked against the Khronos glTF exporter that ships
 with Blender, glTF-Blender-IO): with *Include > Custom Properties* on, an action's custom
 properties become its glTF animation's ``extras`` and the scene's become the scene's
-``extras`` (a collection's, exporting a collection). Timeline markers and pose markers are not written (add-ons exist that write
-them in extensions of their own), and BVH has no place for anything but the motion. So:
+``extras`` (a collection's, exporting a collection). Timeline markers and pose markers are
+not written (add-ons exist that write them in extensions of their own), and BVH has no
+place for anything but the motion. So:
 
 - a custom property ``cue`` on the action (the glTF's first animation, the one imported)
   or else on the scene: either a string ``"2.0 lights up; 4.5 bow"`` (seconds from the

@@ -166,6 +166,9 @@ def run(args: argparse.Namespace) -> int:
         "target_speed_m_s": setup.target_speed, "start_speed_m_s": ref.get("speed_m_s"),
         "best_speed_m_s": top.user_attrs.get("speed_m_s") if top else ref.get("speed_m_s"),
         "best_walking": bool(top.user_attrs.get("walking")) if top else None,
+        "start_bumps_speed_m_s": ref.get("bumps_speed_m_s"),
+        "best_bumps_speed_m_s": (top.user_attrs.get("bumps_speed_m_s") if top
+                                 else ref.get("bumps_speed_m_s")),
         "start_cadence_steps_min": cadence(start), "best_cadence_steps_min": cadence(best),
         "start_crouch": start.stance, "best_crouch": best.stance,
         "knobs": {k.name: {"start": getattr(start, k.targets[0]),

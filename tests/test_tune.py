@@ -31,7 +31,13 @@ from robot.tuning.objective import (
     walks,
 )
 from robot.tuning.robustness import Outcome
-from robot.tuning.space import DEFAULT_KNOBS, apply, parse_knob, search_space
+from robot.tuning.space import (
+    DEFAULT_KNOBS,
+    FIVE_DOF_KNOBS,
+    apply,
+    parse_knob,
+    search_space,
+)
 
 WALK = load_gait("walk").params
 PY = sys.executable
@@ -53,10 +59,16 @@ def test_a_pair_knob_sets_both_sides_and_its_range_holds_the_preset() -> None:
 
 
 def test_default_ranges_stay_inside_the_documented_ones() -> None:
-    for k in search_space([], WALK):
+    for k in search_space([], WALK, hip_yaw=False):
         spec = SPECS[k.targets[0]]
         assert spec.lo <= k.lo < k.hi <= spec.hi, k
     assert [k.name for k in search_space([], WALK)] == list(DEFAULT_KNOBS)
+    # 5-DoF legs: the heading loop's stride gain, either sign, and its trim's size too.
+    five = {k.name: (k.lo, k.hi) for k in search_space([], WALK, hip_yaw=False)}
+    assert list(five) == [*DEFAULT_KNOBS, "bal_stride_turn", "bal_turn_max"]
+    assert five["bal_stride_turn"] == (-1.0, 1.0) and five["bal_turn_max"] == (0.0, 0.1)
+    assert len(FIVE_DOF_KNOBS) == 2
+    assert [k.name for k in search_space(["vM"], WALK, hip_yaw=False)] == ["vM"]
     stance = parse_knob("stance", WALK)          # 0.88 * 1.5 is over the 0.99 limit
     assert stance.hi == SPECS["stance"].hi
 

@@ -109,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
         return sensitivity(args, start)
     if args.out is None:
         raise ConfigError("--out: required (the tuned preset to write), unless --sensitivity")
-    knobs = tuple(search_space(args.param, start))
+    knobs = tuple(search_space(args.param, start, hip_yaw=robot.has_hip_yaw))
     out = Path(args.out)
     if out.suffix != ".toml":
         raise ConfigError(f"--out {args.out}: a gait preset is a .toml file")

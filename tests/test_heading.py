@@ -120,7 +120,7 @@ def test_an_open_loop_five_dof_walk_is_flagged_when_it_drifts(
 
 def test_the_heading_loop_holds_a_five_dof_robot_by_step_length_with_its_own_sign(
         capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
-    """In MuJoCo (balance on, 20 s) this robot turns left for `--set turn=0.05` (+29 deg
+    """In MuJoCo (balance on, 20 s) this robot turns left for `--set turn=0.05` (+22 deg
     measured), so bal_stride_turn = 1 is its sign: the loop holds it (-1.1 deg measured,
     lateral 1 cm), and the opposite sign runs away (+16 deg): the trim really steers."""
     robot = str(five_dof_with_head(tmp_path))

@@ -183,8 +183,8 @@ def run(args: argparse.Namespace) -> int:
         print(format_report(knobs, start, written.params, start_score + 0.0, best_score,
                             start_groups, best_groups, walk=WalkFigures(
                                 setup.target_speed, ref.get("speed_m_s"),
-                                top.user_attrs.get("speed_m_s") if top else
-                                ref.get("speed_m_s"))))
+                                result["best_speed_m_s"], result["start_bumps_speed_m_s"],
+                                result["best_bumps_speed_m_s"])))
         print(f"\nwrote {out} ({done} trials in {study_s:.0f} s on {jobs} workers: "
               f"{per_trial:.1f} s of one core per trial); plots: "
               + ", ".join(str(p) for p in pngs))

@@ -23,7 +23,7 @@ from robot.config.params import GaitParams
 from robot.gait import expressions as gait
 from robot.gait.engine import GaitEngine
 from robot.gait.ik import leg_fk_full
-from robot.gait.targets import body_targets
+from robot.gait.targets import NO_TRIM, TURN_RANGE, BodyTrim, body_targets
 from robot.run.walk import HEADING_DRIFT_DEG_MIN
 
 ROBOT = five_dof_robot()
@@ -32,10 +32,10 @@ ROBOT = five_dof_robot()
 LEVEL = load_gait("walk").params.replace({"torso_lean": 0.0, "spine_gain": 0.0})
 
 
-def soles(p: GaitParams, theta: float) -> tuple[float, float]:
+def soles(p: GaitParams, theta: float, trim: BodyTrim = NO_TRIM) -> tuple[float, float]:
     """Right and left sole x [m] at phase ``theta``, full amplitude."""
     ph = gait.Phase(theta, 0.0, 0.0, 0.0, 0.0)
-    t = body_targets(gait.channels(ph, p), p, ROBOT.geometry, leg_yaw=False)
+    t = body_targets(gait.channels(ph, p), p, ROBOT.geometry, leg_yaw=False, trim=trim)
     return float(t.r_sole[0]), float(t.l_sole[0])
 
 
@@ -58,6 +58,23 @@ def test_a_left_turn_lengthens_the_right_stride_by_the_half_gap(turn: float) -> 
     r_ref = soles(straight, math.pi)[0] - soles(straight, 0.0)[0]
     assert r_len - r_ref == pytest.approx(2 * turn * half_gap, abs=1e-12)
     assert l_len - r_ref == pytest.approx(-2 * turn * half_gap, abs=1e-12)
+
+
+@pytest.mark.parametrize("gain", [1.0, -0.5, 0.0, 2.0])
+def test_the_heading_trim_steers_by_step_length_times_bal_stride_turn(gain: float) -> None:
+    """A heading loop's turn trim (BodyTrim.turn) moves the soles as an asked turn of
+    turn + bal_stride_turn x trim would (kept inside the turn range): the same stride
+    shift by hand, -cos(theta) x turn x half gap on both feet; 0 leaves it out."""
+    half_gap = ROBOT.geometry.hip_width / 2 + LEVEL.foot_spread
+    p = LEVEL.replace({"turn": 0.02, "bal_stride_turn": gain})
+    trim = BodyTrim(turn=0.04)
+    turn = min(max(0.02 + gain * 0.04, TURN_RANGE[0]), TURN_RANGE[1])
+    for theta in (0.0, 0.7, math.pi / 2, 2.0, math.pi, 4.0):
+        r0, l0 = soles(p.replace({"turn": 0.0}), theta)
+        r1, l1 = soles(p, theta, trim)
+        shift = -math.cos(theta) * turn * half_gap
+        assert r1 - r0 == pytest.approx(shift, abs=1e-12)
+        assert l1 - l0 == pytest.approx(shift, abs=1e-12)
 
 
 def test_the_stride_shift_is_capped_at_half_the_stride() -> None:
@@ -99,6 +116,24 @@ def test_an_open_loop_five_dof_walk_is_flagged_when_it_drifts(
     assert r["heading_drifts"] is True
     held = walk(capsys)
     assert held["heading_drifts"] is False
+
+
+def test_the_heading_loop_holds_a_five_dof_robot_by_step_length_with_its_own_sign(
+        capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    """In MuJoCo (balance on, 20 s) this robot turns left for `--set turn=0.05` (+22 deg
+    measured), so bal_stride_turn = 1 is its sign: the loop holds it (-1.1 deg measured,
+    lateral 1 cm), and the opposite sign runs away (+16 deg): the trim really steers."""
+    robot = str(five_dof_with_head(tmp_path))
+
+    def heading(gain: float) -> float:
+        assert main(["walk", "--json", "--seconds", "20", "--robot", robot,
+                     "--set", f"bal_stride_turn={gain:g}"]) == 0
+        r = json.loads(capsys.readouterr().out)
+        assert r["fell"] is False
+        return float(r["heading_change_deg"])
+    held, away = heading(1.0), heading(-1.0)
+    assert abs(held) < 5.0
+    assert abs(away) > 2.0 * abs(held) + 5.0
 
 
 def test_an_asked_turn_is_not_drift(capsys: pytest.CaptureFixture[str]) -> None:

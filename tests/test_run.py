@@ -157,7 +157,8 @@ def test_the_tuners_objective_walks_in_process(
     same = set(want) - {"gait", "realtime_factor"}
     assert {k: got[k] for k in same} == {k: want[k] for k in same}
     assert flat.fell is False and flat.distance_m == want["distance_m"]
-    # score = walks x (runs + 1) + survived + 0.9 quality; with no references it walks
+    # score = walks x (runs + 1) + survived + 0.9 quality (walks: the flat, bumps skipped);
+    # with no references it walks
     # when it stays up, and speed and energy count 1.
     drift = abs(want["lateral_drift_m"]) / max(want["distance_m"], 0.1)
     straight = max(0.0, 1 - abs(want["heading_change_deg"]) / 20 - drift / 0.2)

@@ -19,8 +19,25 @@ from robot.config.gait_file import Gait, gait_to_toml, load_gait
 from robot.config.params import SPECS
 from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
-from robot.tuning.objective import Setup, combined, evaluate, quality, score, walks
-from robot.tuning.space import DEFAULT_KNOBS, apply, parse_knob, search_space
+from robot.tuning.conditions import Condition
+from robot.tuning.objective import (
+    Evaluation,
+    Setup,
+    combined,
+    evaluate,
+    quality,
+    rescore,
+    score,
+    walks,
+)
+from robot.tuning.robustness import Outcome
+from robot.tuning.space import (
+    DEFAULT_KNOBS,
+    FIVE_DOF_KNOBS,
+    apply,
+    parse_knob,
+    search_space,
+)
 
 WALK = load_gait("walk").params
 PY = sys.executable
@@ -42,10 +59,16 @@ def test_a_pair_knob_sets_both_sides_and_its_range_holds_the_preset() -> None:
 
 
 def test_default_ranges_stay_inside_the_documented_ones() -> None:
-    for k in search_space([], WALK):
+    for k in search_space([], WALK, hip_yaw=False):
         spec = SPECS[k.targets[0]]
         assert spec.lo <= k.lo < k.hi <= spec.hi, k
     assert [k.name for k in search_space([], WALK)] == list(DEFAULT_KNOBS)
+    # 5-DoF legs: the heading loop's stride gain, either sign, and its trim's size too.
+    five = {k.name: (k.lo, k.hi) for k in search_space([], WALK, hip_yaw=False)}
+    assert list(five) == [*DEFAULT_KNOBS, "bal_stride_turn", "bal_turn_max"]
+    assert five["bal_stride_turn"] == (-1.0, 1.0) and five["bal_turn_max"] == (0.0, 0.1)
+    assert len(FIVE_DOF_KNOBS) == 2
+    assert [k.name for k in search_space(["vM"], WALK, hip_yaw=False)] == ["vM"]
     stance = parse_knob("stance", WALK)          # 0.88 * 1.5 is over the 0.99 limit
     assert stance.hi == SPECS["stance"].hi
 
@@ -97,12 +120,46 @@ def test_a_trial_that_survives_more_by_creeping_loses_to_one_that_walks() -> Non
     creep, walk = flat_summary(0.0799), flat_summary(0.0801)
     assert not walks(creep, setup) and walks(walk, setup)
     best_creep = score(11, {"speed": 1.0, "straight": 1.0, "knee": 1.0, "energy": 1.0},
-                       walking=False, runs=11)
+                       tier=0, runs=11)
     worst_walk = score(1, {"speed": 0.0, "straight": 0.0, "knee": 0.0, "energy": 0.0},
-                       walking=True, runs=11)
+                       tier=1, runs=11)
     assert best_creep < worst_walk
     assert not walks({**walk, "fell": True}, setup)            # a fall never walks
     assert walks(creep, Setup("biped12-legs"))                 # no target: standing up is all
+
+
+def run(group: str, summary: dict[str, float | bool]) -> Outcome:
+    return Outcome(Condition(group, group), balance=True, fell=bool(summary["fell"]),
+                   summary=summary)
+
+
+def test_a_trial_that_creeps_over_bumps_loses_to_one_that_walks_them() -> None:
+    """Issue 22's tuned preset: the flat at 0.114 m/s, 3 mm bumps at 0.039 (target 0.110).
+    Walking the flat and creeping over bumps, surviving all 7 runs with the best quality
+    there is, scores below walking both just over 80 % and surviving only those two; a
+    fall on the bumps walks no better than a creep; and the speed term is the mean over
+    the flat and bumps runs (by hand: 1 - |v - 0.1| / 0.1 each)."""
+    setup = Setup("biped12-legs", target_speed=0.1, baseline_energy=30.0)
+    others = [run(g, flat_summary(0.0)) for g in ("slope", "slope", "cross slope",
+                                                   "latency", "imu noise")]
+    creep = Evaluation([run("flat", flat_summary(0.114)), run("bumps", flat_summary(0.039)),
+                        *others])
+    walk = Evaluation([run("flat", flat_summary(0.0801)), run("bumps", flat_summary(0.0801)),
+                       *(run(o.condition.group, {**o.summary, "fell": True}) for o in others)])
+    fallen = Evaluation([run("flat", flat_summary(0.114)),
+                         run("bumps", {**flat_summary(0.114), "fell": True}), *others])
+    assert creep.survived == 7 and walk.survived == 2
+    assert rescore(creep, setup) < rescore(walk, setup)
+    assert rescore(fallen, setup) < rescore(walk, setup)
+    # Within the flat-only tier: the flat's 0.86 and the bumps' 0.39 make 0.625.
+    flat_only = Evaluation(creep.outcomes[:1] + others)
+    terms = {**quality(creep.flat, setup), "speed": 0.5 * (0.86 + 0.39)}
+    assert rescore(creep, setup) == pytest.approx(score(7, terms, tier=1, runs=7))
+    assert rescore(flat_only, setup) == pytest.approx(
+        score(6, quality(creep.flat, setup), tier=1, runs=6))
+    # Walking both: tier 2, over (runs + 1) per tier.
+    assert rescore(walk, setup) == pytest.approx(
+        score(2, {**quality(walk.flat, setup), "speed": 1 - 0.0199 / 0.1}, tier=2, runs=7))
 
 
 def test_a_preset_that_stands_still_loses_in_physics() -> None:

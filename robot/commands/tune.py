@@ -109,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
         return sensitivity(args, start)
     if args.out is None:
         raise ConfigError("--out: required (the tuned preset to write), unless --sensitivity")
-    knobs = tuple(search_space(args.param, start))
+    knobs = tuple(search_space(args.param, start, hip_yaw=robot.has_hip_yaw))
     out = Path(args.out)
     if out.suffix != ".toml":
         raise ConfigError(f"--out {args.out}: a gait preset is a .toml file")
@@ -166,6 +166,9 @@ def run(args: argparse.Namespace) -> int:
         "target_speed_m_s": setup.target_speed, "start_speed_m_s": ref.get("speed_m_s"),
         "best_speed_m_s": top.user_attrs.get("speed_m_s") if top else ref.get("speed_m_s"),
         "best_walking": bool(top.user_attrs.get("walking")) if top else None,
+        "start_bumps_speed_m_s": ref.get("bumps_speed_m_s"),
+        "best_bumps_speed_m_s": (top.user_attrs.get("bumps_speed_m_s") if top
+                                 else ref.get("bumps_speed_m_s")),
         "start_cadence_steps_min": cadence(start), "best_cadence_steps_min": cadence(best),
         "start_crouch": start.stance, "best_crouch": best.stance,
         "knobs": {k.name: {"start": getattr(start, k.targets[0]),
@@ -180,8 +183,8 @@ def run(args: argparse.Namespace) -> int:
         print(format_report(knobs, start, written.params, start_score + 0.0, best_score,
                             start_groups, best_groups, walk=WalkFigures(
                                 setup.target_speed, ref.get("speed_m_s"),
-                                top.user_attrs.get("speed_m_s") if top else
-                                ref.get("speed_m_s"))))
+                                result["best_speed_m_s"], result["start_bumps_speed_m_s"],
+                                result["best_bumps_speed_m_s"])))
         print(f"\nwrote {out} ({done} trials in {study_s:.0f} s on {jobs} workers: "
               f"{per_trial:.1f} s of one core per trial); plots: "
               + ", ".join(str(p) for p in pngs))

@@ -141,6 +141,10 @@ SPECS: dict[str, ParamSpec] = {
                                "of heading error", False),
     "bal_turn_max": ParamSpec(0.2, 0.0, 0.5, "rad/step", BALANCE, "largest turn trim the "
                               "heading loop may add", False),
+    "bal_stride_turn": ParamSpec(0.0, -2.0, 2.0, "-", BALANCE, "5-DoF legs (no hip yaw): "
+                                 "the heading loop's turn trim steers by step length x "
+                                 "this; 1 where `--set turn=0.05` turns the robot left, -1 "
+                                 "where it turns it right, 0: not steered", False),
 }
 
 ALIASES: dict[str, str] = {
@@ -218,6 +222,7 @@ class GaitParams:
     bal_heading_p: float = SPECS["bal_heading_p"].default
     bal_heading_i: float = SPECS["bal_heading_i"].default
     bal_turn_max: float = SPECS["bal_turn_max"].default
+    bal_stride_turn: float = SPECS["bal_stride_turn"].default
 
     def replace(self, changes: Mapping[str, Any], *, where: str = "parameter") -> GaitParams:
         """A copy with ``changes`` applied after validating every one of them.

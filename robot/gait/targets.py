@@ -102,10 +102,11 @@ TURN_RANGE = (SPECS["turn"].lo, SPECS["turn"].hi)
 #: right side of the body moves 4 x turn x half gap farther than the left, which turns a
 #: body of that track by ``turn`` per step), at most STRIDE_TURN_MAX x the stride
 #: amplitude (Slgt, not the speed: turning on the spot still steps). In physics the body
-#: can only yaw by its feet slipping, so which way it turns depends on the robot: in
-#: MuJoCo the 5-DoF Dynamixel legs-only robot turns against the stride law, the AX-12
-#: one with it (docs/gait.md). A heading loop's turn trim is therefore not steered this
-#: way (a wrong sign would run away: the 5-DoF Feetech robot fell): only the asked turn.
+#: can only yaw by its feet slipping, so which way and how much it turns depends on the
+#: robot: in MuJoCo (balance on) the 5-DoF Dynamixel and AX-12 robots turn with the law at
+#: a tenth of its rate, the Feetech one against it (docs/gait.md). A heading loop's turn
+#: trim is therefore steered this way x ``bal_stride_turn``, the robot's own sign and
+#: gain (0 by default: a wrong sign runs away).
 STRIDE_TURN_MAX = 0.5
 
 
@@ -115,6 +116,17 @@ def stride_turn(turn: Num, half_w: Num, stride: Num) -> Num:
     d = turn * half_w
     lim = STRIDE_TURN_MAX * stride
     return lim if d > lim else -lim if d < -lim else d
+
+
+def stride_shift(p: GaitParams, trim_turn: float, half_w: float, s: float) -> float:
+    """The stride shift [m] per unit of ``tz`` of 5-DoF legs (``stride_turn``) for the
+    asked ``turn`` plus a feedback loop's ``trim_turn`` x ``bal_stride_turn`` [rad/step],
+    kept inside TURN_RANGE; the feet ``half_w`` [m] apart, ``s`` metres per rig unit."""
+    turn = p.turn
+    if trim_turn != 0.0 and p.bal_stride_turn != 0.0:
+        turn = min(max(turn + p.bal_stride_turn * trim_turn, TURN_RANGE[0]), TURN_RANGE[1])
+    return (0.0 if turn == 0.0
+            else stride_turn(turn, half_w, s * 0.5 * (abs(p.Slgt_R) + abs(p.Slgt_L))))
 
 
 def _per_foot(pelvis_rot: Rot, yaw: Num, pitch: Num, roll: float, foot_roll: float,
@@ -178,11 +190,11 @@ def body_targets(ch: dict[str, Num], p: GaitParams, g: Geometry, *,
     yaw_l = 0.5 * yaw_turn * tz
     r_rot = xm.rz_ry(yaw_r, -p.toe_gain * ch["RightToe_tY"] * w_r)
     l_rot = xm.rz_ry(yaw_l, -p.toe_gain * ch["LeftToe_tY"] * w_l)
-    if not leg_yaw and p.turn != 0.0:
+    shift = 0.0 if leg_yaw else stride_shift(p, trim.turn, half_w, s)
+    if shift != 0.0:
         # 5-DoF steering by step length (STRIDE_TURN_MAX): both feet x - tz * dx, so for
         # a left turn the right stride (-tz * Slgt_R) grows and the left (+tz) shrinks.
-        # The asked turn only, not a feedback loop's trim (see STRIDE_TURN_MAX).
-        dx = stride_turn(p.turn, half_w, s * 0.5 * (abs(p.Slgt_R) + abs(p.Slgt_L))) * tz
+        dx = shift * tz
         r_pos = (r_pos[0] - dx, r_pos[1], r_pos[2])
         l_pos = (l_pos[0] - dx, l_pos[1], l_pos[2])
     if yaw_turn != 0.0:

@@ -27,7 +27,7 @@ from robot.gait.rot_floats import apply_t as _apply_t
 from robot.gait.rot_floats import per_foot as _per_foot
 from robot.gait.rot_floats import rz_ry as _rz_ry
 from robot.gait.rot_floats import t_matmul as _t_matmul
-from robot.gait.targets import ARM_HANG, HAND_OUT, TURN_RANGE, BodyTrim, stride_turn
+from robot.gait.targets import ARM_HANG, HAND_OUT, TURN_RANGE, BodyTrim, stride_shift
 from robot.gait.vectorised import spans
 from robot.gait.xmath import Rot
 
@@ -185,9 +185,9 @@ class TickKernel:
         yaw_l = 0.5 * yaw_turn * tz
         r_rot = _rz_ry(yaw_r, d.neg_toe * ftau * w_r)
         l_rot = _rz_ry(yaw_l, d.neg_toe * -ftau * w_l)
-        if not self._leg_yaw and p.turn != 0.0:   # 5-DoF: by step length, asked turn only
-            dx = stride_turn(p.turn, half_w, s * 0.5 * (abs(p.Slgt_R) + abs(p.Slgt_L))) * tz
-            rx_, lx_ = rx_ - dx, lx_ - dx
+        shift = 0.0 if self._leg_yaw else stride_shift(p, trim.turn, half_w, s)
+        if shift != 0.0:                         # 5-DoF: by step length
+            rx_, lx_ = rx_ - shift * tz, lx_ - shift * tz
         if yaw_turn != 0.0:  # targets._yawed, with cos and sin of the yaw from the rotations
             c, sn = r_rot[4], -r_rot[1]
             rx_, ry_ = c * rx_ - sn * ry_, sn * rx_ + c * ry_

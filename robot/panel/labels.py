@@ -35,6 +35,7 @@ LABELS: dict[str, str] = {
     "bal_swing_level": "Keep the swinging foot level", "bal_learn_cycles": "Learn the walk's rhythm",
     "bal_heading_p": "Heading hold",
     "bal_heading_i": "Heading hold, slow part", "bal_turn_max": "Largest heading trim",
+    "bal_stride_turn": "Heading hold by step length (no hip yaw)",
 }
 
 #: The simple view: steer, foot height, stride, crouch (and the presets above them).

@@ -46,11 +46,13 @@ def group_survival(runs_json: str, groups: dict[str, str]) -> dict[str, tuple[in
 
 class WalkFigures(NamedTuple):
     """The flat walk's speeds [m/s]: the target, the starting preset's and the tuned
-    one's (None: none, or it fell)."""
+    one's, and the slowest bumps run's of both (None: none, or it fell)."""
 
     target: float | None
     start: float | None
     best: float | None
+    bumps_start: float | None = None
+    bumps_best: float | None = None
 
 
 def cadence(p: GaitParams) -> float:
@@ -85,6 +87,8 @@ def format_report(knobs: Sequence[Knob], start: GaitParams, best: GaitParams,
                   f"{walk.target:.3f} m/s, walking from {WALK_SHARE * walk.target:.3f}")
         lines += [f"{'speed m/s (flat)':<18}{_speed(walk.start):>10}{_speed(walk.best):>10}"
                   f"  target {target}",
+                  f"{'speed m/s (bumps)':<18}{_speed(walk.bumps_start):>10}"
+                  f"{_speed(walk.bumps_best):>10}  the slowest run (walks from the same)",
                   f"{'cadence steps/min':<18}{cadence(start):>10.1f}{cadence(best):>10.1f}",
                   f"{'crouch (stance)':<18}{start.stance:>10.3f}{best.stance:>10.3f}"
                   "  hip height / leg length"]

@@ -11,7 +11,7 @@ from concurrent.futures import ProcessPoolExecutor
 from typing import NamedTuple
 
 from robot.config.params import BALANCE, SPECS, GaitParams
-from robot.tuning.objective import Setup, evaluate, quality, score, walks
+from robot.tuning.objective import Setup, evaluate, rescore
 from robot.tuning.robustness import worker_init
 from robot.tuning.space import FIXED, PAIRS, Knob, apply, targets_of
 
@@ -62,8 +62,7 @@ def with_references(setup: Setup, params: GaitParams) -> tuple[Setup, float]:
     ref = setup._replace(
         target_speed=setup.target_speed if setup.target_speed is not None
         else float(flat["speed_m_s"]), baseline_energy=flat.get("energy_per_m"))
-    return ref, score(ev.survived, quality(flat, ref), walking=walks(flat, ref),
-                      runs=len(ev.outcomes))
+    return ref, rescore(ev, ref)
 
 
 def study(setup: Setup, params: GaitParams, *, jobs: int,

@@ -30,6 +30,13 @@ PAIRS = {n[:-2]: (n, n[:-2] + "_L") for n in SPECS if n.endswith("_R")
 #: ankle stiffness moved it more, but only down from 0, so they stay off.
 DEFAULT_KNOBS = ("vM", "Slgt", "Fhgt", "sway", "stance", "delta_f", "bal_ankle_pd",
                  "bal_brace_xi")
+#: Added to the default search on 5-DoF legs (no hip yaw): the heading loop steers them by
+#: step length, and which way a longer right stride turns the body depends on the robot
+#: and the gait (in MuJoCo the 5-DoF AX-12 robot turns with it in `walk`, against it in a
+#: deep crouch with long strides), so its sign and gain and the trim's size are searched
+#: with the walk (issue 22: without them the tuned preset crossed 3 mm bumps at 0.050 to
+#: 0.106 m/s, turning 20-70 deg; with them at 0.088 to 0.115, target 0.110).
+FIVE_DOF_KNOBS = ("bal_stride_turn=-1:1", "bal_turn_max=0:0.1")
 #: Never searched: they are commands or units, not properties of a good walk.
 FIXED = frozenset({"fps", "speed", "turn", "side_step", "rig_leg", "ramp_cycles"})
 
@@ -94,10 +101,13 @@ def parse_knob(text: str, params: GaitParams) -> Knob:
     return Knob(name, lo, hi, targets)
 
 
-def search_space(texts: Sequence[str], params: GaitParams) -> list[Knob]:
-    """The knobs of ``--param`` items, or DEFAULT_KNOBS when none is given; a parameter
-    searched twice is an error."""
-    knobs = [parse_knob(t, params) for t in (texts or DEFAULT_KNOBS)]
+def search_space(texts: Sequence[str], params: GaitParams, *,
+                 hip_yaw: bool = True) -> list[Knob]:
+    """The knobs of ``--param`` items, or DEFAULT_KNOBS when none is given (and
+    FIVE_DOF_KNOBS for legs without ``hip_yaw``); a parameter searched twice is an
+    error."""
+    default = DEFAULT_KNOBS if hip_yaw else DEFAULT_KNOBS + FIVE_DOF_KNOBS
+    knobs = [parse_knob(t, params) for t in (texts or default)]
     seen: set[str] = set()
     for k in knobs:
         clash = seen.intersection(k.targets)

@@ -34,10 +34,8 @@ from robot.tuning.objective import (
     Evaluation,
     Setup,
     evaluate,
-    quality,
-    score,
+    rescore,
     summary_json,
-    walks,
 )
 from robot.tuning.robustness import WalkJob, run_condition
 from robot.tuning.space import Knob, apply
@@ -105,6 +103,8 @@ def objective(plan: Plan) -> Callable[[optuna.Trial], float]:
         trial.set_user_attr("terms", ev.terms)
         trial.set_user_attr("speed_m_s", trial_speed(ev))
         trial.set_user_attr("walking", ev.walking)
+        trial.set_user_attr("tier", ev.tier)
+        trial.set_user_attr("bumps_speed_m_s", ev.slowest("bumps"))
         return ev.score
     return run
 
@@ -215,10 +215,10 @@ def references(study: optuna.Study, setup: Setup, start: GaitParams,
         energy = flat.get("energy_per_m") if flat and not flat.get("fell") else None
         ref_setup = Setup(setup.robot, setup.suite, setup.seconds, speed, energy, setup.skip)
         kept = {"target_speed": speed, "baseline_energy": energy,
-                "score": score(ev.survived, quality(flat, ref_setup),
-                               walking=walks(flat, ref_setup), runs=len(ev.outcomes)),
+                "score": rescore(ev, ref_setup),
                 "runs": summary_json(ev), "survived": ev.survived, "runs_total":
-                len(ev.outcomes), "speed_m_s": trial_speed(ev)}
+                len(ev.outcomes), "speed_m_s": trial_speed(ev),
+                "bumps_speed_m_s": ev.slowest("bumps")}
         study.set_user_attr("reference", kept)
     ref = Setup(setup.robot, setup.suite, setup.seconds, kept["target_speed"],
                 kept["baseline_energy"], setup.skip)

@@ -10,11 +10,6 @@
   (``bal_step_*``, ``bal_tempo_max``). A swinging foot follows its step target; a standing
   foot keeps its offset (moving it would push the body) until it swings again, when it
   goes back to the gait's own footstep unless a new step is needed.
-- The error is taken relative to the stance foot where the balance put it: the IK keeps
-  the torso's attitude, so a stance foot s from its own footstep puts the body -s from the
-  gait's place over it, which the torso's tilt does not see. Without this, the step after a
-  capture step planned the first one's error again (a forward push: +8 cm, then +8 cm
-  more while the body already fell back; docs/robustness.md).
 - Level swing: the pelvis turns relative to the swinging foot with the residual tilt
   (``bal_swing_level``), so a foot swinging under a torso that rolls toward it keeps its
   height over the ground and its sole flat, and lands where the step was planned instead
@@ -155,49 +150,26 @@ def _standing_level(level: Quad, g: GaitPhase) -> tuple[float, float]:
     return 0.5 * (level[0] + level[2]), 0.5 * (level[1] + level[3])
 
 
-def stance_offset(feet: Quad, g: GaitPhase, next_lift: int) -> tuple[float, float]:
-    """Where the balance put the foot the body stands on [m] (forward, left) from the
-    gait's own footstep: the one not swinging; in double support the one that stays
-    down while the other lifts next."""
-    foot = 0 if g.swinging[0] else 1 if g.swinging[1] else next_lift
-    return (feet[2], feet[3]) if foot == 0 else (feet[0], feet[1])
-
-
 def capture_step(feet: Quad, xi: tuple[float, float], p: GaitParams, g: GaitPhase,
                  next_lift: int) -> tuple[StepPlan, float]:
     """The capture step of the foot that swings now, or of the one that lifts next in
-    double support, and the phase speed-up it asks for. ``xi``: the capture point's
-    error (forward, left) [m] from where the gait puts it over the stance foot *where it
-    stands* (``step``: the torso's estimate less ``stance_offset``).
-
-    The pendulum pivots on the stance foot, s from the gait's own footstep (the leg's
-    kinematics: the IK keeps the torso's attitude, so a foot moved by s moves the body
-    by -s relative to it). The swing foot's offset from its own footstep, relative to
-    the pelvis, is then s + xi(T): the gait's step from where the stance foot stands, plus
-    the error grown until touchdown (the capture point relative to the actual foot,
-    Englsberger et al. 2015)."""
+    double support, and the phase speed-up it asks for."""
     rate = p.omega
     if not (math.isfinite(rate) and rate > 0.0) or all(g.swinging):
         return StepPlan(math.inf, 0.0, 0.0), 0.0
     foot = 0 if g.swinging[0] else 1 if g.swinging[1] else next_lift
     t_nom = swing_phase_left(g.theta, p.delta_f, foot) / rate
-    sx, sy = stance_offset(feet, g, next_lift)
     _, ry, _, ly = feet
     out = p.bal_step_max
     # Inward, a foot may use its share of the gap, and what the other foot moved out.
     reach = (Reach(out, out, out, g.inward + max(0.0, ly)) if foot == 0
              else Reach(out, out, g.inward + max(0.0, -ry), out))
-    # The room left once the foot follows the stance foot's offset.
-    room = Reach(max(0.0, reach.back + sx), max(0.0, reach.forward - sx),
-                 max(0.0, reach.right + sy), max(0.0, reach.left - sy))
     gain = p.bal_step_gain
     dxi = (gain * _dead(xi[0], p.bal_step_dead), gain * _dead(xi[1], p.bal_step_dead))
     w0 = math.sqrt(GRAVITY / max(g.height, 1e-3))
     plan = plan_step(dxi, w0=w0, t_nominal=t_nom, t_min=t_nom / (1.0 + p.bal_tempo_max),
-                     reach=room, margin=p.bal_step_dead)
-    dx = min(max(sx + plan.dx, -reach.back), reach.forward)
-    dy = min(max(sy + plan.dy, -reach.right), reach.left)
-    return StepPlan(plan.t_s, dx, dy), tempo_for(t_nom, plan.t_s)
+                     reach=reach, margin=p.bal_step_dead)
+    return plan, tempo_for(t_nom, plan.t_s)
 
 
 def _feet(feet: Quad, plan: StepPlan, p: GaitParams, g: GaitPhase, dt: float) -> Quad:
@@ -238,10 +210,8 @@ def step(state: StepState, values: tuple[float, float, float, float], p: GaitPar
     new = _standing_level(level, g)
     legs = (res[0] - new[0], res[1] - new[1], res[2] - (new[0] - old[0]) / dt,
             res[3] - (new[1] - old[1]) / dt)
+    xi = capture_error(legs, g.height)
     next_lift = 1 if g.swinging[0] else 0 if g.swinging[1] else state.next_lift
-    sx, sy = stance_offset(state.feet, g, next_lift)
-    ex, ey = capture_error(legs, g.height)
-    xi = (ex - sx, ey - sy)
     plan, want_tempo = capture_step(state.feet, xi, p, g, next_lift)
     # Latch: late in a swing the torso's tilt no longer says where the body goes (the
     # swinging foot already takes weight, the ankles push); the foot keeps the furthest

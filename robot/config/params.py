@@ -120,7 +120,7 @@ SPECS: dict[str, ParamSpec] = {
                                False),
     "bal_brace_xi": ParamSpec(0.0, 0.0, 0.2, "m", BALANCE, "capture-point error at which "
                               "the swinging foot is put down and the gait holds still (a "
-                              "mostly sagittal error waits for the foot to land; 0: never)",
+                              "mostly forward error waits for the foot to land; 0: never)",
                               False),
     "bal_brace_s": ParamSpec(0.5, 0.0, 3.0, "s", BALANCE, "the gait holds still this long "
                              "after the error was last that large", False),

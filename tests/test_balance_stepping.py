@@ -240,12 +240,33 @@ def test_a_large_capture_error_braces_and_calm_releases() -> None:
     assert corr.land == 0.0
 
 
+def test_a_forward_error_braces_once_the_swinging_foot_lands() -> None:
+    """A forward capture error of 5 cm (over bal_brace_xi = 4 cm) while the right foot
+    swings does not put that foot down mid-swing: it lands where the gait puts it, ahead,
+    and the base the body tips over is longer. With both feet down it braces. A backward
+    or a lateral error of the same size braces at once, mid-swing."""
+    p = STEP.replace({"bal_step_gain": 0.0, "bal_brace_xi": 0.04, "bal_brace_s": 0.5})
+    big = 0.05 / (H / W0)                    # h x rate / omega0 = 5 cm
+    state, corr = settle(LEARNT, LEVEL._replace(pitch_rate=big), p, SWING_R, 0.15)
+    assert corr.capture == pytest.approx((0.05, 0.0), rel=1e-9)
+    assert corr.land == 0.0 and corr.tempo == 0.0
+    _, corr = settle(state, LEVEL._replace(pitch_rate=big), p,
+                     GaitPhase(height=H, inward=1.0), 0.15)
+    assert corr.land > 0.99 and 1.0 + corr.tempo < 0.01
+    for kick, xi in ((LEVEL._replace(pitch_rate=-big), (-0.05, 0.0)),
+                     (LEVEL._replace(roll_rate=big), (0.0, -0.05))):
+        _, corr = settle(LEARNT, kick, p, SWING_R, 0.15)
+        assert corr.capture == pytest.approx(xi, rel=1e-9)
+        assert corr.land > 0.99 and 1.0 + corr.tempo < 0.01
+
+
 def test_braced_the_engine_holds_its_phase_with_both_feet_down() -> None:
     robot = load_robot("biped18-dynamixel")
     params = load_gait("walk").params.replace({"bal_brace_xi": 0.04, "bal_brace_s": 1.0,
                                                "bal_learn_cycles": 0.5, "ramp_cycles": 0.1})
     engine = GaitEngine(robot, params)
-    tilts = iter([LEVEL] * 400 + [LEVEL._replace(pitch_rate=3.0)] * 10 + [LEVEL] * 200)
+    # A sideways kick (a forward one waits for the swinging foot to land).
+    tilts = iter([LEVEL] * 400 + [LEVEL._replace(roll_rate=3.0)] * 10 + [LEVEL] * 200)
     stage = Balance(engine, lambda: next(tilts))
     engine.start()
     stage.start()

@@ -16,7 +16,8 @@
   of early, on its edge; once it stands, that turn returns to 0 in ``LEVEL_OUT_S``.
 - Hold: in double support the gait does not lift the foot the body leans onto
   (``bal_hold_xi``); brace: over ``bal_brace_xi`` both feet go down and the gait holds
-  still for ``bal_brace_s``.
+  still for ``bal_brace_s``; a mostly forward error waits for a swinging foot to land
+  first (a longer base to tip over; docs/robustness.md, issue 22).
 
 Signs: REP-103, as robot.balance.law; dxi forward / left [m], tilts +roll right side down,
 +pitch nose down [rad].
@@ -223,7 +224,13 @@ def step(state: StepState, values: tuple[float, float, float, float], p: GaitPar
     feet = _feet(state.feet, plan, p, g, dt)
     tempo = _follow(state.tempo, want_tempo, dt, TEMPO_TAU_S)
     size = math.hypot(*xi)
-    brace_s = (p.bal_brace_s if 0.0 < p.bal_brace_xi < size
+    # A mostly forward error braces only once no foot swings: set down mid-swing beside
+    # the stance foot, the swinging foot would shorten the base the body then tips over
+    # (a forward push: it pivots on the toes of two feet side by side); landing where the
+    # gait puts it, ahead, it lengthens that base. A backward or mostly lateral one braces
+    # at once (waiting for those too cost a bump case on each robot's suite).
+    may_brace = not any(g.swinging) or abs(xi[1]) > abs(xi[0]) or xi[0] < 0.0
+    brace_s = (p.bal_brace_s if 0.0 < p.bal_brace_xi < size and may_brace
                else max(0.0, state.brace_s - dt))
     brace = _follow(state.brace, 1.0 if brace_s > 0.0 else 0.0, dt,
                     BRACE_IN_S if brace_s > 0.0 else BRACE_OUT_S)

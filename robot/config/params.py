@@ -119,8 +119,9 @@ SPECS: dict[str, ParamSpec] = {
                                "by stepping and tempo (the walk's own unlearned rocking)",
                                False),
     "bal_brace_xi": ParamSpec(0.0, 0.0, 0.2, "m", BALANCE, "capture-point error at which "
-                              "the swinging foot is put down and the gait holds still (0: "
-                              "never)", False),
+                              "the swinging foot is put down and the gait holds still (a "
+                              "mostly forward error waits for the foot to land; 0: never)",
+                              False),
     "bal_brace_s": ParamSpec(0.5, 0.0, 3.0, "s", BALANCE, "the gait holds still this long "
                              "after the error was last that large", False),
     "bal_hold_xi": ParamSpec(0.0, 0.0, 0.2, "m", BALANCE, "lateral capture-point error "

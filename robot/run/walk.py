@@ -23,6 +23,7 @@ from robot.motion.scripted import RecordingEngine
 from robot.motion.takes import TakeHeader, is_take
 from robot.run.result import RunResult
 from robot.run.spec import Recording, RunOptions, RunSpec
+from robot.run.switching import PresetSwitch, PresetSwitcher
 
 log = logging.getLogger(__name__)
 
@@ -52,10 +53,12 @@ def walk_imu(robot: RobotConfig, bus: Bus, *, balance: bool = True,
 
 def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
               imu: Imu | None = None, keyframes: Sequence | None = None,
-              record: str | None = None, options: RunOptions | None = None) -> RunSpec[GaitEngine]:
+              record: str | None = None, options: RunOptions | None = None,
+              switches: tuple[PresetSwitch, ...] = ()) -> RunSpec[GaitEngine]:
     """The run of a walk with ``params`` (preset ``gait``, for a take's header), a
-    keyframe layer on the arms, and a recording (NAME.take.jsonl: the parameter
-    timeline; .csv or .jsonl: the joint stream)."""
+    keyframe layer on the arms, a recording (NAME.take.jsonl: the parameter
+    timeline; .csv or .jsonl: the joint stream) and preset ``switches`` (blended live,
+    robot.run.switching; not with a take: its timeline records parameter changes only)."""
     options = options or RunOptions()
     recorder: Recording | None = None
     engine: GaitEngine
@@ -72,8 +75,12 @@ def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
             recorder = Recorder(record, robot.joint_names, robot.ids)
         engine = (LayeredEngine(robot, params, keyframes=keyframes) if keyframes
                   else GaitEngine(robot, params))
+    if switches and isinstance(recorder, TakeWriter):
+        raise ConfigError("--switch cannot be recorded in a take (its timeline holds "
+                          "parameter changes); record a .csv or .jsonl instead")
     return RunSpec(robot=robot, source=engine, bus=bus, options=options, imu=imu,
-                   recorder=recorder)
+                   recorder=recorder,
+                   observer=PresetSwitcher(engine, switches) if switches else None)
 
 
 #: A walk whose heading changes by more than this [deg per minute of the run] beyond what
@@ -92,6 +99,11 @@ def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *,
     out = {"robot": spec.robot.name, "gait": gait, "bus": spec.bus.kind,
            "seconds": spec.options.seconds, "balance": spec.imu is not None,
            **result.as_dict()}
+    if isinstance(spec.observer, PresetSwitcher):
+        out["switches"] = spec.observer.as_list()
+    feet = out.get("feet")
+    if isinstance(feet, dict) and "flight_share" in feet:   # the sim's: per gait cycle
+        feet["flight_s_per_cycle"] = feet["flight_share"] * spec.source.params.cycle_s
     engine, rate = spec.source, result.stats.rate_hz
     out["ik_unreachable_s"] = engine.unreachable_ticks / rate if rate else 0.0
     out["clamped_joints_s"] = {name: n / rate for name, n in

@@ -64,6 +64,8 @@ class Condition:
             out += ["--friction", f"{w.friction_scale:g}"]
         if w.mass_scale != 1.0:
             out += ["--mass-scale", f"{w.mass_scale:g}"]
+        if w.stairs_count:
+            out += ["--stairs", f"{w.stairs_height_m:g},{w.stairs_count}"]
         for name, value in self.changes:
             out += ["--set", f"{name}={value!r}"]
         if self.imu_noise is not None:

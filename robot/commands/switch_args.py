@@ -4,11 +4,14 @@ live (robot.run.switching, robot.gait.blend; docs/gait.md "Switching presets liv
 from __future__ import annotations
 
 import argparse
+import logging
 
 from robot.config.gait_file import load_gait
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.run.switching import PresetSwitch
+
+log = logging.getLogger(__name__)
 
 #: Latest gait time a switch may name [s] (as --push).
 SWITCH_MAX_S = 1e6
@@ -44,5 +47,7 @@ def switches_from(args: argparse.Namespace, robot: RobotConfig) -> tuple[PresetS
             gait = load_gait(name)
         except ConfigError as e:
             raise ConfigError(f"--switch {t:g}:{name}: {str(e).removeprefix('--gait: ')}") from e
+        if gait.warning:
+            log.warning("--switch %g:%s: gait %r: %s", t, name, gait.name, gait.warning)
         out.append(PresetSwitch(t, gait.name, gait.for_robot(robot)))
     return tuple(out)

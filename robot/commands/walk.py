@@ -83,6 +83,8 @@ def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
     gait, params = params_from(args, robot)
     switches = switches_from(args, robot)
+    if gait.warning:
+        log.warning("gait %r: %s", gait.name, gait.warning)
     kind = args.bus or "sim"
     if kind != "sim" and (args.view or args.realtime or args.stop_on_fall):
         raise ConfigError("--view, --realtime and --stop-on-fall apply to --bus sim only")
@@ -102,6 +104,8 @@ def run(args: argparse.Namespace) -> int:
                          seconds=args.seconds, stop_on_fall=args.stop_on_fall, signals=True),
                      switches=switches)
     result = walk_summary(spec, execute(spec), gait=gait.name)
+    if gait.warning:
+        result["gait_warning"] = gait.warning
     if args.json:
         print(json.dumps(result))
     else:

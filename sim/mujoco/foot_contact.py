@@ -2,8 +2,8 @@
 
 A foot is on the ground when its sole geom (``r_foot`` / ``l_foot``, sim.mujoco.mjcf_robot)
 has a contact with a geom outside the robot (the floor, a bump, a stair step). Sampled once
-per control tick while the gait walks (the ramp in and out included, the ramps to and from
-the start pose not), so times are multiples of the tick; the time with no foot on the
+per control tick while the gait walks, until a fall (the gait's ramp in and out included,
+the ramps to and from the start pose not), so times are multiples of the tick; the time with no foot on the
 ground is the flight phase (a jog has none, a run has one per step).
 """
 

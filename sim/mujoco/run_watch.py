@@ -39,7 +39,7 @@ class SimRunWatch:
     def __call__(self, tel: Telemetry) -> None:
         self.monitor.update_qpos(tel.t, self._qpos[:7].tolist())
         self.effort.update(tel.t)
-        if tel.state == "walking":
+        if tel.state == "walking" and not self.monitor.fell:   # on its feet, walking
             self.feet.update(tel.t)
         if self.pushes is not None:
             self.pushes(tel)

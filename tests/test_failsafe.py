@@ -24,9 +24,13 @@ from waiting import sleep_until, wait_for
 
 from robot.bus.base import Bus
 from robot.bus.sdk_bus import SdkBus
+from robot.bus.servo_map import ServoMap
 from robot.bus.tables import TABLES
+from robot.config.gait_file import load_gait
 from robot.config.robot import RobotConfig
 from robot.errors import BusError, ConfigError
+from robot.gait.engine import GaitEngine
+from robot.loop.streamer import Streamer
 from robot.loop.watchdog import FAILSAFE_MARGIN
 from sim.emulator.chain import Emulator, Packet
 
@@ -299,3 +303,34 @@ def test_register_range_and_reboot_as_the_manual_says(bus: SdkBus, emu: Emulator
     bus.packet_handler.reboot(bus.port_handler, KNEE)   # RAM back to its initial value 0
     regs = emu.registers(KNEE)
     assert regs["bus_watchdog"] == 0 and regs["torque_enable"] == 0
+
+
+class StallingEngine(GaitEngine):
+    """A gait engine whose host stalls once, ``STALL_S`` inside one tick after ``stall_at``
+    ticks (swap, a full SD card, another process on the core): the injected fault."""
+
+    stall_at = 400                      # 2 s of walking at 200 Hz
+
+    def tick(self, dt: float) -> list[float]:
+        self.stall_at -= 1
+        if self.stall_at == 0:
+            sleep_until(time.monotonic() + STALL_S)
+        return super().tick(dt)
+
+
+STALL_S = 0.5                           # 5 x the 100 ms the run arms
+
+
+@pytest.mark.parametrize("protocol", ["dynamixel"])
+def test_a_host_stall_that_trips_the_watchdog_is_named_as_such(
+        bus: SdkBus, emu: Emulator, robot: RobotConfig) -> None:
+    """The servos refuse goals after the trip, so the loop finds them not following; the
+    stop reason names their tripped watchdog (not a jam), and the end leaves torque off and
+    the watchdog cleared, judged at the emulator's registers."""
+    engine = StallingEngine(robot, load_gait("walk").params)
+    stats = Streamer(ServoMap(robot), bus, engine, rate_hz=200.0).run(seconds=20)
+    assert stats.fault and "stopped following" in stats.stop_reason
+    assert "bus watchdog tripped on servo" in stats.stop_reason, stats.stop_reason
+    assert "the host stalled" in stats.stop_reason and "\n" not in stats.stop_reason
+    assert {emu.registers(i)["torque_enable"] for i in robot.ids} == {0}
+    assert {emu.registers(i)["bus_watchdog"] for i in robot.ids} == {0}

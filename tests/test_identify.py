@@ -137,3 +137,21 @@ def test_a_bad_log_is_one_line_and_exit_2(tmp_path: Path, content: str, message:
     assert cli.main(["identify", "check", str(bad), "--model", "STS3250"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and message in err and str(bad) in err
+
+
+def test_a_fit_started_at_the_truth_never_ends_worse_than_it_began(tmp_path: Path) -> None:
+    """One CMA-ES generation samples around the start, never the start itself: from the
+    model that made the logs (replay error 0 by construction), any sample is worse, so the
+    result must be the start, its error the start's replayed here."""
+    truth = ServoPhysics(name="XL330-M288", law="dynamixel_x", kt=0.3, resistance=4.5,
+                         armature=0.002, coulomb=0.02, viscous=0.01, nominal_voltage=7.4,
+                         gain_scale=0.5)
+    logs = [read_log(p) for p in _synthetic_logs(truth, tmp_path)[:2]]
+    params = ("kt", "coulomb")
+    result = fit_physics(logs, MODELS["XL330-M288"], truth, params=params, trials=1, seed=3)
+    bench = PendulumBench(logs, MODELS["XL330-M288"])
+    at_start = float(bench.errors(bench.replay(truth))[0].mean())
+    assert at_start < 1e-3
+    assert result.train_error == pytest.approx(at_start, abs=1e-12)
+    for name in params:
+        assert getattr(result.physics, name) == pytest.approx(getattr(truth, name), rel=1e-12)

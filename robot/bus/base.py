@@ -103,6 +103,11 @@ class Bus(ABC):
         """
         return None
 
+    def failsafe_tripped(self, ids: Iterable[int]) -> list[int]:
+        """Which of ``ids`` have their armed watchdog tripped (they then refuse goals until
+        it is disarmed). This default is for buses without one: none."""
+        return []
+
     def disarm_failsafe(self, ids: Iterable[int]) -> None:
         """Disarm it (and clear a tripped watchdog) so the servos accept goals again; no-op
         when there is none. This default is for buses without one: it does nothing."""

@@ -53,6 +53,14 @@ def arm(bus: SdkRegisters, wd: CommWatchdog, ids: Iterable[int], timeout_s: floa
     return steps * wd.unit_s
 
 
+def tripped(bus: SdkRegisters, wd: CommWatchdog, ids: Iterable[int]) -> list[int]:
+    """The ids among ``ids`` we armed whose ``wd`` register reads its tripped value (a
+    signed value: the register reads unsigned, -1 is 255 in one byte)."""
+    raw = wd.tripped % (1 << 8 * bus.table[wd.register].size)
+    return [sid for sid in sorted(set(ids) & bus.failsafe_armed)
+            if bus.read_register(sid, wd.register) == raw]
+
+
 def disarm(bus: SdkRegisters, wd: CommWatchdog, ids: Iterable[int]) -> None:
     """Write ``wd.off`` on every id: disarms the watchdog and clears a trip."""
     def one(sid: int) -> None:

@@ -245,6 +245,10 @@ class Session(Bus):
         with self.lease.io:
             return self.lease.bus.arm_failsafe(ids, timeout_s=timeout_s)
 
+    def failsafe_tripped(self, ids: Iterable[int]) -> list[int]:
+        with self.lease.io:
+            return self.lease.bus.failsafe_tripped(ids)
+
     def disarm_failsafe(self, ids: Iterable[int]) -> None:
         with self.lease.io:
             self.lease.bus.disarm_failsafe(ids)

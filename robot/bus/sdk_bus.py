@@ -198,6 +198,10 @@ class SdkBus(SdkRegisters, Bus):
         wd = COMM_WATCHDOG[self.family]
         return None if wd is None else failsafe.arm(self, wd, ids, timeout_s)
 
+    def failsafe_tripped(self, ids: Iterable[int]) -> list[int]:
+        wd = COMM_WATCHDOG[self.family]
+        return [] if wd is None else failsafe.tripped(self, wd, ids)
+
     def disarm_failsafe(self, ids: Iterable[int]) -> None:
         wd = COMM_WATCHDOG[self.family]
         if wd is not None:

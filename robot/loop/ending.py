@@ -31,6 +31,25 @@ def arm_failsafe(bus: Bus, ids: Sequence[int], failsafe_s: float | None, *,
             log.info("servo bus watchdog armed: %.2f s", armed)
 
 
+def explain_stop(bus: Bus, ids: Sequence[int], error: SafetyStop,
+                 describe: Callable[[int], str]) -> str:
+    """``error``'s message, with the cause when servos stopped following because their own
+    bus watchdog tripped: the host sent them nothing for longer than its timeout (a stall:
+    swap, another process, a full SD card), so they refused every goal since. ``describe``
+    names a servo id. A bus that cannot tell leaves the message as it is."""
+    if "stopped following" not in str(error):
+        return str(error)
+    try:
+        tripped = bus.failsafe_tripped(ids)
+    except BusError:
+        return str(error)
+    if not tripped:
+        return str(error)
+    names = ", ".join(describe(i) for i in tripped)
+    return (f"the servos' own bus watchdog tripped on {names}: no packet reached them within "
+            f"its timeout (the host stalled), so they refused every goal since ({error})")
+
+
 #: What a run's end left the servos doing, as far as the bus told (LoopStats.torque):
 #: "on": holding (every step answered); "off": torque off, confirmed servo by servo;
 #: "sent": the torque-off packet went out but no servo confirmed it (the bus stopped

@@ -40,7 +40,7 @@ from robot.config.params import GaitParams
 from robot.config.read_back import max_read_every
 from robot.errors import BusDead, BusError, ConfigError, SafetyStop
 from robot.loop.clock import Clock, MonotonicClock, Pacer
-from robot.loop.ending import arm_failsafe, end
+from robot.loop.ending import arm_failsafe, end, explain_stop
 from robot.loop.latency import SampleStats
 from robot.loop.source import Feedback, JointTargets, JointVector, MotionSource, SourceT
 from robot.loop.start_check import check_inside_limits
@@ -140,7 +140,7 @@ class Streamer(Generic[SourceT]):
             self._stream(seconds)
         except SafetyStop as e:                  # the watchdog: unsafe or impossible to drive
             self._bus_dead = isinstance(e, BusDead)
-            self._set_fault(f"watchdog: {e}")
+            self._set_fault(f"watchdog: {explain_stop(self.bus, ids, e, self.watchdog.name)}")
         except Exception as e:
             log.exception("the control loop failed")
             self._set_fault(f"exception: {type(e).__name__}: {e}")

@@ -63,7 +63,8 @@ class Watchdog:
         self._follow_streak = np.zeros(len(servo_map.ids), dtype=int)
         self._follow = FollowCheck(servo_map, read_period_s=read_period_s)
 
-    def _joint(self, servo_id: int) -> str:
+    def name(self, servo_id: int) -> str:
+        """'servo 4 (r_knee)': a servo as messages name it."""
         j = self.robot.joint_by_id(servo_id) if self.robot else None
         return f"servo {servo_id}" + (f" ({j.name})" if j else "")
 
@@ -98,9 +99,9 @@ class Watchdog:
         for sid, s in states.items():
             bad = sorted(s.errors & FAULTS)
             if bad:
-                raise SafetyStop(f"{self._joint(sid)} reports {', '.join(bad)}")
+                raise SafetyStop(f"{self.name(sid)} reports {', '.join(bad)}")
             if s.temperature is not None and s.temperature > self.cfg.max_temperature_c:
-                raise SafetyStop(f"{self._joint(sid)} at {s.temperature:.0f} °C "
+                raise SafetyStop(f"{self.name(sid)} at {s.temperature:.0f} °C "
                                  f"(limit {self.cfg.max_temperature_c:.0f} °C)")
 
     def _following(self, states: Mapping[int, ServoState],
@@ -109,7 +110,7 @@ class Watchdog:
         stuck = self._follow.add(q_cmd, present)
         if stuck is not None:
             i, r_goal, r_present = stuck
-            raise SafetyStop(f"{self._joint(self.map.ids[i])} stopped following: its goal "
+            raise SafetyStop(f"{self.name(self.map.ids[i])} stopped following: its goal "
                              f"moved over {r_goal:.2f} rad in {self._follow.window_s:.2g} s, "
                              f"it moved {r_present:.3f} rad (jammed or blocked)")
         err = np.abs(present - q_cmd)
@@ -118,5 +119,5 @@ class Watchdog:
         worst = int(np.argmax(self._follow_streak))
         if self._follow_streak[worst] >= self.cfg.follow_reads:
             sid = self.map.ids[worst]
-            raise SafetyStop(f"{self._joint(sid)} stopped following: {err[worst]:.2f} rad "
+            raise SafetyStop(f"{self.name(sid)} stopped following: {err[worst]:.2f} rad "
                              f"from its goal for {self._follow_streak[worst]} read-backs")

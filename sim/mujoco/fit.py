@@ -39,7 +39,8 @@ DEFAULT_PARAMS = ("gain_scale", "kt", "resistance", "armature", "coulomb", "visc
 @dataclass(frozen=True)
 class FitResult:
     """physics: the fitted model; offset: the rig's mounting offset [rad];
-    train_error: mean replay error on the training logs [rad]; trials: how many ran."""
+    train_error: mean replay error on the training logs [rad] (never above the start's:
+    the start is replayed too); trials: how many replays ran, the start's included."""
 
     physics: ServoPhysics
     offset: float
@@ -102,8 +103,15 @@ def fit_physics(logs: Sequence[PendulumLog], servo: ServoModel, start: ServoPhys
         if progress is not None:
             progress(generation, float(study.best_value))
     best = study.best_params
+    # CMA-ES samples around the start but never replays the start itself: a short search
+    # can end worse than where it began, and then the start is the result.
+    started, start_offset = physics_of(x0), x0.get("offset", offset)
+    start_error = float(bench.errors(bench.replay(started, offset=start_offset))[0].mean())
+    if start_error <= study.best_value:
+        return FitResult(physics=started, offset=start_offset, train_error=start_error,
+                         trials=len(study.trials) + 1)
     return FitResult(physics=physics_of(best), offset=float(best.get("offset", offset)),
-                     train_error=float(study.best_value), trials=len(study.trials))
+                     train_error=float(study.best_value), trials=len(study.trials) + 1)
 
 
 def replay_errors(logs: Sequence[PendulumLog], servo: ServoModel, physics: ServoPhysics, *,

@@ -7,13 +7,16 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from pathlib import Path
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 import numpy as np  # noqa: E402
 import numpy.typing as npt  # noqa: E402
 import pytest  # noqa: E402
+from waiting import wait_for  # noqa: E402
 
+import robot.cli as cli  # noqa: E402
 from robot.bus.factory import make_bus  # noqa: E402
 from robot.config.gait_file import load_gait  # noqa: E402
 from robot.config.robot import RobotConfig  # noqa: E402
@@ -21,6 +24,9 @@ from robot.config.robot_file import load_robot  # noqa: E402
 from robot.gait.blend import PRESET_BLEND_S, Blend, min_jerk  # noqa: E402
 from robot.gait.engine import GaitEngine  # noqa: E402
 from robot.loop.telemetry import Telemetry  # noqa: E402
+from robot.motion.takes import read_take  # noqa: E402
+from robot.panel.controller import BusSpec, LoopOptions, make_controller  # noqa: E402
+from robot.panel.studio import Studio  # noqa: E402
 from robot.run.run import execute  # noqa: E402
 from robot.run.spec import RunOptions  # noqa: E402
 from robot.run.switching import PresetSwitch, PresetSwitcher  # noqa: E402
@@ -136,3 +142,40 @@ def test_walk_jog_crouch_walk_in_the_sim(name: str, balance: bool) -> None:
     assert not r["fell"] and r["stop_reason"] == "completed"
     if not balance:
         assert worst[0] < 0.999
+
+
+def test_a_switch_is_recorded_in_a_take_and_replays_exactly(tmp_path: Path) -> None:
+    """`biped walk --switch` records the switch as a blend line; `biped play` replays it
+    to the same joint stream."""
+    take, replay = tmp_path / "switch.take.jsonl", tmp_path / "replay.take.jsonl"
+    assert cli.main(["walk", "--seconds", "4", "--switch", "3:crouch", "--record",
+                     str(take)]) == 0
+    assert cli.main(["play", str(take), "--record", str(replay)]) == 0
+    a, b = read_take(take), read_take(replay)
+    # seen after the tick at gait time 3 s was written: it shapes the next one
+    assert list(a.blends) == [round(3.0 * RATE) + 1] == list(b.blends)
+    assert a.blends[601]["Hhgt"] == load_gait("crouch").params.Hhgt
+    assert a.q.shape == b.q.shape and np.max(np.abs(a.q - b.q)) <= 1e-6
+
+
+def test_the_panels_preset_picker_blends_while_walking(tmp_path: Path) -> None:
+    """The panel's preset switch goes to the loop as a blend (the take says "blend"), and
+    the walk goes on."""
+    robot = load_robot("biped18-dynamixel")
+    controller = make_controller(robot, BusSpec("sim"), load_gait("walk").params,
+                                 options=LoopOptions(rate_hz=100.0, read_every=5),
+                                 preset="walk")
+    studio = Studio(controller, takes_dir=tmp_path / "takes", keys_dir=tmp_path / "keys")
+    try:
+        name = studio.record("switch")
+        wait_for(lambda: int(controller.state()["tick"]) >= 300)
+        assert controller.load_preset("crouch").Hhgt == load_gait("crouch").params.Hhgt
+        at = int(controller.state()["tick"])
+        wait_for(lambda: int(controller.state()["tick"]) >= at + 200)
+        assert controller.running, controller.state()
+        controller.stop()
+        assert controller.wait(30) and not controller.last_stats.fault  # type: ignore[union-attr]
+    finally:
+        controller.shutdown(timeout=5)
+    take = read_take(tmp_path / "takes" / f"{name}.take.jsonl")
+    assert len(take.blends) == 1 and not take.changes

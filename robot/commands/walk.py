@@ -131,7 +131,7 @@ def format_summary(r: dict[str, Any]) -> str:
         feet = r.get("feet")
         if feet:
             lines.append(f"  feet          at least {feet['fewest_feet_down']} on the ground, flight "
-                         f"{feet.get('flight_s_per_cycle', 0.0) * 1e3:.0f} ms per cycle")
+                         f"{r.get('flight_s_per_cycle', 0.0) * 1e3:.0f} ms per cycle")
         if r.get("clamped_joints_s") or r.get("ik_unreachable_s"):
             lines.append(f"  joint limits  {clamp_words(r)}")
         world = describe_world(r.get("world"))

@@ -58,7 +58,7 @@ def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
     """The run of a walk with ``params`` (preset ``gait``, for a take's header), a
     keyframe layer on the arms, a recording (NAME.take.jsonl: the parameter
     timeline; .csv or .jsonl: the joint stream) and preset ``switches`` (blended live,
-    robot.run.switching; not with a take: its timeline records parameter changes only)."""
+    robot.run.switching; a take records them as blends)."""
     options = options or RunOptions()
     recorder: Recording | None = None
     engine: GaitEngine
@@ -75,9 +75,6 @@ def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
             recorder = Recorder(record, robot.joint_names, robot.ids)
         engine = (LayeredEngine(robot, params, keyframes=keyframes) if keyframes
                   else GaitEngine(robot, params))
-    if switches and isinstance(recorder, TakeWriter):
-        raise ConfigError("--switch cannot be recorded in a take (its timeline holds "
-                          "parameter changes); record a .csv or .jsonl instead")
     return RunSpec(robot=robot, source=engine, bus=bus, options=options, imu=imu,
                    recorder=recorder,
                    observer=PresetSwitcher(engine, switches) if switches else None)
@@ -95,7 +92,9 @@ def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *,
     the heading the gait asked for, the drift beyond it per minute and whether that is
     more than ``HEADING_DRIFT_DEG_MIN``; the time [s, at the loop's rate] the IK met an
     unreachable target (``ik_unreachable_s``) and each joint was held at a limit
-    (``clamped_joints_s``: only those that were)."""
+    (``clamped_joints_s``: only those that were); where the bus counted the feet on the
+    ground (simulation), the flight time per gait cycle (``flight_s_per_cycle``); the
+    preset switches made (``switches``)."""
     out = {"robot": spec.robot.name, "gait": gait, "bus": spec.bus.kind,
            "seconds": spec.options.seconds, "balance": spec.imu is not None,
            **result.as_dict()}
@@ -103,7 +102,7 @@ def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *,
         out["switches"] = spec.observer.as_list()
     feet = out.get("feet")
     if isinstance(feet, dict) and "flight_share" in feet:   # the sim's: per gait cycle
-        feet["flight_s_per_cycle"] = feet["flight_share"] * spec.source.params.cycle_s
+        out["flight_s_per_cycle"] = feet["flight_share"] * spec.source.params.cycle_s
     engine, rate = spec.source, result.stats.rate_hz
     out["ik_unreachable_s"] = engine.unreachable_ticks / rate if rate else 0.0
     out["clamped_joints_s"] = {name: n / rate for name, n in

@@ -137,6 +137,9 @@ def format_summary(r: dict[str, Any]) -> str:
         world = describe_world(r.get("world"))
         if world:
             lines.append(f"  world         {world}")
+    if r.get("switches"):
+        lines.append("  switches      " + ", ".join(f"to {s['preset']} at {s['at_s']:g} s"
+                                                   for s in r["switches"]))
     lines += [
         f"  loop          {r['ticks']} ticks at {r['rate_hz']:g} Hz"
         f" (achieved {r['achieved_hz']:.1f} Hz), period error"

@@ -12,6 +12,7 @@ import pytest
 
 from robot.config.gait_file import load_gait
 from robot.config.params import SPECS
+from robot.tuning.conditions import STAIRS_REACH_M, STAIRS_S, SWITCHES_S
 from robot.tuning.robustness import (
     PUSH_AT_S,
     STRAIGHT_S,
@@ -45,7 +46,7 @@ def test_the_full_suite_has_every_group_of_the_issue() -> None:
     assert groups == {"flat", "slope", "cross slope", "bumps", "push forward",
                       "push backward", "push left", "push right", "push 1.5 N*s",
                       "params +/-20 %", "latency", "imu noise", "flat 60 s", "friction",
-                      "mass"}
+                      "mass", "stairs", "preset switches"}
     hard = [c for c in conditions(WALK) if c.group == "push 1.5 N*s"]
     pushes = [c for c in conditions(WALK) if c.group.startswith("push ")
               and c not in hard]
@@ -61,7 +62,12 @@ def test_the_full_suite_has_every_group_of_the_issue() -> None:
     assert times[0] == PUSH_AT_S
     assert times[-1] == pytest.approx(PUSH_AT_S + 0.75 * WALK.cycle_s, abs=1e-3)
     long = [c for c in conditions(WALK) if c.seconds is not None]
-    assert [c.seconds for c in long] == [STRAIGHT_S]
+    assert [c.seconds for c in long] == [STRAIGHT_S, STAIRS_S, SWITCHES_S]
+    stairs, switches = long[1:]
+    assert stairs.args == ("--stairs", "0.015,3") and stairs.reach_m == STAIRS_REACH_M
+    assert switches.args == ("--switch", "4:jog", "--switch", "7:crouch",
+                             "--switch", "10:walk")
+    assert not {"stairs", "preset switches"} & {c.group for c in conditions(WALK, quick=True)}
 
 
 def test_straightness_judges_heading_and_drift_against_the_goal() -> None:

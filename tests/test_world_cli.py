@@ -34,6 +34,13 @@ def run_walk(argv: list[str], capsys: pytest.CaptureFixture[str],
     (["--latency", "150"], ("--latency", "'150'", "[0, 100] ms")),
     (["--friction", "0.1"], ("--friction", "'0.1'", "[0.2, 3]")),
     (["--mass-scale", "2.5"], ("--mass-scale", "'2.5'", "[0.5, 2]")),
+    (["--stairs", "0.015"], ("--stairs", "'0.015'", "H,N")),
+    (["--stairs", "0.06,3"], ("--stairs", "'0.06,3'", "(0, 0.05] m")),
+    (["--stairs", "0,3"], ("--stairs", "'0,3'", "(0, 0.05] m")),
+    (["--stairs", "0.015,0"], ("--stairs", "'0.015,0'", "[1, 10]")),
+    (["--stairs", "0.015,2.5"], ("--stairs", "'0.015,2.5'", "[1, 10]")),
+    (["--switch", "x:jog"], ("--switch", "'x:jog'", "T:PRESET")),
+    (["--switch", "3:"], ("--switch", "'3:'", "T:PRESET")),
 ])
 def test_a_bad_value_is_one_line_naming_option_value_and_range(
         argv: list[str], needles: tuple[str, ...], capsys: pytest.CaptureFixture[str],
@@ -81,7 +88,8 @@ def test_json_world_defaults_without_options(capsys: pytest.CaptureFixture[str],
     w = json.loads(out)["world"]
     assert w == {"slope_deg": 0.0, "cross_slope_deg": 0.0, "bumps_mm": 0.0,
                  "terrain_seed": 0, "pushes": [], "latency_s": 0.0, "friction_scale": 1.0,
-                 "mass_scale": 1.0, "pushes_applied": []}
+                 "mass_scale": 1.0, "stairs_height_m": 0.0, "stairs_count": 0,
+                 "pushes_applied": []}
 
 
 def test_stop_on_fall_ends_the_walk_at_the_fall(capsys: pytest.CaptureFixture[str],

@@ -132,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
             args.no_balance = not args.balance
         else:
             args.no_balance = args.no_balance or not h.balance
-            engine = PlaybackEngine(robot, h.params, changes=take.changes, stop_tick=stop,
+            engine = PlaybackEngine(robot, h.params, changes=take.changes, blends=take.blends, stop_tick=stop,
                                     keyframes=layer)
         rate, read_every, limit = h.rate_hz, h.read_every, None
         header = h
@@ -180,8 +180,10 @@ def run(args: argparse.Namespace) -> int:
     try:
         with playing:
             if isinstance(writer, TakeWriter) and isinstance(engine, PlaybackEngine):
-                for k, step in sorted(take.changes.items()):
-                    writer.event(k, set=dict(step))
+                timeline = [(k, "blend", b) for k, b in take.blends.items()] + \
+                    [(k, "set", c) for k, c in take.changes.items()]
+                for k, kind_, step in sorted(timeline, key=lambda e: (e[0], e[1])):
+                    writer.event(k, **{kind_: dict(step)})
                 writer.event(stop, stop=True)
             playing.stream()
     finally:

@@ -22,6 +22,7 @@ from robot.commands.common import (
     robot_from,
     seconds,
 )
+from robot.commands.switch_args import add_switch_arg, switches_from
 from robot.commands.world_args import add_world_args, describe_world, world_from
 from robot.config.read_back import MAX_READ_PERIOD_S, check_read_every, max_read_every
 from robot.errors import ConfigError
@@ -73,6 +74,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                    help="sim: end the walk as soon as the robot falls (torque off at once, "
                         "as a fall detector on a real robot would)")
     add_set_arg(p)
+    add_switch_arg(p)
     add_world_args(p)
     return p
 
@@ -80,6 +82,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
 def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
     gait, params = params_from(args, robot)
+    switches = switches_from(args, robot)
+    if gait.warning:
+        log.warning("gait %r: %s", gait.name, gait.warning)
     kind = args.bus or "sim"
     if kind != "sim" and (args.view or args.realtime or args.stop_on_fall):
         raise ConfigError("--view, --realtime and --stop-on-fall apply to --bus sim only")
@@ -96,8 +101,11 @@ def run(args: argparse.Namespace) -> int:
     spec = walk_spec(robot, params, bus, gait=gait.name, imu=imu, keyframes=layer,
                      record=args.record, options=RunOptions(
                          rate_hz=args.rate, read_every=every, hold=args.hold,
-                         seconds=args.seconds, stop_on_fall=args.stop_on_fall, signals=True))
+                         seconds=args.seconds, stop_on_fall=args.stop_on_fall, signals=True),
+                     switches=switches)
     result = walk_summary(spec, execute(spec), gait=gait.name)
+    if gait.warning:
+        result["gait_warning"] = gait.warning
     if args.json:
         print(json.dumps(result))
     else:
@@ -120,11 +128,18 @@ def format_summary(r: dict[str, Any]) -> str:
             f"  fell          {fell} (lowest torso {r['min_torso_height_m']:.3f} m,"
             f" max tilt {r['max_tilt_deg']:.1f} deg)",
         ]
+        feet = r.get("feet")
+        if feet:
+            lines.append(f"  feet          at least {feet['fewest_feet_down']} on the ground, flight "
+                         f"{r.get('flight_s_per_cycle', 0.0) * 1e3:.0f} ms per cycle")
         if r.get("clamped_joints_s") or r.get("ik_unreachable_s"):
             lines.append(f"  joint limits  {clamp_words(r)}")
         world = describe_world(r.get("world"))
         if world:
             lines.append(f"  world         {world}")
+    if r.get("switches"):
+        lines.append("  switches      " + ", ".join(f"to {s['preset']} at {s['at_s']:g} s"
+                                                   for s in r["switches"]))
     lines += [
         f"  loop          {r['ticks']} ticks at {r['rate_hz']:g} Hz"
         f" (achieved {r['achieved_hz']:.1f} Hz), period error"

@@ -1,5 +1,5 @@
 """`biped walk` perturbation options (sim only): slope, bumps, pushes, latency, friction,
-mass. Parsed and range-checked here at parse time (one line, exit 2); turned into a
+mass, stairs. Parsed and range-checked here at parse time (one line, exit 2); turned into a
 ``robot.config.world.World`` by ``world_from``. Units and sign conventions:
 ``robot.config.world`` and docs/robustness.md."""
 
@@ -18,7 +18,7 @@ DEFAULTS: dict[str, tuple[str, Any]] = {
     "--slope": ("slope", 0.0), "--cross-slope": ("cross_slope", 0.0),
     "--bumps": ("bumps", 0.0), "--terrain-seed": ("terrain_seed", 0), "--push": ("push", []),
     "--latency": ("latency", 0.0), "--friction": ("friction", 1.0),
-    "--mass-scale": ("mass_scale", 1.0),
+    "--mass-scale": ("mass_scale", 1.0), "--stairs": ("stairs", (0.0, 0)),
 }
 
 def _float(key: str, what: str) -> Any:
@@ -40,6 +40,22 @@ def push_spec(text: str) -> tuple[float, float, float]:
         raise argparse.ArgumentTypeError(
             f"expected T:JX,JY with T in {t} and JX, JY in {jx} (e.g. 8:1.0,0), got {text!r}")
     return values
+
+
+def stairs_spec(text: str) -> tuple[float, int]:
+    """An argparse type: ``H,N`` → (step height [m] above 0, number of steps up and then
+    down, at least 1)."""
+    h_text, _, n_text = text.partition(",")
+    h, n = RANGES["stairs_height"], RANGES["stairs_count"]
+    try:
+        height, count = float(h_text), int(n_text)
+    except ValueError:
+        height, count = float("nan"), 0
+    if not (0.0 < height <= h.hi and 1 <= count <= n.hi):  # false for nan
+        raise argparse.ArgumentTypeError(
+            f"expected H,N with H in (0, {h.hi:g}] m and N an integer in [1, {n.hi:g}] "
+            f"(e.g. 0.015,3), got {text!r}")
+    return height, count
 
 
 def add_world_args(p: argparse.ArgumentParser) -> None:
@@ -66,6 +82,9 @@ def add_world_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--mass-scale", type=_float("mass_scale", "a mass scale"), default=1.0,
                    metavar="SCALE", help=f"scale every body's mass and inertia "
                    f"{RANGES['mass_scale']}")
+    g.add_argument("--stairs", type=stairs_spec, default=(0.0, 0), metavar="H,N",
+                   help="N steps of height H [m] up ahead of the robot, a landing, N steps "
+                   "down (e.g. 0.015,3)")
 
 
 def given(args: argparse.Namespace) -> list[str]:
@@ -86,7 +105,8 @@ def world_from(args: argparse.Namespace, kind: str) -> World | None:
                  bumps_mm=args.bumps, terrain_seed=args.terrain_seed,
                  pushes=tuple(Push(t, jx, jy) for t, jx, jy in args.push),
                  latency_s=args.latency * MS, friction_scale=args.friction,
-                 mass_scale=args.mass_scale)
+                 mass_scale=args.mass_scale, stairs_height_m=args.stairs[0],
+                 stairs_count=args.stairs[1])
 
 
 def describe_world(w: dict[str, Any] | None) -> str | None:
@@ -106,4 +126,7 @@ def describe_world(w: dict[str, Any] | None) -> str | None:
         parts.append(f"friction x{w['friction_scale']:g}")
     if w["mass_scale"] != 1.0:
         parts.append(f"mass x{w['mass_scale']:g}")
+    if w.get("stairs_count"):
+        parts.append(f"stairs {w['stairs_count']} x {w['stairs_height_m'] * 1e3:g} mm up "
+                     "and down")
     return ", ".join(parts) or None

@@ -22,12 +22,14 @@ if TYPE_CHECKING:
 @dataclass(frozen=True)
 class Gait:
     """A named gait preset: parameters plus where it came from; given: the parameters
-    the file names itself (the others are defaults)."""
+    the file names itself (the others are defaults); warning: what a user should know
+    before walking it (a previs-only preset that falls), said when it is walked."""
 
     name: str
     params: GaitParams
     source: str = "<memory>"
     given: frozenset[str] = frozenset()
+    warning: str = ""
 
     def for_robot(self, robot: RobotConfig) -> GaitParams:
         """The parameters with the robot's ``[balance]`` gains for those the preset does
@@ -47,13 +49,16 @@ def parse_gait(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> Ga
     """A validated gait preset from a gait file's table (ConfigError, one line, on any
     problem)."""
     src = source
-    allowed = {"name", "fps", "description", "params", "mapping"}
+    allowed = {"name", "fps", "description", "warning", "params", "mapping"}
     unknown = sorted(set(data) - allowed)
     if unknown:
         raise ConfigError(f"{src}: {unknown[0]}: unknown key; valid: {', '.join(sorted(allowed))}")
     name = data.get("name", Path(src).stem)
     if not isinstance(name, str) or not name:
         raise ConfigError(f"{src}: name: expected a non-empty string, got {show(name)}")
+    warning = data.get("warning", "")
+    if not isinstance(warning, str):
+        raise ConfigError(f"{src}: warning: expected a string, got {show(warning)}")
     values: dict[str, float] = {}
     if "fps" in data:
         values["fps"] = check_value("fps", data["fps"], where=f"{src}: fps")
@@ -74,7 +79,7 @@ def parse_gait(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> Ga
         raise ConfigError(f"{src}: no parameters (fps, [params] or [mapping]); a preset "
                           "names at least one, or it would walk on the defaults unasked")
     return Gait(name=name, params=GaitParams().replace(values, where=src), source=src,
-                given=frozenset(values))
+                given=frozenset(values), warning=warning)
 
 
 def gait_to_toml(gait: Gait) -> str:

@@ -19,6 +19,9 @@ Sign conventions (REP-103, the robot starts at the origin facing +x):
   (``sim.mujoco.world.PushScheduler``) as a constant force at the torso's centre of mass
   for a short window.
 - ``latency_s``: goals written to the bus take effect that much sim time later.
+- ``stairs_height_m``, ``stairs_count``: a flight of that many steps up, each that high,
+  a landing, and a flight as many steps down, straight ahead (sim.mujoco.world_stairs has
+  the tread, the landing and where the first riser stands); 0, 0: none.
 - ``friction_scale``: scales the sliding friction of every geom (floor, bumps, feet,
   body), hence of every contact; ``mass_scale``: scales every robot body's mass and
   inertia.
@@ -64,7 +67,8 @@ class World:
     """The perturbations of one simulated run (module docstring: units and signs).
 
     slope_deg, cross_slope_deg [deg]; bumps_mm: bump height [mm] (0: none); terrain_seed:
-    the bump layout; pushes; latency_s: goal latency [s]; friction_scale, mass_scale [1].
+    the bump layout; pushes; latency_s: goal latency [s]; friction_scale, mass_scale [1];
+    stairs_height_m [m], stairs_count: steps up, then as many down (0, 0: none).
     """
 
     slope_deg: float = 0.0
@@ -75,6 +79,8 @@ class World:
     latency_s: float = 0.0
     friction_scale: float = 1.0
     mass_scale: float = 1.0
+    stairs_height_m: float = 0.0
+    stairs_count: int = 0
 
     def __post_init__(self) -> None:
         for name, key in (("slope_deg", "slope"), ("cross_slope_deg", "cross_slope"),
@@ -85,6 +91,7 @@ class World:
         if not (isinstance(self.terrain_seed, int) and seed.lo <= self.terrain_seed <= seed.hi):
             raise ConfigError(f"World.terrain_seed: {self.terrain_seed!r} is not an integer "
                               f"in {seed}")
+        _check_stairs(self.stairs_height_m, self.stairs_count)
         ms = RANGES["latency"]
         _check("World.latency_s", self.latency_s, Range(ms.lo * MS, ms.hi * MS, "s"))
         if not all(isinstance(p, Push) for p in self.pushes):
@@ -115,6 +122,18 @@ class World:
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready: every field (pushes as objects)."""
         return dataclasses.asdict(self)
+
+
+def _check_stairs(height: float, count: int) -> None:
+    """ConfigError unless the stairs are none (0, 0) or a height in range above 0 and a
+    count in range above 0."""
+    _check("World.stairs_height_m", height, RANGES["stairs_height"])
+    n = RANGES["stairs_count"]
+    if not (isinstance(count, int) and not isinstance(count, bool) and n.lo <= count <= n.hi):
+        raise ConfigError(f"World.stairs_count: {count!r} is not an integer in {n}")
+    if (height > 0.0) != (count > 0):
+        raise ConfigError(f"World.stairs_height_m, stairs_count: {height!r}, {count!r}: give "
+                          "both above 0 (stairs) or both 0 (none)")
 
 
 def _check(where: str, value: Any, valid: Range) -> None:

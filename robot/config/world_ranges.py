@@ -1,5 +1,5 @@
 """Valid ranges of the simulated world's perturbations (slope, bumps, pushes, latency,
-friction, mass), in the `biped walk` options' units. One table for the CLI
+friction, mass, stairs), in the `biped walk` options' units. One table for the CLI
 (robot.commands.world_args, at parse time) and for ``sim.mujoco.world.World`` (its fields), kept
 in robot/ so the CLI checks them without importing sim."""
 
@@ -17,4 +17,6 @@ RANGES: dict[str, Range] = {
     "latency": Range(0.0, 100.0, "ms"),
     "friction": Range(0.2, 3.0),
     "mass_scale": Range(0.5, 2.0),
+    "stairs_height": Range(0.0, 0.05, "m"),
+    "stairs_count": Range(0, 10),
 }

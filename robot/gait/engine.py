@@ -22,6 +22,7 @@ from robot.config.params import SPECS, GaitParams
 from robot.config.robot import RobotConfig
 from robot.gait import expressions as gait
 from robot.gait import vectorised
+from robot.gait.blend import PARAM_TAU_S, PRESET_BLEND_S, STEER_RATE, Blend, follow
 from robot.gait.targets import NO_TRIM, BodyTrim, body_targets
 from robot.gait.tick import TickKernel
 from robot.gait.vectorised import solve
@@ -29,14 +30,9 @@ from robot.gait.xmath import Num
 
 log = logging.getLogger(__name__)
 
-#: Time constant [s] with which live parameter changes are followed while the gait runs.
-#: Phase rates are integrated, but amplitudes (stride, foot height, ...) would otherwise
-#: step the targets within one tick.
-PARAM_TAU_S = 0.1
-#: Steering parameters follow a live change at most this fast [unit/s]: a reversal or a
-#: sudden side step or turn would otherwise change the step under a foot that stands.
-#: (speed: stride multiplier per s; turn: rad/step per s; side_step: m/step per s)
-STEER_RATE: dict[str, float] = {"speed": 0.5, "turn": 0.25, "side_step": 0.02}
+__all__ = ["PARAM_TAU_S", "PRESET_BLEND_S", "STEER_BUDGET", "STEER_RATE", "GaitEngine",
+           "within_steering_budget"]
+
 #: Steering is limited jointly: each of speed, turn and side step may reach the end of
 #: its range alone, but |speed| / its end + |turn| / its end + |side_step| / its end
 #: may not exceed this; a combination beyond it is scaled down (all three alike). Measured
@@ -78,8 +74,9 @@ class GaitEngine:
 
     The envelope ramps the gait amplitude in after ``start()`` and out after ``stop()``,
     over ``ramp_cycles`` gait cycles; the phase starts at 0 (start of the right swing).
-    Parameter changes while the gait moves are followed smoothly (``PARAM_TAU_S``):
-    ``params`` is what was set, ``live_params`` what the last tick used.
+    Parameter changes while the gait moves are followed smoothly (``PARAM_TAU_S``; a
+    preset switch, ``blend_to``, over ``PRESET_BLEND_S``): ``params`` is what was set,
+    ``live_params`` what the last tick used.
     """
 
     def __init__(self, robot: RobotConfig, params: GaitParams) -> None:
@@ -116,6 +113,8 @@ class GaitEngine:
         self._plain_trim: BodyTrim | None = None  # the last trim found _plain
         self._ramp_p: GaitParams | None = None    # the parameters _ramp_s is for
         self._ramp_s = 0.0
+        self._blend: Blend | None = None  # a preset switch in progress (blend_to)
+        self._blend_t = 0.0               # [s] since it began
 
     # -- parameters -------------------------------------------------------------------
     @property
@@ -141,26 +140,25 @@ class GaitEngine:
         """The parameters in effect now (approaching ``params`` after a live change)."""
         return self._live
 
+    def blend_to(self, params: GaitParams, *, seconds: float = PRESET_BLEND_S) -> None:
+        """Switch to another preset's ``params``: at once while stopped, else every
+        shaping parameter along one minimum-jerk blend over ``seconds`` [s] from the
+        values live now (robot.gait.blend; steering at its rate). A later
+        ``replace_params`` ends the blend (the rest followed as a slider change)."""
+        self.replace_params(params)
+        if not self.stopped:
+            self._blend, self._blend_t = Blend(self._live, self._target, seconds), 0.0
+
     def _follow(self, dt: float) -> None:
-        """Move the live parameters towards the set ones (first order, ``PARAM_TAU_S``)."""
-        live, target = self._live, self._target
-        if live is target:
-            return
-        a = 1.0 - math.exp(-dt / PARAM_TAU_S)
-        moved: dict[str, float] = {}
-        for name, spec in SPECS.items():
-            cur, goal = getattr(live, name), getattr(target, name)
-            if cur != goal:
-                rate = STEER_RATE.get(name)
-                if rate is not None:
-                    step = rate * dt
-                    v = goal if abs(goal - cur) <= step else cur + math.copysign(step, goal - cur)
-                    moved[name] = v
-                    continue
-                v = cur + a * (goal - cur)
-                moved[name] = goal if abs(goal - v) <= 1e-9 * (spec.hi - spec.lo) else v
-        self._live = target if all(moved[n] == getattr(target, n) for n in moved) \
-            else dataclasses.replace(live, **moved)
+        """Move the live parameters towards the set ones (robot.gait.blend.follow)."""
+        blend = self._blend
+        if blend is not None:
+            self._blend_t += dt
+            if blend.end is not self._target:      # replaced since: a slider's follow
+                blend = self._blend = None
+        self._live = follow(self._live, self._target, dt, blend=blend, blend_t=self._blend_t)
+        if blend is not None and self._live is self._target:
+            self._blend = None
 
     # -- envelope ---------------------------------------------------------------------
     def start(self) -> None:

@@ -38,10 +38,11 @@ from robot.bus.base import Bus
 from robot.bus.servo_map import ServoMap
 from robot.config.params import GaitParams
 from robot.config.read_back import max_read_every
-from robot.errors import BusDead, BusError, ConfigError, SafetyStop
+from robot.errors import BusDead, BusError, SafetyStop
 from robot.loop.clock import Clock, MonotonicClock, Pacer
 from robot.loop.ending import arm_failsafe, end, explain_stop
 from robot.loop.latency import SampleStats
+from robot.loop.pending import PendingParams
 from robot.loop.source import Feedback, JointTargets, JointVector, MotionSource, SourceT
 from robot.loop.start_check import check_inside_limits
 from robot.loop.telemetry import LoopStats, Telemetry, TickObserver, loop_stats
@@ -75,8 +76,7 @@ class Streamer(Generic[SourceT]):
         self.observer, self.feedback = observer, feedback
         self._feedback_on = False
         self.telemetry = Telemetry()
-        self._lock = threading.Lock()
-        self._pending: dict[str, float] = {}
+        self._pending = PendingParams()
         self._stop = threading.Event()
         self._estop = threading.Event()
         self._fault: str | None = None
@@ -98,14 +98,12 @@ class Streamer(Generic[SourceT]):
                    ) -> GaitParams:
         """Validate ``changes`` now (ConfigError, nothing changes) and apply them at the next
         tick. Returns the parameters as they will be."""
-        params = self.source.params
-        if params is None:
-            raise ConfigError(f"{where}: {type(self.source).__name__} has no parameters to set")
-        with self._lock:
-            merged = {**self._pending, **changes}
-            new = params.replace(merged, where=where)
-            self._pending = {k: float(v) for k, v in merged.items()}
-        return new
+        return self._pending.add(self.source, changes, where=where)
+
+    def blend_to(self, params: GaitParams) -> None:
+        """Switch the source to another preset's ``params`` (validated) at the next tick,
+        blended (robot.gait.blend; a source without blends takes them as a change)."""
+        self._pending.blend(params)
 
     def request_stop(self, reason: str = "stop requested") -> None:
         """Ramp the gait out, go to rest, then torque off (or hold)."""
@@ -212,11 +210,7 @@ class Streamer(Generic[SourceT]):
         return torque
 
     def _apply_pending(self) -> None:
-        with self._lock:
-            if not self._pending:
-                return
-            changes, self._pending = self._pending, {}
-        self.source.set_params(changes)
+        self._pending.apply(self.source)
 
     def _ramp_to(self, q_goal: JointTargets, *, state: str, interruptible: bool = False
                  ) -> None:

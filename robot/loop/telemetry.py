@@ -76,3 +76,19 @@ def loop_stats(lateness: SampleStats, *, ticks: int, rate_hz: float, duration_s:
         period_error_max_ms=max(lateness.max, 0.0) * 1e3 if lateness.count else 0.0,
         overruns=overruns, bus_errors=bus_errors, wall_s=wall_s, stop_reason=stop_reason,
         fault=fault, holding=holding, estop=estop, torque=torque)
+
+
+class GaitClock:
+    """Gait time for observers that act at a time of the gait (a push, a preset switch):
+    the loop time [s] since the first tick whose state is "walking" (``t0``)."""
+
+    def __init__(self) -> None:
+        self.t0: float | None = None
+
+    def __call__(self, tel: Telemetry) -> float | None:
+        """The gait time [s] at this tick; None before the gait walks."""
+        if self.t0 is None:
+            if tel.state != "walking":
+                return None
+            self.t0 = tel.t
+        return tel.t - self.t0

@@ -9,6 +9,9 @@ everything up to the last line written); plain text that ``jq`` or pandas read:
   {"gait_tick": k, "t": ..., "set": {"turn": 0.2, ...}}
       a parameter change, applied just before gait tick k (t = k / rate_hz [s] of gait
       time); every change made live (panel, gamepad, keyboard) is one such line
+  {"gait_tick": k, "t": ..., "blend": {"vM": 0.34, ...}}
+      a preset switch before gait tick k: every parameter of the preset, blended in over
+      robot.gait.blend.PRESET_BLEND_S (the panel's preset picker, `biped walk --switch`)
   {"gait_tick": k, "t": ..., "stop": true}     the gait told to ramp out before tick k
   {"gait_tick": k, "t": ..., "start": true}    the gait told to start before tick k (a show
       whose legs walk in spans, robot/motion/show_walk.py; a recorded walk starts at 0)
@@ -98,6 +101,7 @@ class Take:
     stops: tuple[int, ...] = ()
     present: npt.NDArray[np.float64] | None = None
     present_t: npt.NDArray[np.float64] | None = None
+    blends: Mapping[int, Mapping[str, float]] = field(default_factory=dict)
 
     @property
     def gait_seconds(self) -> float:
@@ -199,6 +203,7 @@ def read_take(path: str | Path) -> Take:
     starts: list[int] = []
     stops: list[int] = []
     changes: dict[int, dict[str, float]] = {}
+    blends: dict[int, dict[str, float]] = {}
     last_gait = -1
     t: list[float] = []
     q: list[list[float]] = []
@@ -214,20 +219,21 @@ def read_take(path: str | Path) -> Take:
             if k < last_gait:
                 raise _fail(where, f"gait_tick {k} is before the previous one ({last_gait})")
             last_gait = k
-            new = row.get("set")
+            new = row.get("set") or row.get("blend")
+            into = blends if "blend" in row else changes
             if row.get("stop") is True:
                 stop = k if stop is None else stop
                 stops.append(k)
             elif row.get("start") is True:
                 starts.append(k)
             elif isinstance(new, dict) and new:
-                w = f"{where}: set"
+                w = f"{where}: {'blend' if into is blends else 'set'}"
                 step = {canonical_name(m, where=w): check_value(m, v, where=w)
                         for m, v in new.items()}
-                changes.setdefault(k, {}).update(step)
+                into.setdefault(k, {}).update(step)
             else:
-                raise _fail(where, "expected \"set\": {name: value}, \"start\": true or "
-                                   "\"stop\": true")
+                raise _fail(where, "expected \"set\" or \"blend\": {name: value}, "
+                                   "\"start\": true or \"stop\": true")
         elif "tick" in row:
             q.append(_angles(where, row.get("q"), n))
             t.append(number(where, "t", row.get("t", len(t) / header.rate_hz)))
@@ -245,4 +251,4 @@ def read_take(path: str | Path) -> Take:
     return Take(header, changes, stop, np.asarray(t, dtype=float), q_arr, tuple(states),
                 source=str(p), starts=tuple(starts), stops=tuple(stops),
                 present=read if np.isfinite(read).any() else None,
-                present_t=np.asarray(read_t, dtype=float))
+                present_t=np.asarray(read_t, dtype=float), blends=blends)

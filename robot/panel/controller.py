@@ -104,8 +104,9 @@ class PanelController:
         return new
 
     def load_preset(self, name: object) -> GaitParams:
-        gait = self.presets.load(name)
-        new = self.set_params(gait.for_robot(self.robot).as_dict())
+        """Preset ``name``: blended in while walking (robot.gait.blend), else next run."""
+        values = self.presets.load(name).for_robot(self.robot).as_dict()
+        self._params = new = self.loop.call("preset", timeout=STATE_TIMEOUT_S, values=values)
         self.preset = str(name)
         return new
 

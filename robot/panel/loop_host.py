@@ -140,6 +140,19 @@ class LoopHost:
             self.params = new
             return new
 
+    def load_preset(self, values: Mapping[str, float]) -> GaitParams:
+        """Another preset's parameters: blended in while a walk runs (robot.gait.blend),
+        else for the next run."""
+        with self._lock:
+            run, driver = self._run, self.watch.driver
+            if run is not None and driver is not None:
+                raise PanelStateError(f"{driver} is playing; stop it to drive by hand")
+            new = self.params.replace(values, where="preset")
+            if run is not None:
+                run.streamer.blend_to(new)
+            self.params = new
+            return new
+
     def _acquire(self, owner: str) -> Session:
         """The bus for ``owner`` (BusBusy naming the holder; refused while closing)."""
         if self.closing:

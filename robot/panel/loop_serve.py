@@ -26,6 +26,7 @@ def _commands(host: LoopHost) -> tuple[dict[str, Callable[[Args], object]],
     quick: dict[str, Callable[[Args], object]] = {
         "state": lambda a: host.state(),
         "params": lambda a: host.set_params(a["changes"]),
+        "preset": lambda a: host.load_preset(a["values"]),
         "stop": lambda a: host.stop(),
         "estop": lambda a: host.emergency_stop(),
         "clear": lambda a: host.posing.clear(),

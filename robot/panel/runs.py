@@ -117,7 +117,7 @@ def build(kind: RunKind, robot: RobotConfig, params: GaitParams) -> Built:
         layer = (parse_sequence(h.keyframes, robot, source=f"{kind.path}: keyframes")
                  if h.keyframes else None)
         stop = take.stop_tick if take.stop_tick is not None else len(take.t)
-        return Built(PlaybackEngine(robot, h.params, changes=take.changes, stop_tick=stop,
+        return Built(PlaybackEngine(robot, h.params, changes=take.changes, blends=take.blends, stop_tick=stop,
                                     keyframes=layer), driver=kind.owner)
     if isinstance(kind, ShowTake):
         if kind.travel.walks:

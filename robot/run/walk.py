@@ -23,6 +23,7 @@ from robot.motion.scripted import RecordingEngine
 from robot.motion.takes import TakeHeader, is_take
 from robot.run.result import RunResult
 from robot.run.spec import Recording, RunOptions, RunSpec
+from robot.run.switching import PresetSwitch, PresetSwitcher
 
 log = logging.getLogger(__name__)
 
@@ -52,10 +53,12 @@ def walk_imu(robot: RobotConfig, bus: Bus, *, balance: bool = True,
 
 def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
               imu: Imu | None = None, keyframes: Sequence | None = None,
-              record: str | None = None, options: RunOptions | None = None) -> RunSpec[GaitEngine]:
+              record: str | None = None, options: RunOptions | None = None,
+              switches: tuple[PresetSwitch, ...] = ()) -> RunSpec[GaitEngine]:
     """The run of a walk with ``params`` (preset ``gait``, for a take's header), a
-    keyframe layer on the arms, and a recording (NAME.take.jsonl: the parameter
-    timeline; .csv or .jsonl: the joint stream)."""
+    keyframe layer on the arms, a recording (NAME.take.jsonl: the parameter
+    timeline; .csv or .jsonl: the joint stream) and preset ``switches`` (blended live,
+    robot.run.switching; a take records them as blends)."""
     options = options or RunOptions()
     recorder: Recording | None = None
     engine: GaitEngine
@@ -73,7 +76,8 @@ def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
         engine = (LayeredEngine(robot, params, keyframes=keyframes) if keyframes
                   else GaitEngine(robot, params))
     return RunSpec(robot=robot, source=engine, bus=bus, options=options, imu=imu,
-                   recorder=recorder)
+                   recorder=recorder,
+                   observer=PresetSwitcher(engine, switches) if switches else None)
 
 
 #: A walk whose heading changes by more than this [deg per minute of the run] beyond what
@@ -88,10 +92,17 @@ def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *,
     the heading the gait asked for, the drift beyond it per minute and whether that is
     more than ``HEADING_DRIFT_DEG_MIN``; the time [s, at the loop's rate] the IK met an
     unreachable target (``ik_unreachable_s``) and each joint was held at a limit
-    (``clamped_joints_s``: only those that were)."""
+    (``clamped_joints_s``: only those that were); where the bus counted the feet on the
+    ground (simulation), the flight time per gait cycle (``flight_s_per_cycle``); the
+    preset switches made (``switches``)."""
     out = {"robot": spec.robot.name, "gait": gait, "bus": spec.bus.kind,
            "seconds": spec.options.seconds, "balance": spec.imu is not None,
            **result.as_dict()}
+    if isinstance(spec.observer, PresetSwitcher):
+        out["switches"] = spec.observer.as_list()
+    feet = out.get("feet")
+    if isinstance(feet, dict) and "flight_share" in feet:   # the sim's: per gait cycle
+        out["flight_s_per_cycle"] = feet["flight_share"] * spec.source.params.cycle_s
     engine, rate = spec.source, result.stats.rate_hz
     out["ik_unreachable_s"] = engine.unreachable_ticks / rate if rate else 0.0
     out["clamped_joints_s"] = {name: n / rate for name, n in

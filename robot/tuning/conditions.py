@@ -36,7 +36,9 @@ PUSH_DIRECTIONS = {"forward": (1, 0), "backward": (-1, 0), "left": (0, 1), "righ
 class Condition:
     """One perturbation: a name, a group (one bar of the picture), the walk's world (None:
     the plain scene), its parameter changes (name, value), its IMU noise scale (None: the
-    robot file's); seconds: this condition's walk [s] (None: the suite's)."""
+    robot file's); seconds: this condition's walk [s] (None: the suite's); switches: preset
+    switches (gait time [s], bundled preset) during the walk; reach_m: the distance [m]
+    the walk must cover to survive (None: not falling is enough)."""
 
     group: str
     name: str
@@ -44,6 +46,8 @@ class Condition:
     changes: tuple[tuple[str, float], ...] = ()
     imu_noise: float | None = None
     seconds: float | None = None
+    switches: tuple[tuple[float, str], ...] = ()
+    reach_m: float | None = None
 
     @property
     def args(self) -> tuple[str, ...]:
@@ -64,10 +68,14 @@ class Condition:
             out += ["--friction", f"{w.friction_scale:g}"]
         if w.mass_scale != 1.0:
             out += ["--mass-scale", f"{w.mass_scale:g}"]
+        if w.stairs_count:
+            out += ["--stairs", f"{w.stairs_height_m:g},{w.stairs_count}"]
         for name, value in self.changes:
             out += ["--set", f"{name}={value!r}"]
         if self.imu_noise is not None:
             out += ["--imu-noise", f"{self.imu_noise:g}"]
+        for t, preset in self.switches:
+            out += ["--switch", f"{t:g}:{preset}"]
         return tuple(out)
 
 
@@ -97,6 +105,7 @@ def conditions(params: GaitParams, *, quick: bool = False) -> list[Condition]:
         out += [Condition("friction", f"friction x{f:g}", World(friction_scale=f))
                 for f in (0.5, 2.0)]
         out += [Condition("mass", f"mass x{m:g}", World(mass_scale=m)) for m in (0.8, 1.2)]
+        out += stairs_and_switches()
     return out
 
 
@@ -144,3 +153,26 @@ def scaled_params(params: GaitParams) -> list[Condition]:
             label = f"{name} {sign * 20:+d} %" + ("" if got == want else f" (range: {got:g})")
             out.append(Condition("params +/-20 %", label, changes=((name, got),)))
     return out
+
+
+#: The stairs group: steps [m] and their number (up, a landing, as many down), the walk's
+#: length [s] (room for a walk at 0.06 m/s to cross them) and how far it must get [m]: the
+#: torso past the last riser down (sim.mujoco.world_stairs: 1.20 m for these).
+STAIRS = (0.015, 3)
+STAIRS_S = 30.0
+STAIRS_REACH_M = 1.25
+#: The preset-transition group: the issue's walk -> jog -> crouch -> walk, each switch a
+#: blend (robot.gait.blend), then 2.8 s on the last preset.
+SWITCHES = ((4.0, "jog"), (7.0, "crouch"), (10.0, "walk"))
+SWITCHES_S = 14.0
+
+
+def stairs_and_switches() -> list[Condition]:
+    """The full suite's stairs (up and down, crossed to the far side) and preset switches
+    (issue 22); none in the quick suite (tests/test_transitions.py walks the switches)."""
+    h, n = STAIRS
+    return [Condition("stairs", f"stairs {n} x {h * 1e3:g} mm up and down",
+                      World(stairs_height_m=h, stairs_count=n), seconds=STAIRS_S,
+                      reach_m=STAIRS_REACH_M),
+            Condition("preset switches", " -> ".join(["start"] + [p for _, p in SWITCHES]),
+                      seconds=SWITCHES_S, switches=SWITCHES)]

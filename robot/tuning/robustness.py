@@ -6,7 +6,8 @@ suite measures the product, not a copy of it), run in this process through
 ``robot.run.run.execute``; ``run_suite`` spreads them over a pool of worker processes,
 one per core, each running one walk after the other (no interpreter start and imports
 per run). A condition survives when the walk does not fall (the simulated bus's watch:
-torso low or tilted past the fall threshold) in ``seconds`` of gait.
+torso low or tilted past the fall threshold) in ``seconds`` of gait, and covers the
+condition's ``reach_m`` where it has one (the stairs).
 """
 
 from __future__ import annotations
@@ -21,12 +22,14 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from robot.bus.factory import make_bus
+from robot.config.gait_file import load_gait
 from robot.config.params import GaitParams
 from robot.config.robot_file import load_robot
 from robot.config.world import PUSH_AT_S, PUSH_NS, PUSH_PHASES
 from robot.errors import BipedError
 from robot.run.run import execute
 from robot.run.spec import RunOptions
+from robot.run.switching import PresetSwitch
 from robot.run.walk import walk_imu, walk_spec, walk_summary
 from robot.tuning.conditions import (
     AFTER_PUSH_S,
@@ -94,8 +97,11 @@ def run_condition(job: WalkJob) -> Outcome:
         bus = make_bus("sim", robot=robot, realtime=False, view=False, world=c.world)
         imu = walk_imu(robot, bus, balance=job.balance, noise=c.imu_noise)
         secs = job.seconds if c.seconds is None else c.seconds
+        switches = tuple(PresetSwitch(t, name, load_gait(name).for_robot(robot))
+                         for t, name in c.switches)
         spec = walk_spec(robot, params, bus, gait=job.gait, imu=imu,
-                         options=RunOptions(seconds=secs, stop_on_fall=True))
+                         options=RunOptions(seconds=secs, stop_on_fall=True),
+                         switches=switches)
         r = walk_summary(spec, execute(spec), gait=job.gait)
     except BipedError as e:
         return Outcome(c, job.balance, None, error=str(e))
@@ -105,7 +111,9 @@ def run_condition(job: WalkJob) -> Outcome:
     # A run a servo fault stopped early (e.g. the watchdog on an overloaded knee: the
     # servos go limp) did not survive either, though the torso had not yet fallen.
     stopped = r.get("stop_reason") not in ("completed", None)
-    return Outcome(c, job.balance, bool(r.get("fell")) or stopped, r.get("fell_at_s"),
+    # A walk that must get somewhere (the stairs: past the last riser) and did not, failed.
+    short = c.reach_m is not None and float(r.get("distance_m", 0.0)) < c.reach_m
+    return Outcome(c, job.balance, bool(r.get("fell")) or stopped or short, r.get("fell_at_s"),
                    float(r.get("distance_m", 0.0)), float(r.get("heading_change_deg", 0.0)),
                    summary=r)
 

@@ -1,6 +1,7 @@
 """What the simulated bus watches during one run (robot.run.spec.RunWatch): the torso's
 path and fall (sim.mujoco.metrics.WalkMonitor), the servos' energy and knee load
-(sim.mujoco.effort.EffortMonitor), and the world's pushes (sim.mujoco.world
+(sim.mujoco.effort.EffortMonitor), the feet on the ground (sim.mujoco.foot_contact), and
+the world's pushes (sim.mujoco.world
 .PushScheduler), with their JSON summary."""
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from robot.config.robot import RobotConfig
 from robot.config.world import World
 from robot.loop.telemetry import Telemetry
 from sim.mujoco.effort import EffortMonitor
+from sim.mujoco.foot_contact import FootContacts
 from sim.mujoco.metrics import WalkMonitor
 from sim.mujoco.world import PushScheduler, PushTarget
 
@@ -29,6 +31,7 @@ class SimRunWatch:
         self.world = world
         self.monitor = WalkMonitor(standing_height=standing_height, floor_normal=floor_normal)
         self.effort = EffortMonitor(model, data, robot)
+        self.feet = FootContacts(model, data)
         self.pushes = (PushScheduler(push_target, world.pushes)
                        if world is not None and world.pushes else None)
         self._qpos = data.qpos
@@ -36,6 +39,8 @@ class SimRunWatch:
     def __call__(self, tel: Telemetry) -> None:
         self.monitor.update_qpos(tel.t, self._qpos[:7].tolist())
         self.effort.update(tel.t)
+        if tel.state == "walking" and not self.monitor.fell:   # on its feet, walking
+            self.feet.update(tel.t)
         if self.pushes is not None:
             self.pushes(tel)
 
@@ -49,6 +54,7 @@ class SimRunWatch:
         each applied push with its sim start time."""
         out: dict[str, Any] = self.monitor.summary(seconds or 0.0)
         out.update(self.effort.summary(out["distance_m"]))
+        out["feet"] = self.feet.summary()
         world: dict[str, Any] = (self.world or World()).as_dict()
         world["pushes_applied"] = [] if self.pushes is None else self.pushes.as_list()
         out["world"] = world

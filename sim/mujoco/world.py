@@ -16,7 +16,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.config.world import Push, World
-from robot.loop.telemetry import Telemetry
+from robot.loop.telemetry import GaitClock, Telemetry
 
 __all__ = ["PUSH_WINDOW_S", "AppliedPush", "Push", "PushScheduler", "PushTarget", "TimedForces",
            "World"]
@@ -51,14 +51,17 @@ class PushScheduler:
         self.pushes = tuple(sorted(pushes, key=lambda p: p.at_s))
         self.window_s = window_s
         self.applied: list[AppliedPush] = []
-        self.gait_t0: float | None = None  # sim time of the first walking tick [s]
+        self.clock = GaitClock()
+
+    @property
+    def gait_t0(self) -> float | None:
+        """Sim time of the first walking tick [s]."""
+        return self.clock.t0
 
     def __call__(self, tel: Telemetry) -> None:
-        if self.gait_t0 is None:
-            if tel.state != "walking":
-                return
-            self.gait_t0 = tel.t
-        gait_t = tel.t - self.gait_t0
+        gait_t = self.clock(tel)
+        if gait_t is None:
+            return
         while len(self.applied) < len(self.pushes):
             p = self.pushes[len(self.applied)]
             if p.at_s > gait_t + _TIME_EPS:

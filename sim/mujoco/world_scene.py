@@ -16,6 +16,7 @@ import numpy.typing as npt
 
 from sim.mujoco.mjcf_robot import fmt
 from sim.mujoco.world import World
+from sim.mujoco.world_stairs import stair_boxes
 
 #: Bump field in the floor frame: x from BUMPS_X0_M to BUMPS_X0_M + BUMPS_LENGTH_M (ahead
 #: of the start pose's toes), |y| <= BUMPS_HALF_WIDTH_M [m].
@@ -27,6 +28,8 @@ BUMP_SIDE_M = (0.03, 0.08)  # each side of a box: uniform in this range [m]
 BUMP_COVER = 0.25  # expected share of the field's area under a box
 BUMP_PREFIX = "bump"
 BUMP_RGBA = "0.55 0.45 0.35 1"
+STAIR_PREFIX = "stair"
+STAIR_RGBA = "0.5 0.55 0.6 1"
 MM = 1e-3  # [m/mm]
 
 
@@ -70,21 +73,28 @@ def _rotate(quat: tuple[float, float, float, float],
 
 
 def add_world_to_scene(worldbody: ET.Element, floor: ET.Element, world: World) -> None:
-    """Tilt ``floor`` and add the bump boxes (static geoms colliding like the floor)."""
+    """Tilt ``floor`` and add the bump boxes and the stairs (static geoms colliding like
+    the floor)."""
     quat = world.floor_quat()
     if world.tilted:
         floor.set("quat", fmt(*quat))
+
+    def box(name: str, centre: tuple[float, float, float],
+            half: tuple[float, float, float], rgba: str) -> None:
+        attrs = {"name": name, "type": "box", "pos": fmt(*_rotate(quat, centre)),
+                 "size": fmt(*half), "rgba": rgba, "contype": "1", "conaffinity": "1"}
+        if world.tilted:
+            attrs["quat"] = fmt(*quat)
+        ET.SubElement(worldbody, "geom", attrs)
+
+    for k, s in enumerate(stair_boxes(world.stairs_height_m, world.stairs_count)):
+        box(f"{STAIR_PREFIX}{k}", s.centre, s.half_sides, STAIR_RGBA)
     if world.bumps_mm <= 0.0:
         return
     half_h = world.bumps_mm * MM / 2
     for k, b in enumerate(bump_layout(world.terrain_seed)):
-        pos = _rotate(quat, (b.x, b.y, half_h))
-        attrs = {"name": f"{BUMP_PREFIX}{k}", "type": "box", "pos": fmt(*pos),
-                 "size": fmt(b.size_x / 2, b.size_y / 2, half_h), "rgba": BUMP_RGBA,
-                 "contype": "1", "conaffinity": "1"}
-        if world.tilted:
-            attrs["quat"] = fmt(*quat)
-        ET.SubElement(worldbody, "geom", attrs)
+        box(f"{BUMP_PREFIX}{k}", (b.x, b.y, half_h), (b.size_x / 2, b.size_y / 2, half_h),
+            BUMP_RGBA)
 
 
 def apply_world_to_model(model: mujoco.MjModel, data: mujoco.MjData, world: World) -> None:

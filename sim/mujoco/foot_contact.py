@@ -1,0 +1,66 @@
+"""Which feet touch the ground, tick by tick: the gait's flight phase and double support.
+
+A foot is on the ground when its sole geom (``r_foot`` / ``l_foot``, sim.mujoco.mjcf_robot)
+has a contact with a geom outside the robot (the floor, a bump, a stair step). Sampled once
+per control tick while the gait walks, until a fall (the gait's ramp in and out included,
+the ramps to and from the start pose not), so times are multiples of the tick; the time with no foot on the
+ground is the flight phase (a jog has none, a run has one per step).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import mujoco
+
+FEET = ("r_foot", "l_foot")
+
+
+class FootContacts:
+    """``update(t)`` once per walking tick at sim time ``t`` [s]: the time since the last
+    one counts for the number of feet on the ground now. ``summary``: seconds with none
+    (flight), one and two, the fewest feet down, the longest flight and its share."""
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+        self.data = data
+        self.feet = {mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n) for n in FEET}
+        if min(self.feet) < 0:
+            raise ValueError(f"the model has no foot geoms named {FEET}")
+        body = model.geom_bodyid
+        self.robot = {g for g in range(model.ngeom) if body[g] != 0}
+        self.seconds = [0.0, 0.0, 0.0]     # with 0, 1, 2 feet down [s]
+        self.fewest = 2
+        self.longest_flight_s = 0.0
+        self._last_t: float | None = None
+        self._flight_s = 0.0               # the flight in progress [s]
+
+    def feet_down(self) -> int:
+        """How many feet touch something that is not the robot, now."""
+        down = set()
+        feet, robot = self.feet, self.robot
+        for c in self.data.contact[: self.data.ncon]:
+            g1, g2 = int(c.geom1), int(c.geom2)
+            if g1 in feet and g2 not in robot:
+                down.add(g1)
+            elif g2 in feet and g1 not in robot:
+                down.add(g2)
+        return len(down)
+
+    def update(self, t: float) -> None:
+        n = self.feet_down()
+        if self._last_t is not None:
+            dt = t - self._last_t
+            self.seconds[n] += dt
+            self.fewest = min(self.fewest, n)
+            self._flight_s = self._flight_s + dt if n == 0 else 0.0
+            self.longest_flight_s = max(self.longest_flight_s, self._flight_s)
+        self._last_t = t
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready: seconds with 0, 1, 2 feet down, the fewest, the longest flight [s]
+        and the flight's share of the walking time."""
+        total = sum(self.seconds)
+        return {"flight_s": self.seconds[0], "single_support_s": self.seconds[1],
+                "double_support_s": self.seconds[2], "fewest_feet_down": self.fewest,
+                "longest_flight_s": self.longest_flight_s,
+                "flight_share": self.seconds[0] / total if total > 0 else 0.0}

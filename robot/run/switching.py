@@ -13,7 +13,6 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 from robot.config.params import GaitParams
 from robot.errors import ConfigError
@@ -62,6 +61,6 @@ class PresetSwitcher:
             self.engine.blend_to(s.params, seconds=self.blend_s)
             self.applied.append((s, tel.t))
 
-    def as_list(self) -> list[dict[str, Any]]:
+    def as_list(self) -> list[dict[str, float | str]]:
         """JSON-ready: each applied switch (gait time, preset) with its loop time."""
         return [{"at_s": s.at_s, "preset": s.name, "t_s": t} for s, t in self.applied]

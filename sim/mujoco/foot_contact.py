@@ -9,8 +9,6 @@ ground is the flight phase (a jog has none, a run has one per step).
 
 from __future__ import annotations
 
-from typing import Any
-
 import mujoco
 
 FEET = ("r_foot", "l_foot")
@@ -56,7 +54,7 @@ class FootContacts:
             self.longest_flight_s = max(self.longest_flight_s, self._flight_s)
         self._last_t = t
 
-    def summary(self) -> dict[str, Any]:
+    def summary(self) -> dict[str, float]:
         """JSON-ready: seconds with 0, 1, 2 feet down, the fewest, the longest flight [s]
         and the flight's share of the walking time."""
         total = sum(self.seconds)

@@ -6,6 +6,7 @@ stays up, and the standing spans play the authored legs."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -15,8 +16,10 @@ import pytest
 from walk_anim import RIG_LEG, WalkShape, root_end, write_walk_bvh
 
 import robot.cli as cli
+from robot.config.gait_file import load_gait
 from robot.config.joint_names import LEG_NAMES
 from robot.config.robot_file import load_robot
+from robot.gait.blend import PRESET_BLEND_S
 from robot.motion.show import stream_sequence
 from robot.motion.show_walk import ShowEngine, Travel
 from robot.motion.takes import Take, read_take
@@ -201,3 +204,31 @@ def test_the_panel_plays_a_walking_show_with_the_gait(tmp_path: Path) -> None:
     for _ in range(int(walk_mid)):
         engine.tick(1.0 / rate)
     assert engine.gait_share == 1.0 and engine.state == "walking"
+
+
+def test_a_show_plays_a_recorded_preset_switch_as_a_blend(tmp_path: Path) -> None:
+    """A take's ``blend`` line (a preset switch recorded by `biped walk --switch` or the
+    panel's picker) reaches the show's engine: the live parameters are the take's until
+    the switch, then move to the preset's, and equal them once the blend's time is over.
+    The expected values are the preset file's own (robot/configs/gaits/crouch.toml)."""
+    take = _import(tmp_path, WalkShape(steps=6))
+    rate = take.header.rate_hz
+    switch_s = WalkShape().stand_s + 1.0                 # a second into the walk
+    crouch = load_gait("crouch").params.as_dict()
+    take = dataclasses.replace(take, blends={round(switch_s * rate): crouch})
+    travel = Travel.of_take(take)
+    assert [line for line in travel.timeline(rate) if "blend" in line] == [
+        {"gait_tick": round(switch_s * rate), "t": round(switch_s * rate) / rate,
+         "blend": crouch}]
+    engine = ShowEngine(load_robot(take.header.robot), take.header.params,
+                        stream=stream_sequence(take), travel=travel)
+    engine.start()
+    hhgt: list[float] = []
+    for _ in range(round((switch_s + PRESET_BLEND_S + 0.1) * rate)):
+        engine.tick(1.0 / rate)
+        hhgt.append(engine.live_params.Hhgt)
+    before = round(switch_s * rate) - 1
+    assert hhgt[before] == take.header.params.Hhgt != crouch["Hhgt"]
+    assert hhgt[-1] == pytest.approx(crouch["Hhgt"], abs=1e-12)
+    between = hhgt[before + round(PRESET_BLEND_S * rate / 2)]
+    assert min(hhgt[before], crouch["Hhgt"]) < between < max(hhgt[before], crouch["Hhgt"])

@@ -5,9 +5,11 @@ paper's gait drives the legs with travel parameters (speed, turn, side step) tha
 
 The gait's part is a ``Travel``: the walks as (start, stop) pairs of show time [s] (the
 gait starts its ramp in at ``start`` and is told to stop at ``stop``, then ramps out over
-the same ``ramp_cycles`` of the gait) and the steering changes at their times. In a take
-it is the parameter timeline (robot/motion/takes.py: ``start``, ``set`` and ``stop``
-lines at gait ticks of the take's rate), so it plays at any loop rate.
+the same ``ramp_cycles`` of the gait), the steering changes at their times and the preset
+switches (each a blend over robot.gait.blend.PRESET_BLEND_S, as ``biped walk --switch`` and
+the panel's preset picker record them). In a take it is the parameter timeline
+(robot/motion/takes.py: ``start``, ``set``, ``blend`` and ``stop`` lines at gait ticks of
+the take's rate), so it plays at any loop rate.
 
 The legs blend between authored and gait angles without a snap, by the gait's own
 envelope: the gait's share of the legs is smoothstep(2 r), r the envelope's linear ramp
@@ -36,10 +38,13 @@ from robot.motion.takes import Take
 @dataclass(frozen=True)
 class Travel:
     """walks: (start, stop) [s of show time], in order, not overlapping; changes: (t [s],
-    {parameter: value}) steering changes in time order."""
+    {parameter: value}) steering changes in time order; blends: (t [s], {parameter:
+    value}) preset switches in time order, each blended in from t (a blend and a change at
+    the same tick: the blend first, as robot.motion.scripted.PlaybackEngine does)."""
 
     walks: tuple[tuple[float, float], ...] = ()
     changes: tuple[tuple[float, Mapping[str, float]], ...] = ()
+    blends: tuple[tuple[float, Mapping[str, float]], ...] = ()
 
     def timeline(self, rate_hz: float) -> list[dict[str, Any]]:
         """The take's timeline lines for it, at gait ticks of ``rate_hz`` [Hz]."""
@@ -49,6 +54,8 @@ class Travel:
             events.append((round(stop * rate_hz), 2, {"stop": True}))
         for t, step in self.changes:
             events.append((round(t * rate_hz), 0, {"set": dict(step)}))
+        for t, preset in self.blends:
+            events.append((round(t * rate_hz), -1, {"blend": dict(preset)}))
         events.sort(key=lambda e: (e[0], e[1]))
         return [{"gait_tick": k, "t": k / rate_hz, **what} for k, _, what in events]
 
@@ -73,7 +80,8 @@ class Travel:
         if start is not None:
             walks.append((start / rate, math.inf))
         changes = tuple((k / rate, dict(step)) for k, step in sorted(take.changes.items()))
-        return Travel(tuple(walks), changes)
+        blends = tuple((k / rate, dict(preset)) for k, preset in sorted(take.blends.items()))
+        return Travel(tuple(walks), changes, blends)
 
 
 def _smoothstep(x: float) -> float:
@@ -99,6 +107,7 @@ class ShowEngine(GaitEngine):
         for start, stop in travel.walks:
             events += [(start, 1, None), (stop, 2, None)]
         events += [(t, 0, step) for t, step in travel.changes]
+        events += [(t, -1, preset) for t, preset in travel.blends]
         self._events = sorted(events, key=lambda e: (e[0], e[1]))
         self._next = 0
         self._on = False
@@ -152,7 +161,9 @@ class ShowEngine(GaitEngine):
         while self._next < len(self._events) and self._events[self._next][0] <= self.time + 1e-9:
             t, kind, step = self._events[self._next]
             self._next += 1
-            if kind == 0 and step:
+            if kind == -1 and step:
+                self.blend_to(self.params.replace(step, where=f"show blend at t={t:.3f} s"))
+            elif kind == 0 and step:
                 self.set_params(step, where=f"show travel at t={t:.3f} s")
             elif kind == 1 and self._on:
                 super().start()

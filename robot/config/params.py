@@ -134,6 +134,10 @@ SPECS: dict[str, ParamSpec] = {
                                  "with this share of the torso's unexpected tilt (1: kept "
                                  "level with the ground, so it lands where the step was "
                                  "planned)", False),
+    "bal_kin_xi": ParamSpec(0.0, 0.0, 1.0, "-", BALANCE, "share of the capture-point "
+                            "error taken from the legs' kinematics (joint angles and IMU "
+                            "tilt: where the body stands over its feet) rather than from "
+                            "the torso's tilt alone (0: tilt only)", False),
     "bal_learn_cycles": ParamSpec(4.0, 0.0, 50.0, "cycle", BALANCE, "time constant of the "
                                   "learned gait rhythm the stepping ignores (0: none)", False),
     "bal_heading_p": ParamSpec(0.5, 0.0, 2.0, "1/step", BALANCE, "turn trim per rad of "
@@ -219,6 +223,7 @@ class GaitParams:
     bal_hold_xi: float = SPECS["bal_hold_xi"].default
     bal_tempo_max: float = SPECS["bal_tempo_max"].default
     bal_swing_level: float = SPECS["bal_swing_level"].default
+    bal_kin_xi: float = SPECS["bal_kin_xi"].default
     bal_learn_cycles: float = SPECS["bal_learn_cycles"].default
     bal_heading_p: float = SPECS["bal_heading_p"].default
     bal_heading_i: float = SPECS["bal_heading_i"].default

@@ -42,6 +42,9 @@ __all__ = ["Attitude", "Balance", "BalanceState", "Correction", "GaitPhase", "Jo
 #: The servos' lag behind their command (read back every few ticks) is followed with
 #: this time constant [s]: about the loop's read-back period (10 ticks at 200 Hz).
 LAG_TAU_S = 0.05
+#: The kinematic estimate's support passes from one sole to the other over this time
+#: constant [s] when a foot lifts or lands.
+SUPPORT_TAU_S = 0.03
 #: Feet stay this far apart at least [m] when a step moves one toward the other.
 FOOT_GAP_M = 0.005
 
@@ -99,6 +102,7 @@ class Balance:
         self._before: tuple[tuple[float, ...], tuple[float, ...]] | None = None
         self._plan_before: tuple[tuple[float, ...], tuple[float, ...]] | None = None
         self._trim_before: BodyTrim | None = None
+        self._w: float | None = None
         self.state = BalanceState()
         self.last = Correction()
         self._theta = 0.0
@@ -109,7 +113,7 @@ class Balance:
         self.last = Correction()
         self._theta = float(self.engine.phase.theta)
         self._sent = self._lag = self._lag_seen = None
-        self._before = self._plan_before = self._trim_before = None
+        self._before = self._plan_before = self._trim_before = self._w = None
         self.stop()
 
     def stop(self) -> None:
@@ -153,7 +157,12 @@ class Balance:
         held = self.held(q, dt).tolist()
         legs = (leg_angles(held, self.legs.right), leg_angles(held, self.legs.left))
         plan = (leg_angles(q.tolist(), self.legs.right), leg_angles(q.tolist(), self.legs.left))
-        w = support_weight((not gait.swinging[0], not gait.swinging[1]))
+        # The support moves from foot to foot over SUPPORT_TAU_S, not in one tick: the two
+        # feet's unplanned offsets differ by a few mm, and a jump by half of that at a
+        # lift that the learned rhythm places a bin early or late reads as a push.
+        want = support_weight((not gait.swinging[0], not gait.swinging[1]))
+        w = self._w = (want if self._w is None
+                       else self._w + min(1.0, dt / SUPPORT_TAU_S) * (want - self._w))
         g = self.engine.robot.geometry
         measured = over_support(g, legs, self._before,
                                 (tilt.roll, tilt.pitch, tilt.roll_rate, tilt.pitch_rate), w, dt)

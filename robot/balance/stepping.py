@@ -4,6 +4,10 @@
   (robot.balance.rhythm); what it does not explain (a residual tilt e and rate de/dt) puts
   the capture point dxi = h (e + de/dt / omega0) from where the walk expects it (a linear
   inverted pendulum of the hip height h pivoting on its feet, omega0 = sqrt(g / h)).
+  With ``bal_kin_xi`` > 0 a share of dxi comes instead from the legs' kinematics
+  (robot.balance.kinematic: the pelvis over its support from the held joint angles and the
+  IMU's tilt, less the gait's plan and the feedback's own step offsets), its rhythm
+  learned the same way: dxi = x + vx / omega0 of what the walk does not explain.
 - The capture step (robot.balance.capture_step): the foot that swings (in double support,
   the one that lifts next) lands where dxi will have grown to by touchdown, within its
   reach, and the gait phase runs faster when that step would be out of reach

@@ -10,9 +10,10 @@ Per control tick, from the torso's tilt (roll, pitch) [rad], tilt rate [rad/s] a
 - heading: a PI loop trims ``turn`` so the heading follows the commanded turn rate;
 - stepping (robot.balance.stepping): a push is what the walk's learned rhythm does not
   explain (in the torso's tilt, and with ``bal_kin_xi`` in where the legs' kinematics put
-  the body over its feet: robot.balance.kinematic); the swinging foot takes the capture step (robot.balance.capture_step: where
-  the capture point will be at touchdown, sooner when that is out of reach), kept level
-  with the ground; in double support the gait holds rather than lift a loaded foot.
+  the body over its feet: robot.balance.kinematic); the swinging foot takes the capture
+  step (robot.balance.capture_step: where the capture point will be at touchdown, sooner
+  when that is out of reach), kept level with the ground; in double support the gait
+  holds rather than lift a loaded foot.
 
 Sign conventions (REP-103; robot/gait/ik.py): every pitch joint turns about +y and every roll
 joint about +x of its parent. With a foot flat on the ground, the torso's pitch is

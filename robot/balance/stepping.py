@@ -93,6 +93,8 @@ class StepState(NamedTuple):
     rhythm: Rhythm = Rhythm()
     latch: tuple[float, float] = (0.0, 0.0)
     kin_rhythm: Rhythm = Rhythm()
+    braced_for: float = 0.0
+    released: bool = False
 
 
 def _clip(x: float, limit: float) -> float:
@@ -258,17 +260,26 @@ def step(state: StepState, values: tuple[float, float, float, float], p: GaitPar
     # gait puts it, ahead, it lengthens that base. A backward or mostly lateral one braces
     # at once (waiting for those too cost a bump case on each robot's suite).
     may_brace = not any(g.swinging) or abs(xi[1]) > abs(xi[0]) or xi[0] < 0.0
-    brace_s = (p.bal_brace_s if 0.0 < p.bal_brace_xi < size and may_brace
-               else max(0.0, state.brace_s - dt))
+    # A brace that has held bal_brace_max_s and still sees the error is given up: the
+    # robot only tips slower over the edge of its feet while it stands (docs/robustness.md,
+    # issue 22, third pass); the gait steps instead (the capture step, sooner), with no
+    # brace or hold until the error is back under the brace's threshold.
+    large = 0.0 < p.bal_brace_xi < size
+    released = state.released and large
+    braced_for = state.braced_for + dt if state.brace_s > 0.0 else 0.0
+    if 0.0 < p.bal_brace_max_s <= braced_for and large:
+        released, braced_for = True, 0.0
+    brace_s = (0.0 if released
+               else p.bal_brace_s if large and may_brace else max(0.0, state.brace_s - dt))
     brace = _follow(state.brace, 1.0 if brace_s > 0.0 else 0.0, dt,
                     BRACE_IN_S if brace_s > 0.0 else BRACE_OUT_S)
     # Hold: in double support, do not lift the foot the body is leaning onto.
     toward = -xi[1] if next_lift == 0 else xi[1]       # the right foot is on the -y side
-    holding = not any(g.swinging) and 0.0 < p.bal_hold_xi < toward
+    holding = not any(g.swinging) and 0.0 < p.bal_hold_xi < toward and not released
     hold = _follow(state.hold, 1.0 if holding else 0.0, dt,
                    BRACE_IN_S if holding else BRACE_OUT_S)
     return StepState(feet, level, tempo, brace, brace_s, hold, next_lift, rhythm, latch,
-                     kin_rhythm), xi
+                     kin_rhythm, braced_for, released), xi
 
 
 def phase_rate(state: StepState, amplitude: float) -> float:

@@ -31,6 +31,7 @@ LABELS: dict[str, str] = {
     "bal_lean_max": "Largest learned lean", "bal_step_gain": "Step toward a fall",
     "bal_step_max": "Largest catch step", "bal_step_dead": "Ignore small wobbles",
     "bal_brace_xi": "Put the foot down at", "bal_brace_s": "Stand still for",
+    "bal_brace_max_s": "Give up bracing after",
     "bal_hold_xi": "Don't lift a loaded foot", "bal_tempo_max": "Largest hurry",
     "bal_swing_level": "Keep the swinging foot level", "bal_kin_xi": "Capture point from the legs",
     "bal_learn_cycles": "Learn the walk's rhythm",

@@ -179,7 +179,11 @@ class Balance:
         tilt = self._read_tilt()
         p = self.engine.live_params
         gait = self.gait_phase()
-        kin = self.kinematics(q, tilt, gait, dt) if p.bal_kin_xi > 0.0 else None
+        kin = None
+        if p.bal_kin_xi > 0.0:
+            kin = self.kinematics(q, tilt, gait, dt)
+        else:       # switched on later (the panel), it starts afresh: no stale last tick
+            self._before = self._plan_before = self._trim_before = self._w = None
         self.state, corr = balance_step(self.state, tilt, p, dt, gait, kin)
         r_roll, r_pitch, l_roll, l_pitch = corr.level
         self.engine.trim = BodyTrim(corr.pelvis_roll, corr.pelvis_pitch, *corr.feet,

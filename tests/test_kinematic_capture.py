@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from robot.balance.kinematic import (
@@ -152,3 +153,29 @@ def test_the_law_takes_the_kinematic_capture_error(share: float, kin: tuple[floa
     _, corr = balance_step(state, LEVEL, p, DT, GaitPhase(height=H),
                            (kin[0], kin[1], kin[2], kin[3]))
     assert corr.capture == pytest.approx(want, abs=1e-12)
+
+
+def test_the_stage_takes_the_legs_at_the_command_plus_the_read_back_lag() -> None:
+    """Before anything is sent, this tick's target; then the last command plus the lag
+    the read-back showed: taken whole at the first read-back, then followed with the
+    50 ms time constant (one 5 ms tick: a tenth of the way), held between read-backs."""
+    from robot.balance.stage import LAG_TAU_S, Balance
+    from robot.config.gait_file import load_gait
+    from robot.gait.engine import GaitEngine
+
+    robot = load_robot("biped18-dynamixel")
+    engine = GaitEngine(robot, load_gait("walk").params)
+    reads: list[list[float] | None] = []
+    stage = Balance(engine, lambda: LEVEL, present=lambda: reads.pop(0) if reads else None)
+    n = len(robot.joint_names)
+    q = np.full(n, 0.1)
+    assert stage.held(q, DT) is q
+    stage(q, DT)                                   # sends q (no correction: level, no rate)
+    sent = stage._sent
+    assert sent is not None
+    reads.append((sent - 0.02).tolist())
+    assert stage.held(q, DT) == pytest.approx(sent - 0.02)
+    assert stage.held(q, DT) == pytest.approx(sent - 0.02)      # no new read: held
+    reads.append((sent - 0.04).tolist())
+    assert LAG_TAU_S == 0.05
+    assert stage.held(q, DT) == pytest.approx(sent - 0.02 - 0.1 * 0.02)

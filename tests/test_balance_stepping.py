@@ -309,3 +309,27 @@ def test_the_gait_holds_rather_than_lift_the_foot_the_body_leans_onto() -> None:
     assert state.next_lift == 1
     _, corr = settle(state, LEVEL._replace(roll_rate=-lean), p, down, 0.2)
     assert 1.0 + corr.tempo < 0.01
+
+
+def test_a_brace_that_holds_too_long_is_given_up_for_a_step() -> None:
+    """bal_brace_max_s 0.1 s: a 5 cm backward error (over bal_brace_xi 4 cm) braces at
+    once, and after 0.1 s of it the brace is given up (the phase runs again and no hold
+    stops it, though the error leans onto the foot that lifts next); the error back under
+    4 cm, a new 5 cm error braces again. With bal_brace_max_s 0 the brace holds on."""
+    p = STEP.replace({"bal_step_gain": 0.0, "bal_brace_xi": 0.04, "bal_brace_s": 0.3,
+                      "bal_brace_max_s": 0.1, "bal_hold_xi": 0.03})
+    big = 0.05 / (H / W0)                    # h x rate / omega0 = 5 cm
+    back_right = LEVEL._replace(pitch_rate=-big, roll_rate=0.8 * big)   # 4 cm to the right
+    down = GaitPhase(height=H, swinging=(False, False))
+    state, corr = settle(LEARNT, back_right, p, down, 0.09)
+    assert corr.land > 0.95 and not state.stepping.released
+    state, corr = settle(state, back_right, p, down, 0.02)
+    assert state.stepping.released
+    state, corr = settle(state, back_right, p, down, 0.7)     # 7 time constants out
+    assert corr.land < 0.01 and corr.tempo == pytest.approx(0.0, abs=0.01)
+    state, _ = settle(state, LEVEL, p, down, 0.05)
+    assert not state.stepping.released
+    _, corr = settle(state, back_right, p, down, 0.05)
+    assert corr.land > 0.9
+    _, corr = settle(LEARNT, back_right, p.replace({"bal_brace_max_s": 0.0}), down, 0.6)
+    assert corr.land > 0.99 and 1.0 + corr.tempo < 0.01

@@ -9,9 +9,11 @@ Per control tick, from the torso's tilt (roll, pitch) [rad], tilt rate [rad/s] a
   while the body stays vertical; plus a proportional ankle term on the tilt itself;
 - heading: a PI loop trims ``turn`` so the heading follows the commanded turn rate;
 - stepping (robot.balance.stepping): a push is what the walk's learned rhythm does not
-  explain; the swinging foot takes the capture step (robot.balance.capture_step: where
-  the capture point will be at touchdown, sooner when that is out of reach), kept level
-  with the ground; in double support the gait holds rather than lift a loaded foot.
+  explain (in the torso's tilt, and with ``bal_kin_xi`` in where the legs' kinematics put
+  the body over its feet: robot.balance.kinematic); the swinging foot takes the capture
+  step (robot.balance.capture_step: where the capture point will be at touchdown, sooner
+  when that is out of reach), kept level with the ground; in double support the gait
+  holds rather than lift a loaded foot.
 
 Sign conventions (REP-103; robot/gait/ik.py): every pitch joint turns about +y and every roll
 joint about +x of its parent. With a foot flat on the ground, the torso's pitch is
@@ -135,8 +137,11 @@ def _heading(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float,
 
 
 def balance_step(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float,
-                 gait: GaitPhase = NO_PHASE) -> tuple[BalanceState, Correction]:
-    """One tick of the balance loop: the new state and the correction. dt: tick [s]."""
+                 gait: GaitPhase = NO_PHASE, kin: tuple[float, float, float, float] | None = None
+                 ) -> tuple[BalanceState, Correction]:
+    """One tick of the balance loop: the new state and the correction. dt: tick [s];
+    kin: the pelvis over its support from the legs' angles (x, y [m], vx, vy [m/s];
+    robot.balance.kinematic), None when unknown."""
     if not state.started:
         start = tilt.heading if tilt.heading is not None else 0.0
         state = BalanceState(heading=start, heading_ref=start,
@@ -150,7 +155,7 @@ def balance_step(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float,
     lean_roll = _clip(state.lean_roll - p.bal_lean_i * e_roll * dt, p.bal_lean_max)
     heading, heading_ref, heading_i, turn = _heading(state, tilt, p, dt, a)
     values = (tilt.roll, tilt.pitch, tilt.roll_rate, tilt.pitch_rate)
-    stepping, capture = step(state.stepping, values, p, gait, dt)
+    stepping, capture = step(state.stepping, values, p, gait, dt, kin)
     feet, level = stepping.feet, stepping.level
     corr = Correction(
         ankle_pitch=p.bal_ankle_pd * tilt.pitch_rate + p.bal_ankle_pp * e_pitch,

@@ -14,6 +14,13 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
+from robot.balance.kinematic import (
+    LegSlots,
+    leg_angles,
+    over_support,
+    support_weight,
+    unplanned,
+)
 from robot.balance.law import (
     Attitude,
     BalanceState,
@@ -32,6 +39,12 @@ if TYPE_CHECKING:
 __all__ = ["Attitude", "Balance", "BalanceState", "Correction", "GaitPhase", "JointSlots",
            "apply", "attitude_reader", "balance_step", "commanded_yaw_rate", "wrap"]
 
+#: The servos' lag behind their command (read back every few ticks) is followed with
+#: this time constant [s]: about the loop's read-back period (10 ticks at 200 Hz).
+LAG_TAU_S = 0.05
+#: The kinematic estimate's support passes from one sole to the other over this time
+#: constant [s] when a foot lifts or lands.
+SUPPORT_TAU_S = 0.03
 #: Feet stay this far apart at least [m] when a step moves one toward the other.
 FOOT_GAP_M = 0.005
 
@@ -70,13 +83,26 @@ class Balance:
     engine's turn and return the corrected joints.
 
     read_tilt: returns the current ``Attitude`` (from an IMU; robot.imu); it may raise, and the
-    streamer then ends the walk as a fault and drops the feedback.
+    streamer then ends the walk as a fault and drops the feedback. present: returns the
+    joint angles [rad] the servos reported since the last tick (the loop's read-back) or
+    None; between read-backs the legs are taken at the last command plus the lag the
+    last read-back showed (``bal_kin_xi``: robot.balance.kinematic).
     """
 
-    def __init__(self, engine: GaitEngine, read_tilt: Callable[[], Attitude]) -> None:
+    def __init__(self, engine: GaitEngine, read_tilt: Callable[[], Attitude],
+                 present: Callable[[], Sequence[float] | None] | None = None) -> None:
         self.engine = engine
         self._read_tilt = read_tilt
+        self._present = present
         self.slots = JointSlots.of(engine.robot.joint_names)
+        self.legs = LegSlots.of(engine.robot.joint_names)
+        self._sent: np.ndarray | None = None
+        self._lag: np.ndarray | None = None
+        self._lag_seen: np.ndarray | None = None
+        self._before: tuple[tuple[float, ...], tuple[float, ...]] | None = None
+        self._plan_before: tuple[tuple[float, ...], tuple[float, ...]] | None = None
+        self._trim_before: BodyTrim | None = None
+        self._w: float | None = None
         self.state = BalanceState()
         self.last = Correction()
         self._theta = 0.0
@@ -86,6 +112,8 @@ class Balance:
         self.state = BalanceState()
         self.last = Correction()
         self._theta = float(self.engine.phase.theta)
+        self._sent = self._lag = self._lag_seen = None
+        self._before = self._plan_before = self._trim_before = self._w = None
         self.stop()
 
     def stop(self) -> None:
@@ -105,17 +133,67 @@ class Balance:
                          height=p.stance * g.leg_length + g.ankle_height,
                          inward=max(0.0, 0.5 * (gap - FOOT_GAP_M)))
 
+    def held(self, q: np.ndarray, dt: float) -> np.ndarray:
+        """The joint angles [rad] the servos hold now, as known: the last command plus
+        the lag the read-backs show (present - commanded), followed with the time
+        constant ``LAG_TAU_S`` so that a read-back is no jump; ``q`` (this tick's
+        target) before anything was sent."""
+        got = self._present() if self._present is not None else None
+        if self._sent is None:
+            return q
+        if got is not None and len(got) == len(self._sent):
+            self._lag_seen = np.asarray(got, dtype=float) - self._sent
+        if self._lag_seen is not None:
+            lag = self._lag if self._lag is not None else self._lag_seen
+            self._lag = lag + min(1.0, dt / LAG_TAU_S) * (self._lag_seen - lag)
+        return self._sent if self._lag is None else self._sent + self._lag
+
+    def kinematics(self, q: np.ndarray, tilt: Attitude, gait: GaitPhase, dt: float
+                   ) -> tuple[float, float, float, float]:
+        """What the legs' kinematics show that the gait did not plan: the pelvis over its
+        support (x, y [m], vx, vy [m/s]) from the held joints and the IMU's tilt, less
+        the same from this tick's gait joints ``q`` (level) and the step offsets the
+        feedback put under the support (robot.balance.kinematic.unplanned)."""
+        held = self.held(q, dt).tolist()
+        legs = (leg_angles(held, self.legs.right), leg_angles(held, self.legs.left))
+        plan = (leg_angles(q.tolist(), self.legs.right), leg_angles(q.tolist(), self.legs.left))
+        # The support moves from foot to foot over SUPPORT_TAU_S, not in one tick: the two
+        # feet's unplanned offsets differ by a few mm, and a jump by half of that at a
+        # lift that the learned rhythm places a bin early or late reads as a push.
+        want = support_weight((not gait.swinging[0], not gait.swinging[1]))
+        w = self._w = (want if self._w is None
+                       else self._w + min(1.0, dt / SUPPORT_TAU_S) * (want - self._w))
+        g = self.engine.robot.geometry
+        measured = over_support(g, legs, self._before,
+                                (tilt.roll, tilt.pitch, tilt.roll_rate, tilt.pitch_rate), w, dt)
+        planned = over_support(g, plan, self._plan_before, (0.0, 0.0, 0.0, 0.0), w, dt)
+        t = self.engine.trim
+        shift = (w * t.r_dx + (1.0 - w) * t.l_dx, w * t.r_dy + (1.0 - w) * t.l_dy)
+        b = self._trim_before
+        before = None if b is None else (w * b.r_dx + (1.0 - w) * b.l_dx,
+                                         w * b.r_dy + (1.0 - w) * b.l_dy)
+        self._before, self._plan_before, self._trim_before = legs, plan, t
+        return unplanned(measured, planned, shift, before, dt)
+
     def __call__(self, q: np.ndarray, dt: float) -> np.ndarray:
         tilt = self._read_tilt()
-        self.state, corr = balance_step(self.state, tilt, self.engine.live_params, dt,
-                                        self.gait_phase())
+        p = self.engine.live_params
+        gait = self.gait_phase()
+        kin = None
+        if p.bal_kin_xi > 0.0:
+            kin = self.kinematics(q, tilt, gait, dt)
+        else:       # switched on later (the panel), it starts afresh: no stale last tick
+            self._before = self._plan_before = self._trim_before = self._w = None
+        self.state, corr = balance_step(self.state, tilt, p, dt, gait, kin)
         r_roll, r_pitch, l_roll, l_pitch = corr.level
         self.engine.trim = BodyTrim(corr.pelvis_roll, corr.pelvis_pitch, *corr.feet,
                                     turn=corr.turn, tempo=corr.tempo, land=corr.land,
                                     r_roll=r_roll, r_pitch=r_pitch, l_roll=l_roll,
                                     l_pitch=l_pitch)
         self.last = corr
-        return apply(q, corr, self.slots)
+        out = apply(q, corr, self.slots)
+        self._sent = out
+        return out
 
 
 def attitude_reader(imu: Imu, *, tau_s: float | None = None) -> Callable[[], Attitude]:

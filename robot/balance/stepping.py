@@ -4,6 +4,10 @@
   (robot.balance.rhythm); what it does not explain (a residual tilt e and rate de/dt) puts
   the capture point dxi = h (e + de/dt / omega0) from where the walk expects it (a linear
   inverted pendulum of the hip height h pivoting on its feet, omega0 = sqrt(g / h)).
+  With ``bal_kin_xi`` > 0 a share of dxi comes instead from the legs' kinematics
+  (robot.balance.kinematic: the pelvis over its support from the held joint angles and the
+  IMU's tilt, less the gait's plan and the feedback's own step offsets), its rhythm
+  learned the same way: dxi = x + vx / omega0 of what the walk does not explain.
 - The capture step (robot.balance.capture_step): the foot that swings (in double support,
   the one that lifts next) lands where dxi will have grown to by touchdown, within its
   reach, and the gait phase runs faster when that step would be out of reach
@@ -36,6 +40,9 @@ GRAVITY = 9.81  # [m/s^2]
 #: Largest change one tick may make to the learned rhythm, per signal (roll, pitch [rad],
 #: roll rate, pitch rate [rad/s]) x the learning rate: a push moves the table little.
 LEARN_CLIP = (0.05, 0.05, 0.5, 0.5)
+#: The same for the kinematic signals (the pelvis over its support: x, y [m], vx, vy
+#: [m/s]): the tilt's clip x a 0.23 m pendulum.
+KIN_CLIP = (0.012, 0.012, 0.12, 0.12)
 #: The rhythm counts as learned (stepping and bracing act) after this many gait cycles
 #: at full amplitude (robot.balance.rhythm learns a running mean over the first cycles).
 LEARNED = 2.0
@@ -85,6 +92,9 @@ class StepState(NamedTuple):
     next_lift: int = 0
     rhythm: Rhythm = Rhythm()
     latch: tuple[float, float] = (0.0, 0.0)
+    kin_rhythm: Rhythm = Rhythm()
+    braced_for: float = 0.0
+    released: bool = False
 
 
 def _clip(x: float, limit: float) -> float:
@@ -111,12 +121,13 @@ def used(p: GaitParams) -> bool:
             or p.bal_swing_level != 0.0)
 
 
-def disturbance(rhythm: Rhythm, values: Quad, p: GaitParams, g: GaitPhase, moving: float
-                ) -> tuple[Rhythm, Quad]:
+def disturbance(rhythm: Rhythm, values: Quad, p: GaitParams, g: GaitPhase, moving: float,
+                clip: Quad = LEARN_CLIP) -> tuple[Rhythm, Quad]:
     """The learned rhythm after this tick and the residual of ``values`` = the torso's
     (roll, pitch [rad], roll rate, pitch rate [rad/s]). The rhythm is expected in
     proportion to the envelope and to ``moving`` (1 - brace); it is learned only while the
-    gait walks at full amplitude. Zeros until the rhythm is learned."""
+    gait walks at full amplitude, each tick moving it by at most ``clip`` x the learning
+    rate. Zeros until the rhythm is learned."""
     if not used(p):
         return rhythm, (0.0, 0.0, 0.0, 0.0)
     a = g.amplitude * moving
@@ -124,7 +135,7 @@ def disturbance(rhythm: Rhythm, values: Quad, p: GaitParams, g: GaitPhase, movin
     e_roll, e_pitch, r_roll, r_pitch = (v - a * m for v, m in zip(values, learned, strict=True))
     if a >= 0.999 and p.bal_learn_cycles > 0.0:
         target = tuple(m + _clip(v - m, c)
-                       for v, m, c in zip(values, learned, LEARN_CLIP, strict=True))
+                       for v, m, c in zip(values, learned, clip, strict=True))
         rhythm = rhythm.learn(g.theta, target, g.dtheta, p.bal_learn_cycles)
     if p.bal_learn_cycles > 0.0 and rhythm.cycles < LEARNED:
         return rhythm, (0.0, 0.0, 0.0, 0.0)
@@ -139,6 +150,14 @@ def capture_error(residual: Quad, height: float) -> tuple[float, float]:
     w0 = math.sqrt(GRAVITY / h)
     e_roll, e_pitch, r_roll, r_pitch = residual
     return h * (e_pitch + r_pitch / w0), -h * (e_roll + r_roll / w0)
+
+
+def kinematic_error(residual: Quad, height: float) -> tuple[float, float]:
+    """The capture point's offset (forward, left) [m] from where the walk puts it, for a
+    residual (x, y [m], vx, vy [m/s]) of the pelvis over its support: x + vx / omega0."""
+    w0 = math.sqrt(GRAVITY / max(height, 1e-3))
+    x, y, vx, vy = residual
+    return x + vx / w0, y + vy / w0
 
 
 def _standing_level(level: Quad, g: GaitPhase) -> tuple[float, float]:
@@ -200,10 +219,18 @@ def _level(level: Quad, tilt: tuple[float, float], p: GaitParams, g: GaitPhase,
 
 
 def step(state: StepState, values: tuple[float, float, float, float], p: GaitParams,
-         g: GaitPhase, dt: float) -> tuple[StepState, tuple[float, float]]:
+         g: GaitPhase, dt: float, kin: Quad | None = None
+         ) -> tuple[StepState, tuple[float, float]]:
     """One tick of stepping: the new state and the capture-point error (forward, left)
-    [m] it acted on. ``values``: the torso's (roll, pitch, roll rate, pitch rate)."""
+    [m] it acted on. ``values``: the torso's (roll, pitch, roll rate, pitch rate); ``kin``:
+    the pelvis over its support (x, y [m], vx, vy [m/s]; robot.balance.kinematic), None
+    when the legs' angles are not known (then the tilt alone says where the body is)."""
     rhythm, res = disturbance(state.rhythm, values, p, g, 1.0 - state.brace)
+    kin_rhythm = state.kin_rhythm
+    xi_kin = None
+    if kin is not None and p.bal_kin_xi > 0.0:
+        kin_rhythm, kres = disturbance(kin_rhythm, kin, p, g, 1.0 - state.brace, KIN_CLIP)
+        xi_kin = kinematic_error(kres, g.height)
     # The legs' tilt: the torso's, less the turn the balance itself put over the standing
     # feet (and its rate this tick).
     old = _standing_level(state.level, g)
@@ -212,6 +239,9 @@ def step(state: StepState, values: tuple[float, float, float, float], p: GaitPar
     legs = (res[0] - new[0], res[1] - new[1], res[2] - (new[0] - old[0]) / dt,
             res[3] - (new[1] - old[1]) / dt)
     xi = capture_error(legs, g.height)
+    if xi_kin is not None:
+        k = p.bal_kin_xi
+        xi = ((1.0 - k) * xi[0] + k * xi_kin[0], (1.0 - k) * xi[1] + k * xi_kin[1])
     next_lift = 1 if g.swinging[0] else 0 if g.swinging[1] else state.next_lift
     plan, want_tempo = capture_step(state.feet, xi, p, g, next_lift)
     # Latch: late in a swing the torso's tilt no longer says where the body goes (the
@@ -230,16 +260,26 @@ def step(state: StepState, values: tuple[float, float, float, float], p: GaitPar
     # gait puts it, ahead, it lengthens that base. A backward or mostly lateral one braces
     # at once (waiting for those too cost a bump case on each robot's suite).
     may_brace = not any(g.swinging) or abs(xi[1]) > abs(xi[0]) or xi[0] < 0.0
-    brace_s = (p.bal_brace_s if 0.0 < p.bal_brace_xi < size and may_brace
-               else max(0.0, state.brace_s - dt))
+    # A brace that has held bal_brace_max_s and still sees the error is given up: the
+    # robot only tips slower over the edge of its feet while it stands (docs/robustness.md,
+    # issue 22, third pass); the gait steps instead (the capture step, sooner), with no
+    # brace or hold until the error is back under the brace's threshold.
+    large = 0.0 < p.bal_brace_xi < size
+    released = state.released and large
+    braced_for = state.braced_for + dt if state.brace_s > 0.0 else 0.0
+    if 0.0 < p.bal_brace_max_s <= braced_for and large:
+        released, braced_for = True, 0.0
+    brace_s = (0.0 if released
+               else p.bal_brace_s if large and may_brace else max(0.0, state.brace_s - dt))
     brace = _follow(state.brace, 1.0 if brace_s > 0.0 else 0.0, dt,
                     BRACE_IN_S if brace_s > 0.0 else BRACE_OUT_S)
     # Hold: in double support, do not lift the foot the body is leaning onto.
     toward = -xi[1] if next_lift == 0 else xi[1]       # the right foot is on the -y side
-    holding = not any(g.swinging) and 0.0 < p.bal_hold_xi < toward
+    holding = not any(g.swinging) and 0.0 < p.bal_hold_xi < toward and not released
     hold = _follow(state.hold, 1.0 if holding else 0.0, dt,
                    BRACE_IN_S if holding else BRACE_OUT_S)
-    return StepState(feet, level, tempo, brace, brace_s, hold, next_lift, rhythm, latch), xi
+    return StepState(feet, level, tempo, brace, brace_s, hold, next_lift, rhythm, latch,
+                     kin_rhythm, braced_for, released), xi
 
 
 def phase_rate(state: StepState, amplitude: float) -> float:

@@ -124,6 +124,11 @@ SPECS: dict[str, ParamSpec] = {
                               False),
     "bal_brace_s": ParamSpec(0.5, 0.0, 3.0, "s", BALANCE, "the gait holds still this long "
                              "after the error was last that large", False),
+    "bal_brace_max_s": ParamSpec(0.0, 0.0, 3.0, "s", BALANCE, "a brace that has held this "
+                                 "long and still sees the error is given up: the gait steps "
+                                 "(capture step, no brace or hold) until the error is back "
+                                 "under bal_brace_xi (0: the brace holds as long as the "
+                                 "error does)", False),
     "bal_hold_xi": ParamSpec(0.0, 0.0, 0.2, "m", BALANCE, "lateral capture-point error "
                              "toward the foot that lifts next at which the gait holds in "
                              "double support (a loaded foot is not lifted; 0: never)", False),
@@ -134,6 +139,10 @@ SPECS: dict[str, ParamSpec] = {
                                  "with this share of the torso's unexpected tilt (1: kept "
                                  "level with the ground, so it lands where the step was "
                                  "planned)", False),
+    "bal_kin_xi": ParamSpec(0.0, 0.0, 1.0, "-", BALANCE, "share of the capture-point "
+                            "error taken from the legs' kinematics (joint angles and IMU "
+                            "tilt: where the body stands over its feet) rather than from "
+                            "the torso's tilt alone (0: tilt only)", False),
     "bal_learn_cycles": ParamSpec(4.0, 0.0, 50.0, "cycle", BALANCE, "time constant of the "
                                   "learned gait rhythm the stepping ignores (0: none)", False),
     "bal_heading_p": ParamSpec(0.5, 0.0, 2.0, "1/step", BALANCE, "turn trim per rad of "
@@ -216,9 +225,11 @@ class GaitParams:
     bal_step_dead: float = SPECS["bal_step_dead"].default
     bal_brace_xi: float = SPECS["bal_brace_xi"].default
     bal_brace_s: float = SPECS["bal_brace_s"].default
+    bal_brace_max_s: float = SPECS["bal_brace_max_s"].default
     bal_hold_xi: float = SPECS["bal_hold_xi"].default
     bal_tempo_max: float = SPECS["bal_tempo_max"].default
     bal_swing_level: float = SPECS["bal_swing_level"].default
+    bal_kin_xi: float = SPECS["bal_kin_xi"].default
     bal_learn_cycles: float = SPECS["bal_learn_cycles"].default
     bal_heading_p: float = SPECS["bal_heading_p"].default
     bal_heading_i: float = SPECS["bal_heading_i"].default

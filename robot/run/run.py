@@ -106,7 +106,12 @@ class Run(Generic[SourceT]):
         if not isinstance(spec.source, GaitEngine):
             raise ConfigError(f"run: balance needs a gait engine, not a "
                               f"{type(spec.source).__name__}")
-        return Balance(spec.source, attitude_reader(spec.imu))
+        return Balance(spec.source, attitude_reader(spec.imu), present=self._read_back)
+
+    def _read_back(self) -> list[float] | None:
+        """The joint angles [rad] the loop read back on its last tick, else None."""
+        tel = self._streamer.telemetry if self._streamer is not None else None
+        return tel.q_present if tel is not None and tel.fresh else None
 
     def _observer(self) -> Callable[[Telemetry], None]:
         spec = self.spec

@@ -1,0 +1,119 @@
+"""Where the body stands over its feet, from the legs' joint angles and the torso's tilt:
+the kinematic half of the capture point (issue 22, third pass).
+
+The torso's tilt alone cannot say where the body stands over a foot that landed out of
+its place (docs/robustness.md, issue 22, second pass): a position-controlled leg carries
+the pelvis wherever its joint angles put it. Here each sole is found under the pelvis by
+the legs' forward kinematics (robot.gait.ik.leg_fk_full) of the joint angles the servos
+hold, turned from the pelvis frame into a level, yaw-free frame by the IMU's roll and
+pitch; the pelvis then stands at minus that over each sole. Its velocity over a sole is
+the change of that position over one tick with the same sole as reference, so a change
+of stance foot is no jump. With the feet flat on the ground this is the body's own
+horizontal position and velocity relative to its support, the inputs of the capture point
+xi = c + c' / omega0 (Pratt et al. 2006; the stance-foot frame as in Englsberger et al.
+2015), measured with what a real robot has (present positions, an IMU).
+
+Signs: REP-103 (x forward, y left); +pitch nose down, +roll right side down (the law's
+convention, robot.balance.law). Units: m, m/s, rad.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import NamedTuple
+
+from robot.config.joint_names import LEG_JOINTS
+from robot.config.robot import Geometry
+from robot.gait.ik import leg_fk_full
+
+Point = tuple[float, float, float]
+Quad = tuple[float, float, float, float]
+Plane = tuple[float, float]
+
+
+class LegSlots(NamedTuple):
+    """Indices of each leg's six joints (LEG_JOINTS order) in a robot's joint vector;
+    None for a joint the robot lacks (hip yaw on 5-DoF legs: held at 0)."""
+
+    right: tuple[int | None, ...]
+    left: tuple[int | None, ...]
+
+    @classmethod
+    def of(cls, joint_names: Sequence[str]) -> LegSlots:
+        index = {n: i for i, n in enumerate(joint_names)}
+        return cls(tuple(index.get(f"r_{j}") for j in LEG_JOINTS),
+                   tuple(index.get(f"l_{j}") for j in LEG_JOINTS))
+
+
+def leg_angles(q: Sequence[float], slots: tuple[int | None, ...]) -> tuple[float, ...]:
+    """The six angles [rad] of one leg from the joint vector ``q``; 0 where it has none."""
+    return tuple(0.0 if i is None else float(q[i]) for i in slots)
+
+
+def level(v: tuple[float, float, float], roll: float, pitch: float
+          ) -> tuple[float, float, float]:
+    """Vector ``v`` [m] of the pelvis frame in the level frame: R_y(pitch) R_x(roll) v."""
+    x, y, z = v
+    cr, sr, cp, sp = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch)
+    y, z = cr * y - sr * z, sr * y + cr * z
+    return cp * x + sp * z, y, -sp * x + cp * z
+
+
+def body_over_soles(g: Geometry, q_right: Sequence[float], q_left: Sequence[float],
+                    roll: float, pitch: float) -> tuple[Point, Point]:
+    """The pelvis's position (forward, left, up) [m] relative to the right and to the
+    left sole point, level frame, for leg angles [rad] and torso tilt [rad]."""
+    out = []
+    for side, q in (("r", q_right), ("l", q_left)):
+        sole, _ = leg_fk_full(g, side, tuple(q))
+        x, y, z = level((float(sole[0]), float(sole[1]), float(sole[2])), roll, pitch)
+        out.append((-x, -y, -z))
+    return out[0], out[1]
+
+
+def support_weight(standing: tuple[bool, bool]) -> float:
+    """The right sole's share of the support [0, 1]: 1 when only it stands, 0 when only
+    the left one does, 0.5 when both or neither do."""
+    r, l_ = standing
+    return 1.0 if r and not l_ else 0.0 if l_ and not r else 0.5
+
+
+def over_support(g: Geometry, legs: tuple[Sequence[float], Sequence[float]],
+                 before: tuple[Sequence[float], Sequence[float]] | None,
+                 tilt: Quad, weight: float, dt: float) -> Quad:
+    """(x, y, vx, vy): the pelvis over its support [m] and its velocity there [m/s].
+
+    legs: (right, left) leg angles [rad] now; before: the same one tick ``dt`` [s] ago
+    (None: no motion of the legs); tilt: the torso's (roll, pitch [rad], roll rate, pitch
+    rate [rad/s]); weight: the right sole's share of the support (``support_weight``).
+    The velocity has two parts: the legs' motion (the change of the position over the
+    same support at the same tilt) and the tilt's rate turning the pelvis about the sole
+    (omega x c: pitch rate x height forward, -roll rate x height to the left)."""
+    roll, pitch, roll_rate, pitch_rate = tilt
+
+    def at(q: tuple[Sequence[float], Sequence[float]]) -> Point:
+        a, b = body_over_soles(g, q[0], q[1], roll, pitch)
+        return (weight * a[0] + (1.0 - weight) * b[0], weight * a[1] + (1.0 - weight) * b[1],
+                weight * a[2] + (1.0 - weight) * b[2])
+    x, y, z = at(legs)
+    vx, vy = pitch_rate * z, -roll_rate * z
+    if before is not None and dt > 0.0:
+        bx, by, _ = at(before)
+        vx += (x - bx) / dt
+        vy += (y - by) / dt
+    return x, y, vx, vy
+
+
+def unplanned(measured: Quad, planned: Quad, shift: Plane, shift_before: Plane | None,
+              dt: float) -> Quad:
+    """What the legs' kinematics show that the gait did not plan: ``measured`` (the held
+    joints and the torso's tilt) less ``planned`` (the gait's own joints, level, no tilt)
+    less ``shift`` [m], the feedback's own step offsets of the support (a foot moved
+    forward under the pelvis puts the pelvis that much back over it), and its rate
+    [m/s] from ``shift_before`` one tick ``dt`` [s] ago. (x, y [m], vx, vy [m/s])."""
+    sx, sy = shift
+    bx, by = shift if shift_before is None else shift_before
+    rx, ry = ((sx - bx) / dt, (sy - by) / dt) if dt > 0.0 else (0.0, 0.0)
+    return (measured[0] - planned[0] - sx, measured[1] - planned[1] - sy,
+            measured[2] - planned[2] - rx, measured[3] - planned[3] - ry)

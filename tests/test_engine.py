@@ -16,9 +16,9 @@ from robot.config.params import SPECS, GaitParams
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from robot.gait import expressions as gait
-from robot.gait.engine import GaitEngine, solve
+from robot.gait.engine import ENVELOPE_MIN_RATE, GaitEngine, solve
 from robot.gait.ik import leg_fk_full
-from robot.gait.targets import BodyTargets, body_targets, scale
+from robot.gait.targets import BodyTargets, BodyTrim, body_targets, scale
 
 RATE = 200.0
 DT = 1.0 / RATE
@@ -251,6 +251,41 @@ def test_envelope_ramps_in_and_out_over_ramp_cycles(name: str) -> None:
     # Ramped out: the pose is the start pose again, whatever the phase was.
     assert e.tick(DT) == e.start_pose()
     assert e.amplitude == 0.0
+
+
+def test_the_envelope_runs_in_gait_time_so_a_braced_stop_holds_its_stride() -> None:
+    """The ramp counts cycles of the phase: while the balance loop brakes the phase (a
+    brace, tempo -1) the ramp-out holds too, so the stride does not shrink under two
+    planted feet (the 5-DoF Dynamixel robot turned 7 deg in such a stop, docs/gait.md),
+    at the slowest ENVELOPE_MIN_RATE of its rate so the stop still ends; a phase sped up
+    ramps as much faster. By hand: the linear ramp variable x falls by dt / ramp_s x rate
+    per tick, and the amplitude is smoothstep(x)."""
+    p = load_gait("walk").params
+    ramp_s = p.ramp_cycles * p.cycle_s
+    e = GaitEngine(ROBOT, p)
+    e.start()
+    while e.amplitude < 1.0:
+        e.tick(DT)
+    e.stop()
+    x = 1.0
+    for tempo, rate, n in ((0.0, 1.0, 40), (-0.5, 0.5, 40), (-0.9, ENVELOPE_MIN_RATE, 40),
+                           (-1.0, ENVELOPE_MIN_RATE, 40), (0.1, 1.1, 40)):
+        e.trim = BodyTrim(tempo=tempo, land=1.0 if tempo == -1.0 else 0.0)
+        theta = e.phase.theta
+        for _ in range(n):
+            e.tick(DT)
+            x -= DT / ramp_s * rate
+        assert e.amplitude == pytest.approx(smoothstep(x), abs=1e-9), tempo
+        assert (e.phase.theta - theta) % (2 * math.pi) == pytest.approx(
+            n * DT * (1 + tempo) * p.omega % (2 * math.pi), abs=1e-9)
+    # A stop braced throughout still ends, within 1 / ENVELOPE_MIN_RATE of its time.
+    e.trim = BodyTrim(tempo=-1.0, land=1.0)
+    ticks = 0
+    while not e.stopped:
+        e.tick(DT)
+        ticks += 1
+    assert ticks <= x * ramp_s / ENVELOPE_MIN_RATE / DT + 1
+    assert ticks >= x * ramp_s / ENVELOPE_MIN_RATE / DT - 1
 
 
 @settings(max_examples=60, deadline=None)

@@ -16,10 +16,13 @@ from robot.tuning.conditions import STAIRS_REACH_M, STAIRS_S, SWITCHES_S
 from robot.tuning.robustness import (
     PUSH_AT_S,
     STRAIGHT_S,
+    WALK_ON_SHARE,
     Condition,
     Outcome,
     conditions,
+    judge,
     straightness,
+    survival_table,
 )
 
 WALK = load_gait("walk").params
@@ -82,6 +85,32 @@ def test_straightness_judges_heading_and_drift_against_the_goal() -> None:
     assert straightness([run(0.0, -0.31)])[True]["drift_ratio"] == pytest.approx(0.31 / 6)
 
 
+def test_a_pushed_run_counts_only_if_it_walks_on() -> None:
+    """By hand: the flat walk made 0.100 m/s with balance and 0.080 open loop; a pushed
+    run survives at 0.090 (>= 0.85 x 0.100) and not at 0.080 nor standing still (0.005);
+    open loop 0.070 >= 0.85 x 0.080 = 0.068 survives. A slope run is not a push: 0.02
+    m/s survives. Every push group is judged; no other group is."""
+    assert WALK_ON_SHARE == 0.85
+    pushes = [c for c in conditions(WALK) if c.group.startswith("push")]
+    assert len(pushes) == 32 and all(c.walk_on for c in pushes)
+    assert not any(c.walk_on for c in conditions(WALK) if c not in pushes)
+    flat, push, slope = Condition("flat", "flat"), pushes[0], Condition("slope", "slope")
+
+    def run(c: Condition, speed: float, *, balance: bool = True, fell: bool = False
+            ) -> Outcome:
+        return Outcome(c, balance, fell, summary={"speed_m_s": speed})
+    runs = judge([run(flat, 0.100), run(flat, 0.080, balance=False), run(push, 0.090),
+                  run(push, 0.080), run(push, 0.005), run(push, 0.070, balance=False),
+                  run(slope, 0.02), run(push, 0.2, fell=True)])
+    assert [o.survived for o in runs] == [True, True, True, False, False, True, True, False]
+    assert [o.stood for o in runs] == [False, False, False, True, True, False, False, False]
+    table = dict(survival_table(runs))
+    assert table[push.group] == {True: (1, 4), False: (1, 1)}
+    # No flat walk that stayed up to compare with: no pushed run walks on.
+    alone = judge([run(flat, 0.1, fell=True), run(push, 0.09)])
+    assert not alone[1].survived and alone[1].stood
+
+
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
     png = tmp_path_factory.mktemp("robustness") / "suite.png"
@@ -106,6 +135,23 @@ def test_quick_suite_runs_with_and_without_balance(quick: tuple[dict, Path]) -> 
 def test_with_balance_the_quick_cases_survive(quick: tuple[dict, Path], name: str) -> None:
     run = next(r for r in quick[0]["runs"] if r["condition"] == name and r["balance"])
     assert run["fell"] is False, run
+
+
+def test_the_quick_suite_counts_a_push_only_if_it_walks_on(quick: tuple[dict, Path]) -> None:
+    """Recomputed from the runs' own speeds: a push run survived iff it stayed up at
+    WALK_ON_SHARE of its mode's flat walk; the groups count survivors by that."""
+    result = quick[0]
+    runs = result["runs"]
+    flat = {r["balance"]: r["speed_m_s"] for r in runs if r["condition"] == "flat"}
+    pushes = [r for r in runs if r["group"].startswith("push")]
+    assert len(pushes) == 8 and all(r["walk_on"] for r in pushes)
+    for r in pushes:
+        walks = r["fell"] is False and r["speed_m_s"] >= WALK_ON_SHARE * flat[r["balance"]]
+        assert r["survived"] is walks and r["stood"] is (r["fell"] is False and not walks), r
+    for g, modes in result["groups"].items():
+        for mode, cell in modes.items():
+            mine = [r for r in runs if r["group"] == g and r["balance"] is (mode == "balance")]
+            assert cell == {"survived": sum(r["survived"] for r in mine), "runs": len(mine)}
 
 
 def test_the_5_deg_uphill_needs_the_balance_loop(quick: tuple[dict, Path]) -> None:

@@ -23,6 +23,7 @@ from robot.tuning.robustness import (
     STRAIGHT_DEG,
     STRAIGHT_DRIFT,
     STRAIGHT_S,
+    WALK_ON_SHARE,
     Outcome,
     check_seconds,
     conditions,
@@ -87,8 +88,11 @@ def run(args: argparse.Namespace) -> int:
                            for b, (ok, n) in row.items()} for g, row in table},
             "runs": [{"condition": o.condition.name, "group": o.condition.group,
                       "balance": o.balance, "fell": o.fell, "fell_at_s": o.fell_at_s,
-                      "distance_m": o.distance_m, "heading_deg": o.heading_deg,
-                      "error": o.error} for o in outcomes],
+                      "distance_m": o.distance_m, "speed_m_s": o.speed_m_s,
+                      "heading_deg": o.heading_deg, "walk_on": o.condition.walk_on,
+                      "stood": o.stood, "survived": o.survived, "error": o.error}
+                     for o in outcomes],
+            "walk_on_share": WALK_ON_SHARE,
             "straightness": {("balance" if b else "open_loop"): v
                              for b, v in straight.items()}}))
     else:
@@ -97,6 +101,11 @@ def run(args: argparse.Namespace) -> int:
         if falls:
             print("fell with balance: " + "; ".join(
                 f"{o.condition.name} at {o.fell_at_s:.1f} s" for o in falls))
+        stood = [o for o in outcomes if o.balance and o.stood]
+        if stood:
+            print(f"stood (under {100 * WALK_ON_SHARE:g} % of the flat walk's speed) with "
+                  "balance: " + "; ".join(f"{o.condition.name} {o.speed_m_s:.3f} m/s"
+                                          for o in stood))
         for b, v in straight.items():
             print(f"flat {STRAIGHT_S:g} s, {'balance' if b else 'open loop'}: heading "
                   f"{v['heading_deg']:+.1f} deg, drift {v['drift_m']:+.3f} m = "

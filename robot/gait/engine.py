@@ -40,6 +40,9 @@ __all__ = ["PARAM_TAU_S", "PRESET_BLEND_S", "STEER_BUDGET", "STEER_RATE", "GaitE
 #: (30 s each), 1.5 fell on the Feetech one (speed 1.125 with turn 0.375, and backward
 #: -0.75 with turn 0.375).
 STEER_BUDGET = 1.25
+#: The envelope's slowest rate [-] relative to its own while a feedback loop holds the
+#: phase: a stop braced again and again still ends, in at most 1 / this the time.
+ENVELOPE_MIN_RATE = 0.25
 
 
 def within_steering_budget(p: GaitParams) -> GaitParams:
@@ -258,7 +261,12 @@ class GaitEngine:
         if p is not self._ramp_p:
             self._ramp_p, self._ramp_s = p, p.ramp_cycles * p.cycle_s
         ramp_s = self._ramp_s
-        step = 1.0 if not math.isfinite(ramp_s) or ramp_s <= 0 else dt / ramp_s
+        # The envelope runs in gait time (ramp_cycles are cycles of the phase): while a
+        # feedback loop holds the phase (a brace, tempo -1) it holds too, at least at
+        # ENVELOPE_MIN_RATE, so the stride does not shrink under two planted feet.
+        rate = 1.0 + self.trim.tempo
+        gait_dt = dt if rate == 1.0 else dt * max(rate, ENVELOPE_MIN_RATE)
+        step = 1.0 if not math.isfinite(ramp_s) or ramp_s <= 0 else gait_dt / ramp_s
         if self._running:
             self._ramp = min(1.0, self._ramp + step)
         else:

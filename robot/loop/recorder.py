@@ -17,7 +17,8 @@ FORMATS = (".csv", ".jsonl")
 class Recorder:
     """Writes time since the first tick [s], commanded and present joint positions, loop
     timing, temperatures and loads (present values only on read-back ticks, blank / null
-    otherwise)."""
+    otherwise), and the joints held at a limit that tick (``clamped``: names separated by
+    spaces, blank when none)."""
 
     def __init__(self, path: str | Path, joint_names: tuple[str, ...],
                  ids: tuple[int, ...]) -> None:
@@ -37,7 +38,7 @@ class Recorder:
         cols = ["t", "state", "tick", "period_error_ms", "overruns", "amplitude"]
         cols += [f"cmd_{n}" for n in self.names] + [f"present_{n}" for n in self.names]
         cols += [f"temp_{n}" for n in self.names] + [f"load_{n}" for n in self.names]
-        return cols
+        return [*cols, "clamped"]
 
     def open(self) -> Recorder:
         """Create the file (ConfigError naming the path if it cannot be written)."""
@@ -84,7 +85,7 @@ class Recorder:
         temps = [servo[i].temperature if i in servo else None for i in self.ids]
         loads = [servo[i].load if i in servo else None for i in self.ids]
         row = [tel.t - self._t0, tel.state, tel.tick, tel.period_error_ms, tel.overruns, tel.amplitude,
-               *tel.q_cmd, *present, *temps, *loads]
+               *tel.q_cmd, *present, *temps, *loads, " ".join(tel.clamped) or None]
         if self._csv is not None:
             self._csv.writerow(["" if v is None or (isinstance(v, float) and math.isnan(v))
                                 else v for v in row])

@@ -69,6 +69,15 @@ class MotionSource(Protocol):
     def tick(self, dt: float) -> JointTargets: ...
 
 
+@runtime_checkable
+class ClampReporter(Protocol):
+    """A source that says which joints (indices, robot order) its last ``tick`` held at
+    a limit (the gait engine: ``clamped``); the loop puts them in its telemetry."""
+
+    @property
+    def clamped(self) -> tuple[int, ...]: ...
+
+
 #: A run's or a streamer's source type (e.g. GaitEngine for the panel, which sets its
 #: parameters live).
 SourceT = TypeVar("SourceT", bound=MotionSource)

@@ -43,7 +43,14 @@ from robot.loop.clock import Clock, MonotonicClock, Pacer
 from robot.loop.ending import arm_failsafe, end, explain_stop
 from robot.loop.latency import SampleStats
 from robot.loop.pending import PendingParams
-from robot.loop.source import Feedback, JointTargets, JointVector, MotionSource, SourceT
+from robot.loop.source import (
+    ClampReporter,
+    Feedback,
+    JointTargets,
+    JointVector,
+    MotionSource,
+    SourceT,
+)
 from robot.loop.start_check import check_inside_limits
 from robot.loop.telemetry import LoopStats, Telemetry, TickObserver, loop_stats
 from robot.loop.watchdog import Watchdog, WatchdogConfig
@@ -171,6 +178,7 @@ class Streamer(Generic[SourceT]):
                 self.feedback.start()
                 self._feedback_on = True
             t_gait = self.clock.now()
+            clamps = src if isinstance(src, ClampReporter) else None
             while not self._estop.is_set():
                 if self._stop.is_set() or (seconds is not None
                                            and self.clock.now() - t_gait >= seconds):
@@ -184,7 +192,8 @@ class Streamer(Generic[SourceT]):
                     log.exception("the gait engine failed")
                     self._set_fault(f"exception in the gait engine: {type(e).__name__}: {e}")
                     break
-                self._send(np.asarray(q, dtype=float), state=src.state)
+                self._send(np.asarray(q, dtype=float), state=src.state,
+                           held=clamps.clamped if clamps is not None else ())
         if not self._estop.is_set():
             rest = src.exit_pose()
             if rest is not None:
@@ -222,11 +231,16 @@ class Streamer(Generic[SourceT]):
             self._send(q, state=state)
 
     # -- the one loop --------------------------------------------------------------------
-    def _send(self, q: JointVector, *, state: str) -> None:
-        """(Feedback,) clamp, slew-limit, wait for the deadline, write; every Nth: read."""
+    def _send(self, q: JointVector, *, state: str, held: tuple[int, ...] = ()) -> None:
+        """(Feedback,) clamp, slew-limit, wait for the deadline, write; every Nth: read.
+        ``held``: the joints (indices) the source held at a limit this tick (telemetry)."""
         if self._feedback_on:
             q = self._feed_back(q)
-        q = np.clip(self.map.clamp(q), self._q_last - self._step, self._q_last + self._step)
+        limited = self.map.clamp(q)
+        own = np.flatnonzero(limited != q)
+        clamped = (tuple(self.map.names[i] for i in sorted({*held, *own.tolist()}))
+                   if held or own.size else ())
+        q = np.clip(limited, self._q_last - self._step, self._q_last + self._step)
         q_list = q.tolist()
         self._wait_deadline()
         try:
@@ -240,7 +254,7 @@ class Streamer(Generic[SourceT]):
         tel = self.telemetry
         tel.tick, tel.state, tel.q_cmd = self._ticks, state, q_list
         tel.amplitude = self.source.amplitude
-        tel.fresh = False
+        tel.fresh, tel.clamped = False, clamped
         if self._ticks % self.read_every == 0:
             try:
                 states = self.bus.read_state(self.map.ids)

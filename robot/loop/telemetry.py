@@ -15,7 +15,10 @@ class Telemetry:
     """A snapshot of the loop for the CLI, the panel and recorders (joint order).
 
     state: "idle" | "ramp_in" | "walking" | "ramp_out" | "rest" | "pose" | "stopped" |
-    "estop"; period_error_ms: lateness of the last tick start [ms].
+    "estop"; period_error_ms: lateness of the last tick start [ms]; clamped: the joints
+    (names, joint order) held at a limit in this tick's command: by the source (the gait
+    engine clamps what its IK asks beyond a limit) or by the loop (a feedback correction
+    beyond one); empty when none was.
     """
 
     t: float = 0.0
@@ -29,6 +32,7 @@ class Telemetry:
     amplitude: float = 0.0
     stop_reason: str | None = None
     fresh: bool = False  # True on ticks that read the servos back
+    clamped: tuple[str, ...] = ()
 
 
 TickObserver = Callable[[Telemetry], None]

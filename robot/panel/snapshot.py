@@ -41,7 +41,8 @@ def telemetry_snapshot(tel: Telemetry) -> dict[str, Any]:
     return {"t": tel.t, "state": tel.state, "tick": tel.tick, "q_cmd": tel.q_cmd,
             "q_present": tel.q_present, "servo": tel.servo,
             "period_error_ms": tel.period_error_ms, "overruns": tel.overruns,
-            "amplitude": tel.amplitude, "stop_reason": tel.stop_reason}
+            "amplitude": tel.amplitude, "stop_reason": tel.stop_reason,
+            "clamped": list(tel.clamped)}
 
 
 def show_doing(show: Mapping[str, Any]) -> str:
@@ -77,7 +78,8 @@ def state_snapshot(robot: RobotConfig, tel: Mapping[str, Any], sim: Mapping[str,
         "tick": tel.get("tick", 0), "rate_hz": rate_hz,
         "loop_hz": loop_hz, "period_error_ms": tel.get("period_error_ms", 0.0),
         "overruns": tel.get("overruns", 0), "amplitude": tel.get("amplitude", 0.0),
-        "stop_reason": tel.get("stop_reason"), "joints": list(names),
+        "stop_reason": tel.get("stop_reason"), "clamped": list(tel.get("clamped", [])),
+        "joints": list(names),
         "q_cmd": q_cmd, "q_present": q_present, "servos": servos, "sim": sim or None,
         "figure": figure, "wall_time": time.time()}
 

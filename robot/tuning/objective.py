@@ -32,7 +32,14 @@ from typing import Any
 
 from robot.config.params import GaitParams
 from robot.errors import ConfigError
-from robot.tuning.robustness import Condition, Outcome, WalkJob, conditions, run_condition
+from robot.tuning.robustness import (
+    Condition,
+    Outcome,
+    WalkJob,
+    conditions,
+    judge,
+    run_condition,
+)
 
 QUALITY_WEIGHT = 0.9
 #: A flat walk slower than this share of the target speed does not count as walking.
@@ -73,7 +80,7 @@ class Evaluation:
 
     @property
     def survived(self) -> int:
-        return sum(o.fell is False for o in self.outcomes)
+        return sum(o.survived for o in judge(self.outcomes))
 
     @property
     def flat(self) -> dict[str, Any]:
@@ -202,7 +209,9 @@ def evaluate(setup: Setup, params: GaitParams, *,
 
 
 def summary_json(ev: Evaluation) -> str:
-    """The per-condition results as JSON (kept with each trial)."""
+    """The per-condition results as JSON (kept with each trial; "stood": up, but it did
+    not walk on, robot.tuning.robustness.judge)."""
     return json.dumps({o.condition.name: ("error: " + o.error) if o.fell is None
-                       else "fell %.2f" % (o.fell_at_s or 0.0) if o.fell else "ok"
-                       for o in ev.outcomes})
+                       else "fell %.2f" % (o.fell_at_s or 0.0) if o.fell
+                       else f"stood {o.speed_m_s:.3f} m/s" if o.stood else "ok"
+                       for o in judge(ev.outcomes)})

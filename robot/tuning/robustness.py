@@ -6,12 +6,14 @@ suite measures the product, not a copy of it), run in this process through
 ``robot.run.run.execute``; ``run_suite`` spreads them over a pool of worker processes,
 one per core, each running one walk after the other (no interpreter start and imports
 per run). A condition survives when the walk does not fall (the simulated bus's watch:
-torso low or tilted past the fall threshold) in ``seconds`` of gait, and covers the
-condition's ``reach_m`` where it has one (the stairs).
+torso low or tilted past the fall threshold) in ``seconds`` of gait, covers the
+condition's ``reach_m`` where it has one (the stairs), and, where it must walk on (the
+pushes), keeps WALK_ON_SHARE of the flat walk's speed in the same suite (``judge``).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import multiprocessing
@@ -39,6 +41,7 @@ from robot.tuning.conditions import (
     STRAIGHT_DEG,
     STRAIGHT_DRIFT,
     STRAIGHT_S,
+    WALK_ON_SHARE,
     Condition,
     check_seconds,
     conditions,
@@ -46,14 +49,17 @@ from robot.tuning.conditions import (
 )
 
 __all__ = ["AFTER_PUSH_S", "IMU_NOISE", "PARAM_SCALE", "PUSH_AT_S", "PUSH_NS", "PUSH_PHASES",
-           "SKIP_PARAMS", "STRAIGHT_DEG", "STRAIGHT_DRIFT", "STRAIGHT_S", "Condition",
-           "Outcome", "WalkJob", "check_seconds", "conditions", "run_condition", "run_suite",
-           "scaled_params", "straightness", "survival_table", "worker_init"]
+           "SKIP_PARAMS", "STRAIGHT_DEG", "STRAIGHT_DRIFT", "STRAIGHT_S", "WALK_ON_SHARE",
+           "Condition", "Outcome", "WalkJob", "check_seconds", "conditions", "judge",
+           "run_condition", "run_suite", "scaled_params", "straightness", "survival_table",
+           "worker_init"]
 
 
 @dataclass
 class Outcome:
-    """The result of one condition with balance on or off."""
+    """The result of one condition with balance on or off. stood: it did not fall but
+    did not walk on either (``judge``: under WALK_ON_SHARE of the flat walk's speed, or
+    no flat walk to compare with), so it did not survive."""
 
     condition: Condition
     balance: bool
@@ -63,6 +69,27 @@ class Outcome:
     heading_deg: float = 0.0
     error: str = ""
     summary: dict[str, Any] = field(default_factory=dict)
+    stood: bool = False
+
+    @property
+    def speed_m_s(self) -> float:
+        """Forward speed over the run [m/s] (0 for a run that failed)."""
+        return float(self.summary.get("speed_m_s", 0.0))
+
+    @property
+    def survived(self) -> bool:
+        return self.fell is False and not self.stood
+
+
+def judge(outcomes: Sequence[Outcome]) -> list[Outcome]:
+    """``outcomes`` with ``stood`` set on each run that must walk on (``walk_on``), did
+    not fall and went slower than WALK_ON_SHARE x the unpushed flat walk of its balance
+    mode among ``outcomes`` (a flat walk that fell or is missing: no run walks on)."""
+    flat = {o.balance: o.speed_m_s for o in outcomes
+            if o.condition.group == "flat" and o.fell is False}
+    return [dataclasses.replace(o, stood=o.speed_m_s < WALK_ON_SHARE * flat[o.balance]
+                                if o.balance in flat else True)
+            if o.condition.walk_on and o.fell is False else o for o in outcomes]
 
 
 @dataclass(frozen=True)
@@ -150,16 +177,17 @@ def run_suite(robot: str, gait: str, params: GaitParams, conds: Iterable[Conditi
         except KeyboardInterrupt:        # the running walks stop on their own SIGINT
             pool.shutdown(wait=True, cancel_futures=True)
             raise
-    return [done[i] for i in range(len(work))]
+    return judge([done[i] for i in range(len(work))])
 
 
 def survival_table(outcomes: Sequence[Outcome]) -> list[tuple[str, dict[bool, tuple[int, int]]]]:
-    """Per group, in suite order: {balance: (survived, runs)} (failed runs count as falls)."""
+    """Per group, in suite order: {balance: (survived, runs)} (failed runs count as falls;
+    ``outcomes`` as ``judge`` returns them)."""
     table: dict[str, dict[bool, tuple[int, int]]] = {}
     for o in outcomes:
         row = table.setdefault(o.condition.group, {})
         ok, n = row.get(o.balance, (0, 0))
-        row[o.balance] = (ok + (o.fell is False), n + 1)
+        row[o.balance] = (ok + o.survived, n + 1)
     return list(table.items())
 
 

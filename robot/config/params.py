@@ -97,6 +97,23 @@ SPECS: dict[str, ParamSpec] = {
     "arm_scale": ParamSpec(1.0, 0.0, 3.0, "-", ROBOT, "scale of arm channels to the arm length", False),
     "ramp_cycles": ParamSpec(1.0, 0.1, 10.0, "cycle", ROBOT, "gait cycles to ramp amplitudes "
                              "in and out", False),
+    # --- a staircase the user describes (robot/gait/stairs.py; 0 steps: none) -----------------
+    "stairs_rise": ParamSpec(0.0, 0.0, 0.05, "m", ROBOT, "stairs: height of each step "
+                             "(0: no stairs)", False),
+    "stairs_count": ParamSpec(0.0, 0.0, 10.0, "-", ROBOT, "stairs: steps up, then as many "
+                              "down (0: no stairs)", False),
+    "stairs_tread": ParamSpec(0.25, 0.05, 1.0, "m", ROBOT, "stairs: depth of each tread",
+                              False),
+    "stairs_x0": ParamSpec(0.3, 0.0, 5.0, "m", ROBOT, "stairs: first riser ahead of the "
+                           "start pose's ankles", False),
+    "stairs_landing": ParamSpec(0.3, 0.0, 2.0, "m", ROBOT, "stairs: depth of the landing "
+                                "at the top", False),
+    "stairs_margin": ParamSpec(0.01, 0.0, 0.05, "m", ROBOT, "stairs: a planned sole stays "
+                               "this far from every riser edge", False),
+    "stairs_odometry": ParamSpec(1.0, 0.5, 1.0, "-", ROBOT, "stairs: footstep advance "
+                                 "per commanded advance (measured on the flat)", False),
+    "stairs_reach": ParamSpec(0.04, 0.0, 0.15, "m", ROBOT, "stairs: largest shift of a "
+                              "planned footstep from the gait's own", False),
     # --- balance feedback (robot/balance/stage.py; used only with an IMU and balance on) --------
     "bal_ankle_pd": ParamSpec(0.05, 0.0, 1.0, "s", BALANCE, "ankle pitch/roll per torso "
                               "tilt rate [rad per rad/s] (gyro damping)", False),
@@ -206,6 +223,14 @@ class GaitParams:
     toe_gain: float = SPECS["toe_gain"].default
     arm_scale: float = SPECS["arm_scale"].default
     ramp_cycles: float = SPECS["ramp_cycles"].default
+    stairs_rise: float = SPECS["stairs_rise"].default
+    stairs_count: float = SPECS["stairs_count"].default
+    stairs_tread: float = SPECS["stairs_tread"].default
+    stairs_x0: float = SPECS["stairs_x0"].default
+    stairs_landing: float = SPECS["stairs_landing"].default
+    stairs_margin: float = SPECS["stairs_margin"].default
+    stairs_odometry: float = SPECS["stairs_odometry"].default
+    stairs_reach: float = SPECS["stairs_reach"].default
     bal_ankle_pd: float = SPECS["bal_ankle_pd"].default
     bal_hip_pd: float = SPECS["bal_hip_pd"].default
     bal_ankle_pp: float = SPECS["bal_ankle_pp"].default

@@ -23,6 +23,8 @@ from robot.config.robot import RobotConfig
 from robot.gait import expressions as gait
 from robot.gait import vectorised
 from robot.gait.blend import PARAM_TAU_S, PRESET_BLEND_S, STEER_RATE, Blend, follow
+from robot.gait.stair_steps import StairSteps
+from robot.gait.stairs import StairPlan
 from robot.gait.targets import NO_TRIM, BodyTrim, body_targets
 from robot.gait.tick import TickKernel
 from robot.gait.vectorised import solve
@@ -115,6 +117,10 @@ class GaitEngine:
         self._ramp_s = 0.0
         self._blend: Blend | None = None  # a preset switch in progress (blend_to)
         self._blend_t = 0.0               # [s] since it began
+        #: The footstep planner on the staircase the parameters describe (stairs_*), made
+        #: at the first walking tick that has one; None: the paper's blind gait.
+        self.stairs: StairSteps | None = None
+        self._ticking = False             # inside tick(): the pose is the walk's next
 
     # -- parameters -------------------------------------------------------------------
     @property
@@ -203,7 +209,23 @@ class GaitEngine:
         a = self.amplitude if amplitude is None else amplitude
         p, ph, trim = self._live, self.phase, self.trim
         q: list[Num]
-        if self._plain_inputs(p, ph, a, trim):
+        # The stairs' footstep planner follows the walk's ticks only (not start_pose).
+        plan = StairPlan.of(p) if self._ticking and p.stairs_count > 0 else None
+        if plan is not None:
+            # On a known staircase: the general functions, then the planned footsteps.
+            ch = gait.channels(ph, p, amplitude=a)
+            targets = body_targets(ch, p, self.robot.geometry, amplitude=a,
+                                   leg_yaw=self._leg_yaw, trim=trim)
+            if self.stairs is None or self.stairs.plan != plan:
+                self.stairs = StairSteps(plan, self.robot.geometry, self._leg_yaw,
+                                         p.stairs_odometry)
+            pitch = float(p.torso_lean + trim.pitch
+                          + p.spine_gain * (ch["StZ_ik"] - ch["CtZ"]))
+            targets = self.stairs.adjust(targets, float(ph.theta), p, a, pitch)
+            lift_r, lift_l = float(targets.lift_r), float(targets.lift_l)
+            q, ok = solve(targets, self.robot)
+            q = [float(v) for v in q]
+        elif self._plain_inputs(p, ph, a, trim):
             # Python numbers throughout: the fused kernel, the same bits (robot.gait.tick).
             q, lift_r, lift_l, ok = self._kernel.pose(ph, p, a, trim)
         else:  # numpy scalars somewhere: the general functions, evaluated as they do
@@ -273,7 +295,11 @@ class GaitEngine:
             # resetting it is invisible and the next start begins a fresh stride.
             self.phase = gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0)
         self.time += dt
-        return self.pose()
+        self._ticking = True
+        try:
+            return self.pose()
+        finally:
+            self._ticking = False
 
     def curves(self, times: npt.NDArray[np.float64], *, chunk: int = 16384,
                with_channels: bool = True

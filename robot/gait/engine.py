@@ -17,7 +17,7 @@ from collections.abc import Mapping
 import numpy as np
 import numpy.typing as npt
 
-from robot.config.joint_names import JOINT_NAMES
+from robot.config.joint_names import JOINT_NAMES, LEG_JOINTS, SIDES
 from robot.config.params import SPECS, GaitParams
 from robot.config.robot import RobotConfig
 from robot.gait import expressions as gait
@@ -29,6 +29,7 @@ from robot.gait.targets import NO_TRIM, BodyTrim, body_targets
 from robot.gait.tick import TickKernel
 from robot.gait.vectorised import solve
 from robot.gait.xmath import Num
+from robot.loop.telemetry import Telemetry
 
 log = logging.getLogger(__name__)
 
@@ -121,6 +122,10 @@ class GaitEngine:
         #: at the first walking tick that has one; None: the paper's blind gait.
         self.stairs: StairSteps | None = None
         self._ticking = False             # inside tick(): the pose is the walk's next
+        names = robot.joint_names
+        #: Each leg's joints (hip yaw .. ankle roll) in the joint vector, -1: not there.
+        self._leg_slots = [[names.index(f"{s}_{j}") if f"{s}_{j}" in names else -1
+                            for j in LEG_JOINTS] for s in SIDES]
 
     # -- parameters -------------------------------------------------------------------
     @property
@@ -252,6 +257,16 @@ class GaitEngine:
         elif self.clamped:
             self.clamped = ()
         return out
+
+    def observe(self, tel: Telemetry) -> None:
+        """A tick's telemetry (robot.run.run calls it every tick): a servo read-back on a
+        staircase feeds the footstep planner's leg odometry (StairSteps.measure)."""
+        steps, q = self.stairs, tel.q_present
+        if steps is None or q is None or not tel.fresh:
+            return
+        legs = [[q[i] if i >= 0 else 0.0 for i in idx] for idx in self._leg_slots]
+        p = self._live
+        steps.measure(tuple(legs[0]), tuple(legs[1]), p.torso_lean + self.trim.pitch)
 
     def _plain_inputs(self, p: GaitParams, ph: gait.Phase, a: float, trim: BodyTrim) -> bool:
         """Every input a Python float or int, so the kernel's arithmetic is exactly the

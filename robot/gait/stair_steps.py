@@ -28,6 +28,7 @@ from robot.config.params import GaitParams
 from robot.config.robot import Geometry
 from robot.gait import expressions as gait
 from robot.gait import xmath as xm
+from robot.gait.ik import leg_fk_full
 from robot.gait.stairs import StairPlan
 from robot.gait.targets import BodyTargets, body_targets
 from robot.gait.xmath import Vec
@@ -94,6 +95,7 @@ class _Foot:
     to_dx: float = 0.0      # ... and when it ends [m]
     now_ground: float = 0.0  # this tick's level under the foot [m]
     now_dx: float = 0.0      # this tick's shift [m]
+    placed: bool = True      # its floor x is from a read-back since it landed
 
 
 @dataclass
@@ -117,6 +119,20 @@ class StairSteps:
     feet: tuple[_Foot, _Foot] = field(default_factory=lambda: (_Foot(), _Foot()))
     #: Footsteps planned so far: (right?, floor x of the planned ankle [m], ground [m]).
     steps: list[tuple[bool, float, float]] = field(default_factory=list)
+    #: The soles' level-frame x under the pelvis [m] from the last servo read-back
+    #: (``measure``), None before the first; ``fresh``: not yet used by ``adjust``.
+    measured: tuple[float, float] | None = None
+    fresh: bool = False
+
+    def measure(self, q_r: tuple[float, ...], q_l: tuple[float, ...], pitch: float) -> None:
+        """Take a servo read-back: the leg angles [rad] (hip yaw, roll, pitch, knee, ankle
+        pitch, roll) of the right and left leg and the torso pitch [rad] they were
+        commanded with. Leg odometry: the soles under the pelvis where the servos really
+        are (a soft servo lags its goal, so a footstep lands short of the commanded one)."""
+        r, _ = leg_fk_full(self.geometry, "r", q_r)
+        lft, _ = leg_fk_full(self.geometry, "l", q_l)
+        self.measured = (_level(r, pitch)[0], _level(lft, pitch)[0])
+        self.fresh = True
 
     def _gait_x(self, theta: float, p: GaitParams, amplitude: float) -> tuple[float, float]:
         """The gait's own level-frame x [m] of the right and left sole at phase ``theta``."""
@@ -136,11 +152,23 @@ class StairSteps:
             self.started = True
             for f, x in zip(feet, rel, strict=True):
                 f.x = x * self.odometry
-        # Dead reckoning: the pelvis is where the standing feet say.
-        standing = [f.x - (x + f.now_dx) * self.odometry
-                    for f, x in zip(feet, rel, strict=True) if not f.swinging]
-        if standing:
-            self.body_x = sum(standing) / len(standing)
+        # Dead reckoning: the pelvis is where the standing feet say: where the servos are
+        # (measure) since the last read-back, else where they were sent.
+        meas = self.measured
+        if meas is not None and self.fresh:
+            self.fresh = False
+            placed = [f.x - m for f, m in zip(feet, meas, strict=True)
+                      if not f.swinging and f.placed]
+            if placed:
+                self.body_x = sum(placed) / len(placed)
+            for f, m in zip(feet, meas, strict=True):
+                if not f.swinging and not f.placed and placed:
+                    f.x, f.placed = self.body_x + m, True
+        else:
+            standing = [f.x - (x + f.now_dx) * self.odometry
+                        for f, x in zip(feet, rel, strict=True) if not f.swinging]
+            if standing:
+                self.body_x = sum(standing) / len(standing)
         for i, (f, lift) in enumerate(zip(feet, lifts, strict=True)):
             if lift > 0.0 and not f.swinging:
                 self._lift_off(i, theta, p, amplitude)
@@ -148,6 +176,7 @@ class StairSteps:
                 f.swinging = False
                 f.ground = f.to_ground
                 f.x = self.body_x + (rel[i] + f.to_dx) * self.odometry
+                f.placed = self.measured is None
         for i, f in enumerate(feet):
             mover = f if f.swinging else feet[1 - i]
             u = (1.0 if not mover.swinging

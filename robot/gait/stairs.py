@@ -62,13 +62,15 @@ class StairPlan:
 
     def stands(self, ankle: float, back: float, front: float, margin: float) -> bool:
         """True when a level sole from ``ankle - back`` to ``ankle + front`` [m] rests on
-        the level under its ankle, with no riser edge within ``margin`` [m] of the ankle:
-        the ground under the ankle is the highest under the sole (a sole may overhang a
-        lower level, heel past a riser up or toe past a riser down; it may not rest on a
-        nosing ahead of or behind its ankle)."""
+        the level under its ankle, with ``margin`` [m] to spare: no riser edge within
+        ``margin`` of the ankle, and the ground under the ankle the highest under the sole
+        lengthened by ``margin`` at both ends (a sole may overhang a lower level, heel
+        past a riser up or toe past a riser down; it may not rest on a nosing ahead of or
+        behind its ankle)."""
         if any(ankle - margin < e < ankle + margin for e in self.edges()):
             return False
-        return self.ground(ankle) >= self.under(ankle - back, ankle + front)
+        return self.ground(ankle) >= self.under(ankle - back - margin,
+                                                ankle + front + margin)
 
     def placement(self, ankle: float, back: float, front: float, margin: float,
                   reach: float, *, least: float = -math.inf) -> float:
@@ -77,11 +79,11 @@ class StairPlan:
         stands already or no such shift makes it stand. (``least`` keeps a step from
         going back beside the standing foot: two feet that both step back from a riser
         would never cross it.) The candidates: the ankle ``margin`` either side of an
-        edge, the toe or the heel just short of one."""
+        edge, the toe or the heel ``margin`` short of one."""
         shifts = [0.0]
         for e in self.edges():
-            shifts += [e + margin - ankle, e - margin - ankle, e - front - ankle,
-                       e + back - ankle]
+            shifts += [e + margin - ankle, e - margin - ankle, e - front - margin - ankle,
+                       e + back + margin - ankle]
         for dx in sorted(shifts, key=abs):
             if abs(dx) > reach:
                 break

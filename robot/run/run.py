@@ -120,6 +120,8 @@ class Run(Generic[SourceT]):
                         self.streamer.emergency_stop("fell")
                 observers.append(stop_on_fall)
         observers += [o for o in (spec.recorder, spec.observer) if o is not None]
+        if isinstance(spec.source, GaitEngine):     # leg odometry on stairs (read-backs)
+            observers.append(spec.source.observe)
 
         def observe(tel: Telemetry) -> None:
             for o in observers:

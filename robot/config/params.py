@@ -112,6 +112,8 @@ SPECS: dict[str, ParamSpec] = {
                                "this far from every riser edge", False),
     "stairs_odometry": ParamSpec(1.0, 0.5, 1.0, "-", ROBOT, "stairs: footstep advance "
                                  "per commanded advance (measured on the flat)", False),
+    "stairs_slow": ParamSpec(0.0, 0.0, 0.2, "m", ROBOT, "stairs: a footstep shifted this "
+                             "far swings at half the gait's rate (0: never slowed)", False),
     "stairs_reach": ParamSpec(0.04, 0.0, 0.15, "m", ROBOT, "stairs: largest shift of a "
                               "planned footstep from the gait's own", False),
     # --- balance feedback (robot/balance/stage.py; used only with an IMU and balance on) --------
@@ -230,6 +232,7 @@ class GaitParams:
     stairs_landing: float = SPECS["stairs_landing"].default
     stairs_margin: float = SPECS["stairs_margin"].default
     stairs_odometry: float = SPECS["stairs_odometry"].default
+    stairs_slow: float = SPECS["stairs_slow"].default
     stairs_reach: float = SPECS["stairs_reach"].default
     bal_ankle_pd: float = SPECS["bal_ankle_pd"].default
     bal_hip_pd: float = SPECS["bal_hip_pd"].default

@@ -302,7 +302,9 @@ class GaitEngine:
             self._ramp = max(0.0, self._ramp - step)
         if self._ramp > 0.0:
             theta = self.phase.theta
-            self.phase = gait.advance(self.phase, p, dt * (1.0 + self.trim.tempo))
+            rate = 1.0 if self.stairs is None else self.stairs.rate
+            self.phase = gait.advance(self.phase, p, dt * (1.0 + self.trim.tempo)
+                                      if rate == 1.0 else dt * (1.0 + self.trim.tempo) * rate)
             if p.turn != 0.0:
                 self.asked_yaw += self.amplitude * p.turn * (self.phase.theta - theta) / math.pi
         else:

@@ -35,6 +35,11 @@ from robot.gait.xmath import Vec
 
 #: A shifted footstep lands at least this far [m] ahead of the standing foot.
 STEP_AHEAD = 0.02
+#: Footsteps shorter than this [m] teach ``reach_gain`` nothing; each longer one moves it
+#: this share of the way to what it saw, inside GAIN_RANGE.
+LEARN_MIN_M = 0.03
+LEARN_RATE = 0.3
+GAIN_RANGE = (0.5, 1.2)
 #: A step up is climbed over this share of the swing's phase, from lift-off.
 RISE_END = 0.4
 #: A step down is descended from this share of the swing's phase to touchdown.
@@ -96,6 +101,9 @@ class _Foot:
     now_ground: float = 0.0  # this tick's level under the foot [m]
     now_dx: float = 0.0      # this tick's shift [m]
     placed: bool = True      # its floor x is from a read-back since it landed
+    shift: float = 0.0      # how far [m] the swing's footstep is from the gait's
+    start_x: float = 0.0    # floor x where the swing began [m]
+    aim_x: float = 0.0      # floor x the swing should land at [m]
 
 
 @dataclass
@@ -123,6 +131,12 @@ class StairSteps:
     #: (``measure``), None before the first; ``fresh``: not yet used by ``adjust``.
     measured: tuple[float, float] | None = None
     fresh: bool = False
+    #: The gait's phase runs this much slower now [-]: 1, or less while a shifted
+    #: footstep swings (stairs_slow: the body has further to go over the standing foot).
+    rate: float = 1.0
+    #: Footstep travel landed per travel sent [-], learned from the read-backs (soft
+    #: servos land a long step short); each step is sent that much further.
+    reach_gain: float = 1.0
 
     def measure(self, q_r: tuple[float, ...], q_l: tuple[float, ...], pitch: float) -> None:
         """Take a servo read-back: the leg angles [rad] (hip yaw, roll, pitch, knee, ankle
@@ -164,6 +178,7 @@ class StairSteps:
             for f, m in zip(feet, meas, strict=True):
                 if not f.swinging and not f.placed and placed:
                     f.x, f.placed = self.body_x + m, True
+                    self._learn(f)
         else:
             standing = [f.x - (x + f.now_dx) * self.odometry
                         for f, x in zip(feet, rel, strict=True) if not f.swinging]
@@ -183,11 +198,23 @@ class StairSteps:
                  else (theta - mover.theta0) / max(mover.theta1 - mover.theta0, 1e-9))
             f.now_dx = f.from_dx + (f.to_dx - f.from_dx) * smooth(u)
             f.now_ground = ground_at(u, f.from_ground, f.to_ground) if f.swinging else f.ground
+        slow = p.stairs_slow
+        shift = max([abs(f.shift) for f in feet if f.swinging], default=0.0)
+        self.rate = 1.0 / (1.0 + shift / slow) if slow > 0.0 and shift > 0.0 else 1.0
         ref = 0.5 * (feet[0].now_ground + feet[1].now_ground)
         rot = xm.rz_ry(0.0, pitch)
         r_off = xm.apply_t(rot, (feet[0].now_dx, 0.0, feet[0].now_ground - ref))
         l_off = xm.apply_t(rot, (feet[1].now_dx, 0.0, feet[1].now_ground - ref))
         return replace_soles(t, r_off, l_off)
+
+    def _learn(self, f: _Foot) -> None:
+        """Update ``reach_gain`` from a footstep that landed: the travel it made over the
+        travel it was aimed at (steps under LEARN_MIN_M are too short to tell)."""
+        aimed = f.aim_x - f.start_x
+        if aimed < LEARN_MIN_M:
+            return
+        seen = min(max((f.x - f.start_x) / aimed, GAIN_RANGE[0]), GAIN_RANGE[1])
+        self.reach_gain += LEARN_RATE * (seen - self.reach_gain)
 
     def _lift_off(self, i: int, theta: float, p: GaitParams, amplitude: float) -> None:
         """Plan the swing of foot ``i`` (0 right, 1 left) starting now: where it lands,
@@ -204,11 +231,18 @@ class StairSteps:
         front = g.foot_length / 2 + g.foot_forward
         dx = self.plan.placement(land, back, front, p.stairs_margin, p.stairs_reach,
                                  least=other.x + STEP_AHEAD - land)
-        f.from_ground, f.from_dx, f.to_dx = f.ground, f.now_dx, 0.0
-        f.to_ground = self.plan.under(land + dx - back, land + dx + front)
-        other.from_dx = other.to_dx = other.now_dx
-        other.to_dx = other.now_dx - dx / self.odometry
-        self.steps.append((i == 0, land + dx, f.to_ground))
+        # The pelvis ends over the middle of what the new sole rests on: the foot that
+        # lands goes ``support`` further back under it (and the standing one with it).
+        support = self.plan.support_shift(land + dx, back, front)
+        # Sent further by what soft servos are learned to fall short (reach_gain).
+        f.start_x, f.aim_x = f.x, land + dx
+        dx += (land + dx - f.x) * (1.0 / self.reach_gain - 1.0)
+        f.from_ground, f.from_dx, f.to_dx = f.ground, f.now_dx, -support / self.odometry
+        f.to_ground = self.plan.under(f.aim_x - back, f.aim_x + front)
+        other.from_dx = other.now_dx
+        other.to_dx = other.now_dx - (dx + support) / self.odometry
+        f.shift = dx
+        self.steps.append((i == 0, f.aim_x, f.to_ground))
 
 
 def _level(v: Vec, pitch: float) -> tuple[float, float, float]:

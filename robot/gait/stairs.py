@@ -72,6 +72,15 @@ class StairPlan:
         return self.ground(ankle) >= self.under(ankle - back - margin,
                                                 ankle + front + margin)
 
+    def support_shift(self, ankle: float, back: float, front: float) -> float:
+        """How far [m] the middle of the part of a sole that rests on the level under its
+        ankle is ahead of the sole's middle: a heel overhanging a riser up moves it
+        forward, a toe overhanging a riser down moves it back (0: the whole sole rests)."""
+        heel, toe = ankle - back, ankle + front
+        lo = max([heel] + [e for e in self.edges() if heel < e <= ankle])
+        hi = min([toe] + [e for e in self.edges() if ankle < e < toe])
+        return (lo + hi) / 2 - (heel + toe) / 2
+
     def placement(self, ankle: float, back: float, front: float, margin: float,
                   reach: float, *, least: float = -math.inf) -> float:
         """The smallest shift [m] (+ forward) within ``reach`` [m] either way, and not

@@ -70,6 +70,24 @@ def test_the_smallest_shift_that_makes_a_sole_stand() -> None:
     assert PLAN.placement(0.45, BACK, FRONT, 0.01, 0.12) == 0.0           # stands already
 
 
+def test_a_margin_behind_the_ankle_for_a_step_that_lands_short() -> None:
+    # 2.5 cm past the riser: enough for 1 cm behind, not for 3 cm
+    assert PLAN.stands(0.325, BACK, FRONT, 0.01)
+    assert not PLAN.stands(0.325, BACK, FRONT, 0.01, behind=0.03)
+    # from 5 cm before the riser, forward to 3 cm past it: 8 cm
+    assert PLAN.placement(0.25, BACK, FRONT, 0.01, 0.12, least=0.0,
+                          behind=0.03) == pytest.approx(0.08)
+
+
+def test_the_pelvis_goes_over_the_part_of_the_sole_that_rests() -> None:
+    # ankle 2 cm past the riser up: the sole rests from the riser (0.30) to the toe (0.40),
+    # its middle 0.35 against the sole's 0.335
+    assert PLAN.support_shift(0.32, BACK, FRONT) == pytest.approx(0.015)
+    # ankle 2 cm before the riser down: it rests from the heel (1.03) to the edge (1.10)
+    assert PLAN.support_shift(1.08, BACK, FRONT) == pytest.approx(-0.03)
+    assert PLAN.support_shift(0.45, BACK, FRONT) == 0.0      # all of it on a tread
+
+
 def test_a_swing_ends_where_its_lift_does() -> None:
     """Right lifts while sin(theta) > -delta_f, left while sin(theta) < delta_f."""
     d = -0.4

@@ -109,9 +109,14 @@ SPECS: dict[str, ParamSpec] = {
     "stairs_landing": ParamSpec(0.3, 0.0, 2.0, "m", ROBOT, "stairs: depth of the landing "
                                 "at the top", False),
     "stairs_margin": ParamSpec(0.01, 0.0, 0.05, "m", ROBOT, "stairs: a planned sole stays "
-                               "this far from every riser edge", False),
+                               "this far from every riser edge ahead of its ankle", False),
+    "stairs_margin_back": ParamSpec(0.01, 0.0, 0.06, "m", ROBOT, "stairs: ... and this far "
+                                    "behind it (a footstep that lands short)", False),
     "stairs_odometry": ParamSpec(1.0, 0.5, 1.0, "-", ROBOT, "stairs: footstep advance "
                                  "per commanded advance (measured on the flat)", False),
+    "stairs_learn": ParamSpec(0.0, 0.0, 1.0, "-", ROBOT, "stairs: share of the way each "
+                              "footstep's read-back moves the learned reach gain (0: "
+                              "footsteps are sent where they should land)", False),
     "stairs_slow": ParamSpec(0.0, 0.0, 0.2, "m", ROBOT, "stairs: a footstep shifted this "
                              "far swings at half the gait's rate (0: never slowed)", False),
     "stairs_reach": ParamSpec(0.04, 0.0, 0.15, "m", ROBOT, "stairs: largest shift of a "
@@ -231,7 +236,9 @@ class GaitParams:
     stairs_x0: float = SPECS["stairs_x0"].default
     stairs_landing: float = SPECS["stairs_landing"].default
     stairs_margin: float = SPECS["stairs_margin"].default
+    stairs_margin_back: float = SPECS["stairs_margin_back"].default
     stairs_odometry: float = SPECS["stairs_odometry"].default
+    stairs_learn: float = SPECS["stairs_learn"].default
     stairs_slow: float = SPECS["stairs_slow"].default
     stairs_reach: float = SPECS["stairs_reach"].default
     bal_ankle_pd: float = SPECS["bal_ankle_pd"].default

@@ -36,9 +36,8 @@ from robot.gait.xmath import Vec
 #: A shifted footstep lands at least this far [m] ahead of the standing foot.
 STEP_AHEAD = 0.02
 #: Footsteps shorter than this [m] teach ``reach_gain`` nothing; each longer one moves it
-#: this share of the way to what it saw, inside GAIN_RANGE.
+#: ``stairs_learn`` of the way to what it saw, inside GAIN_RANGE.
 LEARN_MIN_M = 0.03
-LEARN_RATE = 0.3
 GAIN_RANGE = (0.5, 1.2)
 #: A step up is climbed over this share of the swing's phase, from lift-off.
 RISE_END = 0.4
@@ -137,6 +136,7 @@ class StairSteps:
     #: Footstep travel landed per travel sent [-], learned from the read-backs (soft
     #: servos land a long step short); each step is sent that much further.
     reach_gain: float = 1.0
+    learn: float = 0.0      # stairs_learn of the walk's parameters [-]
 
     def measure(self, q_r: tuple[float, ...], q_l: tuple[float, ...], pitch: float) -> None:
         """Take a servo read-back: the leg angles [rad] (hip yaw, roll, pitch, knee, ankle
@@ -214,12 +214,13 @@ class StairSteps:
         if aimed < LEARN_MIN_M:
             return
         seen = min(max((f.x - f.start_x) / aimed, GAIN_RANGE[0]), GAIN_RANGE[1])
-        self.reach_gain += LEARN_RATE * (seen - self.reach_gain)
+        self.reach_gain += self.learn * (seen - self.reach_gain)
 
     def _lift_off(self, i: int, theta: float, p: GaitParams, amplitude: float) -> None:
         """Plan the swing of foot ``i`` (0 right, 1 left) starting now: where it lands,
         how far that is shifted, on what level."""
         f, other = self.feet[i], self.feet[1 - i]
+        self.learn = p.stairs_learn
         f.swinging = True
         f.theta0 = theta
         f.theta1 = swing_end(theta, p.delta_f, i == 0)
@@ -230,7 +231,8 @@ class StairSteps:
         back = g.foot_length / 2 - g.foot_forward
         front = g.foot_length / 2 + g.foot_forward
         dx = self.plan.placement(land, back, front, p.stairs_margin, p.stairs_reach,
-                                 least=other.x + STEP_AHEAD - land)
+                                 least=other.x + STEP_AHEAD - land,
+                                 behind=p.stairs_margin_back)
         # The pelvis ends over the middle of what the new sole rests on: the foot that
         # lands goes ``support`` further back under it (and the standing one with it).
         support = self.plan.support_shift(land + dx, back, front)
@@ -239,6 +241,11 @@ class StairSteps:
         dx += (land + dx - f.x) * (1.0 / self.reach_gain - 1.0)
         f.from_ground, f.from_dx, f.to_dx = f.ground, f.now_dx, -support / self.odometry
         f.to_ground = self.plan.under(f.aim_x - back, f.aim_x + front)
+        # The standing foot goes back under the pelvis by the shift. Past its leg's reach
+        # the IK straightens the leg toward it (robot.gait.ik: counted, ik_unreachable_s):
+        # a push-off. Bounding the shift by the reach instead (the footstep landing
+        # shorter, or the landing foot taking the rest ahead of the pelvis) fell at the
+        # first or second riser on both robots (docs/gait.md, "climb").
         other.from_dx = other.now_dx
         other.to_dx = other.now_dx - (dx + support) / self.odometry
         f.shift = dx

@@ -60,17 +60,19 @@ class StairPlan:
         return max([self.ground(heel), self.ground(toe)]
                    + [self.ground(e + 1e-9) for e in self.edges() if heel < e < toe])
 
-    def stands(self, ankle: float, back: float, front: float, margin: float) -> bool:
+    def stands(self, ankle: float, back: float, front: float, margin: float, *,
+               behind: float | None = None) -> bool:
         """True when a level sole from ``ankle - back`` to ``ankle + front`` [m] rests on
-        the level under its ankle, with ``margin`` [m] to spare: no riser edge within
-        ``margin`` of the ankle, and the ground under the ankle the highest under the sole
-        lengthened by ``margin`` at both ends (a sole may overhang a lower level, heel
-        past a riser up or toe past a riser down; it may not rest on a nosing ahead of or
-        behind its ankle)."""
-        if any(ankle - margin < e < ankle + margin for e in self.edges()):
+        the level under its ankle, with ``margin`` [m] to spare ahead and ``behind`` [m]
+        (default: ``margin``) behind: no riser edge that close to the ankle, and the
+        ground under the ankle the highest under the sole lengthened by as much at each
+        end (a sole may overhang a lower level, heel past a riser up or toe past a riser
+        down; it may not rest on a nosing ahead of or behind its ankle). A footstep that
+        lands short needs the margin behind."""
+        b = margin if behind is None else behind
+        if any(ankle - b < e < ankle + margin for e in self.edges()):
             return False
-        return self.ground(ankle) >= self.under(ankle - back - margin,
-                                                ankle + front + margin)
+        return self.ground(ankle) >= self.under(ankle - back - b, ankle + front + margin)
 
     def support_shift(self, ankle: float, back: float, front: float) -> float:
         """How far [m] the middle of the part of a sole that rests on the level under its
@@ -82,17 +84,19 @@ class StairPlan:
         return (lo + hi) / 2 - (heel + toe) / 2
 
     def placement(self, ankle: float, back: float, front: float, margin: float,
-                  reach: float, *, least: float = -math.inf) -> float:
+                  reach: float, *, least: float = -math.inf,
+                  behind: float | None = None) -> float:
         """The smallest shift [m] (+ forward) within ``reach`` [m] either way, and not
         less than ``least`` [m], that makes the sole of ``stands`` stand; 0 when it
         stands already or no such shift makes it stand. (``least`` keeps a step from
         going back beside the standing foot: two feet that both step back from a riser
         would never cross it.) The candidates: the ankle ``margin`` either side of an
         edge, the toe or the heel ``margin`` short of one."""
+        b = margin if behind is None else behind
         shifts = [0.0]
         for e in self.edges():
-            shifts += [e + margin - ankle, e - margin - ankle, e - front - margin - ankle,
-                       e + back + margin - ankle]
+            shifts += [e + b - ankle, e - margin - ankle, e - front - margin - ankle,
+                       e + back + b - ankle]
         for dx in sorted(shifts, key=abs):
             if abs(dx) > reach:
                 break
@@ -100,6 +104,6 @@ class StairPlan:
                 continue
             # A hair further, so rounding cannot leave the sole on the limit.
             d = dx + (1e-9 if dx > 0 else -1e-9 if dx < 0 else 0.0)
-            if self.stands(ankle + d, back, front, margin):
+            if self.stands(ankle + d, back, front, margin, behind=b):
                 return d
         return 0.0

@@ -13,6 +13,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
+from robot.config.stairs_params import STAIRS
 from robot.config.toml_io import show
 from robot.errors import ConfigError
 
@@ -97,30 +98,8 @@ SPECS: dict[str, ParamSpec] = {
     "arm_scale": ParamSpec(1.0, 0.0, 3.0, "-", ROBOT, "scale of arm channels to the arm length", False),
     "ramp_cycles": ParamSpec(1.0, 0.1, 10.0, "cycle", ROBOT, "gait cycles to ramp amplitudes "
                              "in and out", False),
-    # --- a staircase the user describes (robot/gait/stairs.py; 0 steps: none) -----------------
-    "stairs_rise": ParamSpec(0.0, 0.0, 0.05, "m", ROBOT, "stairs: height of each step "
-                             "(0: no stairs)", False),
-    "stairs_count": ParamSpec(0.0, 0.0, 10.0, "-", ROBOT, "stairs: steps up, then as many "
-                              "down (0: no stairs)", False),
-    "stairs_tread": ParamSpec(0.25, 0.05, 1.0, "m", ROBOT, "stairs: depth of each tread",
-                              False),
-    "stairs_x0": ParamSpec(0.3, 0.0, 5.0, "m", ROBOT, "stairs: first riser ahead of the "
-                           "start pose's ankles", False),
-    "stairs_landing": ParamSpec(0.3, 0.0, 2.0, "m", ROBOT, "stairs: depth of the landing "
-                                "at the top", False),
-    "stairs_margin": ParamSpec(0.01, 0.0, 0.05, "m", ROBOT, "stairs: a planned sole stays "
-                               "this far from every riser edge ahead of its ankle", False),
-    "stairs_margin_back": ParamSpec(0.01, 0.0, 0.06, "m", ROBOT, "stairs: ... and this far "
-                                    "behind it (a footstep that lands short)", False),
-    "stairs_odometry": ParamSpec(1.0, 0.5, 1.0, "-", ROBOT, "stairs: footstep advance "
-                                 "per commanded advance (measured on the flat)", False),
-    "stairs_learn": ParamSpec(0.0, 0.0, 1.0, "-", ROBOT, "stairs: share of the way each "
-                              "footstep's read-back moves the learned reach gain (0: "
-                              "footsteps are sent where they should land)", False),
-    "stairs_slow": ParamSpec(0.0, 0.0, 0.2, "m", ROBOT, "stairs: a footstep shifted this "
-                             "far swings at half the gait's rate (0: never slowed)", False),
-    "stairs_reach": ParamSpec(0.04, 0.0, 0.15, "m", ROBOT, "stairs: largest shift of a "
-                              "planned footstep from the gait's own", False),
+    # --- a staircase the user describes (robot/config/stairs_params.py) -----------------------
+    **{n: ParamSpec(d, lo, hi, u, ROBOT, doc, False) for n, (d, lo, hi, u, doc) in STAIRS.items()},
     # --- balance feedback (robot/balance/stage.py; used only with an IMU and balance on) --------
     "bal_ankle_pd": ParamSpec(0.05, 0.0, 1.0, "s", BALANCE, "ankle pitch/roll per torso "
                               "tilt rate [rad per rad/s] (gyro damping)", False),

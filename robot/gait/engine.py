@@ -17,19 +17,17 @@ from collections.abc import Mapping
 import numpy as np
 import numpy.typing as npt
 
-from robot.config.joint_names import JOINT_NAMES, LEG_JOINTS, SIDES
+from robot.config.joint_names import JOINT_NAMES
 from robot.config.params import SPECS, GaitParams
 from robot.config.robot import RobotConfig
 from robot.gait import expressions as gait
 from robot.gait import vectorised
 from robot.gait.blend import PARAM_TAU_S, PRESET_BLEND_S, STEER_RATE, Blend, follow
-from robot.gait.stair_steps import StairSteps
-from robot.gait.stairs import StairPlan
+from robot.gait.stair_steps import StairPlan, StairSteps
 from robot.gait.targets import NO_TRIM, BodyTrim, body_targets
 from robot.gait.tick import TickKernel
 from robot.gait.vectorised import solve
 from robot.gait.xmath import Num
-from robot.loop.telemetry import Telemetry
 
 log = logging.getLogger(__name__)
 
@@ -118,14 +116,8 @@ class GaitEngine:
         self._ramp_s = 0.0
         self._blend: Blend | None = None  # a preset switch in progress (blend_to)
         self._blend_t = 0.0               # [s] since it began
-        #: The footstep planner on the staircase the parameters describe (stairs_*), made
-        #: at the first walking tick that has one; None: the paper's blind gait.
-        self.stairs: StairSteps | None = None
+        self.stairs: StairSteps | None = None  # footsteps on the stairs_* staircase
         self._ticking = False             # inside tick(): the pose is the walk's next
-        names = robot.joint_names
-        #: Each leg's joints (hip yaw .. ankle roll) in the joint vector, -1: not there.
-        self._leg_slots = [[names.index(f"{s}_{j}") if f"{s}_{j}" in names else -1
-                            for j in LEG_JOINTS] for s in SIDES]
 
     # -- parameters -------------------------------------------------------------------
     @property
@@ -214,22 +206,13 @@ class GaitEngine:
         a = self.amplitude if amplitude is None else amplitude
         p, ph, trim = self._live, self.phase, self.trim
         q: list[Num]
-        # The stairs' footstep planner follows the walk's ticks only (not start_pose).
         plan = StairPlan.of(p) if self._ticking and p.stairs_count > 0 else None
-        if plan is not None:
-            # On a known staircase: the general functions, then the planned footsteps.
-            ch = gait.channels(ph, p, amplitude=a)
-            targets = body_targets(ch, p, self.robot.geometry, amplitude=a,
-                                   leg_yaw=self._leg_yaw, trim=trim)
+        if plan is not None:    # a known staircase, walk ticks only: planned footsteps
             if self.stairs is None or self.stairs.plan != plan:
-                self.stairs = StairSteps(plan, self.robot.geometry, self._leg_yaw,
-                                         p.stairs_odometry)
-            pitch = float(p.torso_lean + trim.pitch
-                          + p.spine_gain * (ch["StZ_ik"] - ch["CtZ"]))
-            targets = self.stairs.adjust(targets, float(ph.theta), p, a, pitch)
+                self.stairs = StairSteps(plan, self.robot, self._leg_yaw, p.stairs_odometry)
+            targets = self.stairs.targets(ph, p, a, trim)
             lift_r, lift_l = float(targets.lift_r), float(targets.lift_l)
             q, ok = solve(targets, self.robot)
-            q = [float(v) for v in q]
         elif self._plain_inputs(p, ph, a, trim):
             # Python numbers throughout: the fused kernel, the same bits (robot.gait.tick).
             q, lift_r, lift_l, ok = self._kernel.pose(ph, p, a, trim)
@@ -257,16 +240,6 @@ class GaitEngine:
         elif self.clamped:
             self.clamped = ()
         return out
-
-    def observe(self, tel: Telemetry) -> None:
-        """A tick's telemetry (robot.run.run calls it every tick): a servo read-back on a
-        staircase feeds the footstep planner's leg odometry (StairSteps.measure)."""
-        steps, q = self.stairs, tel.q_present
-        if steps is None or q is None or not tel.fresh:
-            return
-        legs = [[q[i] if i >= 0 else 0.0 for i in idx] for idx in self._leg_slots]
-        p = self._live
-        steps.measure(tuple(legs[0]), tuple(legs[1]), p.torso_lean + self.trim.pitch)
 
     def _plain_inputs(self, p: GaitParams, ph: gait.Phase, a: float, trim: BodyTrim) -> bool:
         """Every input a Python float or int, so the kernel's arithmetic is exactly the
@@ -302,9 +275,8 @@ class GaitEngine:
             self._ramp = max(0.0, self._ramp - step)
         if self._ramp > 0.0:
             theta = self.phase.theta
-            rate = 1.0 if self.stairs is None else self.stairs.rate
-            self.phase = gait.advance(self.phase, p, dt * (1.0 + self.trim.tempo)
-                                      if rate == 1.0 else dt * (1.0 + self.trim.tempo) * rate)
+            rate = 1.0 if self.stairs is None else self.stairs.rate   # x 1.0: same bits
+            self.phase = gait.advance(self.phase, p, dt * ((1.0 + self.trim.tempo) * rate))
             if p.turn != 0.0:
                 self.asked_yaw += self.amplitude * p.turn * (self.phase.theta - theta) / math.pi
         else:

@@ -24,13 +24,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from robot.config.joint_names import LEG_JOINTS, SIDES
 from robot.config.params import GaitParams
-from robot.config.robot import Geometry
+from robot.config.robot import Geometry, RobotConfig
 from robot.gait import expressions as gait
 from robot.gait import xmath as xm
 from robot.gait.ik import leg_fk_full
 from robot.gait.stairs import StairPlan
-from robot.gait.targets import BodyTargets, body_targets
+from robot.gait.targets import BodyTargets, BodyTrim, body_targets
 from robot.gait.xmath import Vec
 
 #: A shifted footstep lands at least this far [m] ahead of the standing foot.
@@ -117,7 +118,7 @@ class StairSteps:
     """
 
     plan: StairPlan
-    geometry: Geometry
+    robot: RobotConfig
     leg_yaw: bool = True
     #: Footstep advance per commanded advance [-] (stairs_odometry: measured on the flat).
     odometry: float = 1.0
@@ -130,6 +131,7 @@ class StairSteps:
     #: (``measure``), None before the first; ``fresh``: not yet used by ``adjust``.
     measured: tuple[float, float] | None = None
     fresh: bool = False
+    pitch: float = 0.0      # the torso pitch [rad] of the last targets
     #: The gait's phase runs this much slower now [-]: 1, or less while a shifted
     #: footstep swings (stairs_slow: the body has further to go over the standing foot).
     rate: float = 1.0
@@ -138,15 +140,32 @@ class StairSteps:
     reach_gain: float = 1.0
     learn: float = 0.0      # stairs_learn of the walk's parameters [-]
 
-    def measure(self, q_r: tuple[float, ...], q_l: tuple[float, ...], pitch: float) -> None:
-        """Take a servo read-back: the leg angles [rad] (hip yaw, roll, pitch, knee, ankle
-        pitch, roll) of the right and left leg and the torso pitch [rad] they were
-        commanded with. Leg odometry: the soles under the pelvis where the servos really
-        are (a soft servo lags its goal, so a footstep lands short of the commanded one)."""
-        r, _ = leg_fk_full(self.geometry, "r", q_r)
-        lft, _ = leg_fk_full(self.geometry, "l", q_l)
-        self.measured = (_level(r, pitch)[0], _level(lft, pitch)[0])
+    @property
+    def geometry(self) -> Geometry:
+        return self.robot.geometry
+
+    def measure(self, q: list[float]) -> None:
+        """Take a servo read-back: the joint angles [rad] (the robot's order; a leg joint
+        it lacks is 0), under the torso pitch last commanded. Leg odometry:
+        the soles under the pelvis where the servos really are (a soft servo lags its
+        goal, so a footstep lands short of the commanded one)."""
+        names = self.robot.joint_names
+        r, lft = (leg_fk_full(self.geometry, s, tuple(
+            q[names.index(f"{s}_{j}")] if f"{s}_{j}" in names else 0.0
+            for j in LEG_JOINTS))[0] for s in SIDES)
+        self.measured = (_level(r, self.pitch)[0], _level(lft, self.pitch)[0])
         self.fresh = True
+
+    def targets(self, ph: gait.Phase, p: GaitParams, amplitude: float,
+                trim: BodyTrim) -> BodyTargets:
+        """The gait's body targets at phase ``ph`` (the general functions) with both soles
+        on their planned footsteps (``adjust``)."""
+        ch = gait.channels(ph, p, amplitude=amplitude)
+        t = body_targets(ch, p, self.geometry, amplitude=amplitude, leg_yaw=self.leg_yaw,
+                         trim=trim)
+        self.pitch = float(p.torso_lean + trim.pitch
+                           + p.spine_gain * (ch["StZ_ik"] - ch["CtZ"]))
+        return self.adjust(t, float(ph.theta), p, amplitude, self.pitch)
 
     def _gait_x(self, theta: float, p: GaitParams, amplitude: float) -> tuple[float, float]:
         """The gait's own level-frame x [m] of the right and left sole at phase ``theta``."""

@@ -61,7 +61,10 @@ def test_preset_curves_are_finite_and_within_limits(any_robot: RobotConfig,
 
 def test_preset_ticks_through_start_steady_stop_are_within_limits(
         any_robot: RobotConfig, any_gait: Gait) -> None:
-    p = any_gait.params
+    # The gait's own motion; `climb`'s staircase is off here: its footstep across a riser
+    # asks more of the standing leg than it reaches, by design (robot/gait/stair_steps.py,
+    # tests/test_climb_plan.py).
+    p = any_gait.params.replace({"stairs_count": 0.0})
     e = GaitEngine(any_robot, p)
     qs = [e.start_pose()]
     e.start()

@@ -20,9 +20,9 @@ from sim.mujoco.mjcf import build_mjcf  # noqa: E402
 from sim.mujoco.world import World  # noqa: E402
 from sim.mujoco.world_stairs import (  # noqa: E402
     STAIR_LANDING_M,
-    STAIR_TREAD_M,
     STAIRS_HALF_WIDTH_M,
     STAIRS_X0_M,
+    stairs_end_m,
 )
 
 ROBOT = load_robot("biped18-dynamixel")
@@ -42,11 +42,11 @@ def ground(model: mujoco.MjModel, x: float, y: float) -> float:
     return 1.0 - dist
 
 
-def hand_profile(h: float, n: int) -> list[tuple[float, float]]:
+def hand_profile(h: float, n: int, t: float = 0.25) -> list[tuple[float, float]]:
     """(x, expected ground height) written out riser by riser: n risers up T apart from
     x0, a landing L deep, n risers down T apart; sampled just before and after each riser
     and in the middle of each tread."""
-    x0, t, land = STAIRS_X0_M, STAIR_TREAD_M, STAIR_LANDING_M
+    x0, land = STAIRS_X0_M, STAIR_LANDING_M
     up = [x0 + i * t for i in range(n)]                       # riser i up: to (i+1) h
     top_end = up[-1] + land                                   # the landing's far edge
     down = [top_end + i * t for i in range(n)]                # riser i down: to (n-1-i) h
@@ -64,25 +64,30 @@ def hand_profile(h: float, n: int) -> list[tuple[float, float]]:
     return out
 
 
-@pytest.mark.parametrize(("h", "n"), [(0.015, 3), (0.03, 1), (0.01, 5)])
-def test_the_ground_rises_and_falls_step_by_step(h: float, n: int) -> None:
-    model = build_mjcf(ROBOT, world=World(stairs_height_m=h, stairs_count=n)).model()
+@pytest.mark.parametrize(("h", "n", "t"), [(0.015, 3, None), (0.03, 1, None),
+                                           (0.01, 5, None), (0.015, 3, 0.15)])
+def test_the_ground_rises_and_falls_step_by_step(h: float, n: int, t: float | None) -> None:
+    """Default treads (25 cm: ``t`` None) and given ones (``--stairs H,N,TREAD``)."""
+    world = (World(stairs_height_m=h, stairs_count=n) if t is None
+             else World(stairs_height_m=h, stairs_count=n, stairs_tread_m=t))
+    model = build_mjcf(ROBOT, world=world).model()
     for y in (0.3, -0.3):                     # beside the robot's path, both sides
-        for x, want in hand_profile(h, n):
+        for x, want in hand_profile(h, n, 0.25 if t is None else t):
             assert ground(model, x, y) == pytest.approx(want, abs=1e-9), (x, y)
 
 
 def test_the_three_1_5_cm_steps_in_numbers() -> None:
-    """The suite's stairs, by hand: risers up at 0.30, 0.45, 0.60 m, the landing 4.5 cm
-    high to 0.90 m, risers down at 0.90, 1.05, 1.20 m."""
+    """The suite's stairs, by hand (25 cm treads): risers up at 0.30, 0.55, 0.80 m, the
+    landing 4.5 cm high to 1.10 m, risers down at 1.10, 1.35, 1.60 m."""
     model = build_mjcf(ROBOT, world=World(stairs_height_m=0.015, stairs_count=3)).model()
-    for x, want in [(0.29, 0.0), (0.31, 0.015), (0.46, 0.03), (0.61, 0.045), (0.89, 0.045),
-                    (0.91, 0.03), (1.06, 0.015), (1.21, 0.0)]:
+    for x, want in [(0.29, 0.0), (0.31, 0.015), (0.56, 0.03), (0.81, 0.045), (1.09, 0.045),
+                    (1.11, 0.03), (1.36, 0.015), (1.61, 0.0)]:
         assert ground(model, x, 0.3) == pytest.approx(want, abs=1e-9), x
+    assert stairs_end_m(3) == pytest.approx(1.60)
     # and they end sideways where the world says
     inside, outside = STAIRS_HALF_WIDTH_M - EDGE, STAIRS_HALF_WIDTH_M + EDGE
-    assert ground(model, 0.75, inside) == pytest.approx(0.045, abs=1e-9)
-    assert ground(model, 0.75, outside) == pytest.approx(0.0, abs=1e-9)
+    assert ground(model, 0.95, inside) == pytest.approx(0.045, abs=1e-9)
+    assert ground(model, 0.95, outside) == pytest.approx(0.0, abs=1e-9)
 
 
 def test_no_stairs_is_the_plain_scene() -> None:
@@ -95,6 +100,8 @@ def test_no_stairs_is_the_plain_scene() -> None:
     ({"stairs_height_m": 0.015, "stairs_count": 11}, "World.stairs_count: 11 is not an"),
     ({"stairs_height_m": 0.015, "stairs_count": 0}, "give both above 0"),
     ({"stairs_height_m": 0.0, "stairs_count": 2}, "give both above 0"),
+    ({"stairs_height_m": 0.015, "stairs_count": 3, "stairs_tread_m": 0.01},
+     "World.stairs_tread_m: 0.01 is outside"),
 ])
 def test_world_refuses_half_or_out_of_range_stairs(kwargs: dict, needle: str) -> None:
     with pytest.raises(ConfigError, match=needle.replace("(", r"\(")):

@@ -39,6 +39,8 @@ def run_walk(argv: list[str], capsys: pytest.CaptureFixture[str],
     (["--stairs", "0,3"], ("--stairs", "'0,3'", "(0, 0.05] m")),
     (["--stairs", "0.015,0"], ("--stairs", "'0.015,0'", "[1, 10]")),
     (["--stairs", "0.015,2.5"], ("--stairs", "'0.015,2.5'", "[1, 10]")),
+    (["--stairs", "0.015,3,0.01"], ("--stairs", "'0.015,3,0.01'", "TREAD in [0.05, 1] m")),
+    (["--stairs", "0.015,3,0.2,1"], ("--stairs", "'0.015,3,0.2,1'", "H,N[,TREAD]")),
     (["--switch", "x:jog"], ("--switch", "'x:jog'", "T:PRESET")),
     (["--switch", "3:"], ("--switch", "'3:'", "T:PRESET")),
 ])
@@ -88,7 +90,7 @@ def test_json_world_defaults_without_options(capsys: pytest.CaptureFixture[str],
     w = json.loads(out)["world"]
     assert w == {"slope_deg": 0.0, "cross_slope_deg": 0.0, "bumps_mm": 0.0,
                  "terrain_seed": 0, "pushes": [], "latency_s": 0.0, "friction_scale": 1.0,
-                 "mass_scale": 1.0, "stairs_height_m": 0.0, "stairs_count": 0,
+                 "mass_scale": 1.0, "stairs_height_m": 0.0, "stairs_count": 0, "stairs_tread_m": 0.25,
                  "pushes_applied": []}
 
 

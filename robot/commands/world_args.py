@@ -9,7 +9,7 @@ import argparse
 from typing import Any
 
 from robot.commands.common import bounded_float, bounded_int
-from robot.config.world import MS, Push, World
+from robot.config.world import MS, STAIRS_TREAD_M, Push, World
 from robot.config.world_ranges import RANGES
 from robot.errors import ConfigError
 
@@ -18,7 +18,7 @@ DEFAULTS: dict[str, tuple[str, Any]] = {
     "--slope": ("slope", 0.0), "--cross-slope": ("cross_slope", 0.0),
     "--bumps": ("bumps", 0.0), "--terrain-seed": ("terrain_seed", 0), "--push": ("push", []),
     "--latency": ("latency", 0.0), "--friction": ("friction", 1.0),
-    "--mass-scale": ("mass_scale", 1.0), "--stairs": ("stairs", (0.0, 0)),
+    "--mass-scale": ("mass_scale", 1.0), "--stairs": ("stairs", (0.0, 0, STAIRS_TREAD_M)),
 }
 
 def _float(key: str, what: str) -> Any:
@@ -42,20 +42,25 @@ def push_spec(text: str) -> tuple[float, float, float]:
     return values
 
 
-def stairs_spec(text: str) -> tuple[float, int]:
-    """An argparse type: ``H,N`` → (step height [m] above 0, number of steps up and then
-    down, at least 1)."""
-    h_text, _, n_text = text.partition(",")
-    h, n = RANGES["stairs_height"], RANGES["stairs_count"]
+def stairs_spec(text: str) -> tuple[float, int, float]:
+    """An argparse type: ``H,N[,TREAD]`` → (step height [m] above 0, number of steps up
+    and then down, at least 1, tread depth [m], default ``STAIRS_TREAD_M``)."""
+    parts = text.split(",")
+    h, n, t = RANGES["stairs_height"], RANGES["stairs_count"], RANGES["stairs_tread"]
     try:
-        height, count = float(h_text), int(n_text)
+        if len(parts) not in (2, 3):
+            raise ValueError(text)
+        height, count = float(parts[0]), int(parts[1])
+        tread = float(parts[2]) if len(parts) == 3 else STAIRS_TREAD_M
     except ValueError:
-        height, count = float("nan"), 0
-    if not (0.0 < height <= h.hi and 1 <= count <= n.hi):  # false for nan
+        height, count, tread = float("nan"), 0, float("nan")
+    if not (0.0 < height <= h.hi and 1 <= count <= n.hi
+            and t.lo <= tread <= t.hi):  # false for nan
         raise argparse.ArgumentTypeError(
-            f"expected H,N with H in (0, {h.hi:g}] m and N an integer in [1, {n.hi:g}] "
-            f"(e.g. 0.015,3), got {text!r}")
-    return height, count
+            f"expected H,N[,TREAD] with H in (0, {h.hi:g}] m, N an integer in [1, "
+            f"{n.hi:g}] and TREAD in [{t.lo:g}, {t.hi:g}] m (default {STAIRS_TREAD_M:g}; "
+            f"e.g. 0.015,3), got {text!r}")
+    return height, count, tread
 
 
 def add_world_args(p: argparse.ArgumentParser) -> None:
@@ -82,9 +87,10 @@ def add_world_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--mass-scale", type=_float("mass_scale", "a mass scale"), default=1.0,
                    metavar="SCALE", help=f"scale every body's mass and inertia "
                    f"{RANGES['mass_scale']}")
-    g.add_argument("--stairs", type=stairs_spec, default=(0.0, 0), metavar="H,N",
+    g.add_argument("--stairs", type=stairs_spec, default=(0.0, 0, STAIRS_TREAD_M),
+                   metavar="H,N[,TREAD]",
                    help="N steps of height H [m] up ahead of the robot, a landing, N steps "
-                   "down (e.g. 0.015,3)")
+                   f"down, treads TREAD [m] deep (default {STAIRS_TREAD_M:g}; e.g. 0.015,3)")
 
 
 def given(args: argparse.Namespace) -> list[str]:
@@ -106,7 +112,7 @@ def world_from(args: argparse.Namespace, kind: str) -> World | None:
                  pushes=tuple(Push(t, jx, jy) for t, jx, jy in args.push),
                  latency_s=args.latency * MS, friction_scale=args.friction,
                  mass_scale=args.mass_scale, stairs_height_m=args.stairs[0],
-                 stairs_count=args.stairs[1])
+                 stairs_count=args.stairs[1], stairs_tread_m=args.stairs[2])
 
 
 def describe_world(w: dict[str, Any] | None) -> str | None:
@@ -128,5 +134,5 @@ def describe_world(w: dict[str, Any] | None) -> str | None:
         parts.append(f"mass x{w['mass_scale']:g}")
     if w.get("stairs_count"):
         parts.append(f"stairs {w['stairs_count']} x {w['stairs_height_m'] * 1e3:g} mm up "
-                     "and down")
+                     f"and down, treads {w.get('stairs_tread_m', STAIRS_TREAD_M) * 1e2:g} cm")
     return ", ".join(parts) or None

@@ -13,6 +13,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
+from robot.config.stairs_params import STAIRS
 from robot.config.toml_io import show
 from robot.errors import ConfigError
 
@@ -97,6 +98,8 @@ SPECS: dict[str, ParamSpec] = {
     "arm_scale": ParamSpec(1.0, 0.0, 3.0, "-", ROBOT, "scale of arm channels to the arm length", False),
     "ramp_cycles": ParamSpec(1.0, 0.1, 10.0, "cycle", ROBOT, "gait cycles to ramp amplitudes "
                              "in and out", False),
+    # --- a staircase the user describes (robot/config/stairs_params.py) -----------------------
+    **{n: ParamSpec(d, lo, hi, u, ROBOT, doc, False) for n, (d, lo, hi, u, doc) in STAIRS.items()},
     # --- balance feedback (robot/balance/stage.py; used only with an IMU and balance on) --------
     "bal_ankle_pd": ParamSpec(0.05, 0.0, 1.0, "s", BALANCE, "ankle pitch/roll per torso "
                               "tilt rate [rad per rad/s] (gyro damping)", False),
@@ -215,6 +218,17 @@ class GaitParams:
     toe_gain: float = SPECS["toe_gain"].default
     arm_scale: float = SPECS["arm_scale"].default
     ramp_cycles: float = SPECS["ramp_cycles"].default
+    stairs_rise: float = SPECS["stairs_rise"].default
+    stairs_count: float = SPECS["stairs_count"].default
+    stairs_tread: float = SPECS["stairs_tread"].default
+    stairs_x0: float = SPECS["stairs_x0"].default
+    stairs_landing: float = SPECS["stairs_landing"].default
+    stairs_margin: float = SPECS["stairs_margin"].default
+    stairs_margin_back: float = SPECS["stairs_margin_back"].default
+    stairs_odometry: float = SPECS["stairs_odometry"].default
+    stairs_learn: float = SPECS["stairs_learn"].default
+    stairs_slow: float = SPECS["stairs_slow"].default
+    stairs_reach: float = SPECS["stairs_reach"].default
     bal_ankle_pd: float = SPECS["bal_ankle_pd"].default
     bal_hip_pd: float = SPECS["bal_hip_pd"].default
     bal_ankle_pp: float = SPECS["bal_ankle_pp"].default

@@ -21,7 +21,8 @@ Sign conventions (REP-103, the robot starts at the origin facing +x):
 - ``latency_s``: goals written to the bus take effect that much sim time later.
 - ``stairs_height_m``, ``stairs_count``: a flight of that many steps up, each that high,
   a landing, and a flight as many steps down, straight ahead (sim.mujoco.world_stairs has
-  the tread, the landing and where the first riser stands); 0, 0: none.
+  the landing and where the first riser stands); 0, 0: none. ``stairs_tread_m``: the depth
+  of each tread (``STAIRS_TREAD_M`` by default: why, there).
 - ``friction_scale``: scales the sliding friction of every geom (floor, bumps, feet,
   body), hence of every contact; ``mass_scale``: scales every robot body's mass and
   inertia.
@@ -37,6 +38,14 @@ from typing import Any
 from robot.config.toml_io import Range
 from robot.config.world_ranges import RANGES
 from robot.errors import ConfigError
+
+#: Default tread depth of the stairs [m]. The issue fixes the rise (1.5 cm) and the count
+#: (3), not the tread: 25 cm lets a robot with 13 cm soles put a footstep wholly on every
+#: tread with room for its dead reckoning's error (a sole may not rest on a nosing ahead of
+#: or behind its ankle; the tread must hold the ankle 2 cm past the riser and the toe
+#: short of the next one, 10 cm, plus a stride's worth of footsteps: docs/gait.md,
+#: "climb"). Real stairs have 25-30 cm treads for 25 cm human feet.
+STAIRS_TREAD_M = 0.25
 
 MS = 1e-3  # [s/ms]
 #: Push impulse of the robustness suite [N*s] (issue 10's goal) and the gait time of its
@@ -68,7 +77,8 @@ class World:
 
     slope_deg, cross_slope_deg [deg]; bumps_mm: bump height [mm] (0: none); terrain_seed:
     the bump layout; pushes; latency_s: goal latency [s]; friction_scale, mass_scale [1];
-    stairs_height_m [m], stairs_count: steps up, then as many down (0, 0: none).
+    stairs_height_m [m], stairs_count: steps up, then as many down (0, 0: none);
+    stairs_tread_m [m]: each tread's depth.
     """
 
     slope_deg: float = 0.0
@@ -81,6 +91,7 @@ class World:
     mass_scale: float = 1.0
     stairs_height_m: float = 0.0
     stairs_count: int = 0
+    stairs_tread_m: float = STAIRS_TREAD_M
 
     def __post_init__(self) -> None:
         for name, key in (("slope_deg", "slope"), ("cross_slope_deg", "cross_slope"),
@@ -92,6 +103,7 @@ class World:
             raise ConfigError(f"World.terrain_seed: {self.terrain_seed!r} is not an integer "
                               f"in {seed}")
         _check_stairs(self.stairs_height_m, self.stairs_count)
+        _check("World.stairs_tread_m", self.stairs_tread_m, RANGES["stairs_tread"])
         ms = RANGES["latency"]
         _check("World.latency_s", self.latency_s, Range(ms.lo * MS, ms.hi * MS, "s"))
         if not all(isinstance(p, Push) for p in self.pushes):

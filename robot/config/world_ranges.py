@@ -19,4 +19,5 @@ RANGES: dict[str, Range] = {
     "mass_scale": Range(0.5, 2.0),
     "stairs_height": Range(0.0, 0.05, "m"),
     "stairs_count": Range(0, 10),
+    "stairs_tread": Range(0.05, 1.0, "m"),
 }

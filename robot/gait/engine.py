@@ -23,6 +23,7 @@ from robot.config.robot import RobotConfig
 from robot.gait import expressions as gait
 from robot.gait import vectorised
 from robot.gait.blend import PARAM_TAU_S, PRESET_BLEND_S, STEER_RATE, Blend, follow
+from robot.gait.stair_steps import StairPlan, StairSteps
 from robot.gait.targets import NO_TRIM, BodyTrim, body_targets
 from robot.gait.tick import TickKernel
 from robot.gait.vectorised import solve
@@ -118,6 +119,8 @@ class GaitEngine:
         self._ramp_s = 0.0
         self._blend: Blend | None = None  # a preset switch in progress (blend_to)
         self._blend_t = 0.0               # [s] since it began
+        self.stairs: StairSteps | None = None  # footsteps on the stairs_* staircase
+        self._ticking = False             # inside tick(): the pose is the walk's next
 
     # -- parameters -------------------------------------------------------------------
     @property
@@ -206,7 +209,14 @@ class GaitEngine:
         a = self.amplitude if amplitude is None else amplitude
         p, ph, trim = self._live, self.phase, self.trim
         q: list[Num]
-        if self._plain_inputs(p, ph, a, trim):
+        plan = StairPlan.of(p) if self._ticking and p.stairs_count > 0 else None
+        if plan is not None:    # a known staircase, walk ticks only: planned footsteps
+            if self.stairs is None or self.stairs.plan != plan:
+                self.stairs = StairSteps(plan, self.robot, self._leg_yaw, p.stairs_odometry)
+            targets = self.stairs.targets(ph, p, a, trim)
+            lift_r, lift_l = float(targets.lift_r), float(targets.lift_l)
+            q, ok = solve(targets, self.robot)
+        elif self._plain_inputs(p, ph, a, trim):
             # Python numbers throughout: the fused kernel, the same bits (robot.gait.tick).
             q, lift_r, lift_l, ok = self._kernel.pose(ph, p, a, trim)
         else:  # numpy scalars somewhere: the general functions, evaluated as they do
@@ -273,7 +283,8 @@ class GaitEngine:
             self._ramp = max(0.0, self._ramp - step)
         if self._ramp > 0.0:
             theta = self.phase.theta
-            self.phase = gait.advance(self.phase, p, dt * (1.0 + self.trim.tempo))
+            rate = 1.0 if self.stairs is None else self.stairs.rate   # x 1.0: same bits
+            self.phase = gait.advance(self.phase, p, dt * ((1.0 + self.trim.tempo) * rate))
             if p.turn != 0.0:
                 self.asked_yaw += self.amplitude * p.turn * (self.phase.theta - theta) / math.pi
         else:
@@ -281,7 +292,11 @@ class GaitEngine:
             # resetting it is invisible and the next start begins a fresh stride.
             self.phase = gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0)
         self.time += dt
-        return self.pose()
+        self._ticking = True
+        try:
+            return self.pose()
+        finally:
+            self._ticking = False
 
     def curves(self, times: npt.NDArray[np.float64], *, chunk: int = 16384,
                with_channels: bool = True

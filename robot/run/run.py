@@ -125,6 +125,12 @@ class Run(Generic[SourceT]):
                         self.streamer.emergency_stop("fell")
                 observers.append(stop_on_fall)
         observers += [o for o in (spec.recorder, spec.observer) if o is not None]
+        source = spec.source
+        if isinstance(source, GaitEngine):          # leg odometry on stairs (read-backs)
+            def read_back(tel: Telemetry) -> None:
+                if tel.fresh and tel.q_present is not None and source.stairs is not None:
+                    source.stairs.measure(tel.q_present)
+            observers.append(read_back)
 
         def observe(tel: Telemetry) -> None:
             for o in observers:

@@ -87,7 +87,8 @@ def add_world_to_scene(worldbody: ET.Element, floor: ET.Element, world: World) -
             attrs["quat"] = fmt(*quat)
         ET.SubElement(worldbody, "geom", attrs)
 
-    for k, s in enumerate(stair_boxes(world.stairs_height_m, world.stairs_count)):
+    for k, s in enumerate(stair_boxes(world.stairs_height_m, world.stairs_count,
+                                          world.stairs_tread_m)):
         box(f"{STAIR_PREFIX}{k}", s.centre, s.half_sides, STAIR_RGBA)
     if world.bumps_mm <= 0.0:
         return

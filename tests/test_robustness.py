@@ -68,6 +68,9 @@ def test_the_full_suite_has_every_group_of_the_issue() -> None:
     assert [c.seconds for c in long] == [STRAIGHT_S, STAIRS_S, SWITCHES_S]
     stairs, switches = long[1:]
     assert stairs.args == ("--stairs", "0.015,3") and stairs.reach_m == STAIRS_REACH_M
+    # Past the last riser down of the world it builds: the landing (0.30 m) after two
+    # treads (0.25 m) up and two down, from the first riser at 0.30 m.
+    assert 0.30 + 4 * 0.25 + 0.30 < STAIRS_REACH_M < 0.30 + 4 * 0.25 + 0.30 + 0.10
     assert switches.args == ("--switch", "4:jog", "--switch", "7:crouch",
                              "--switch", "10:walk")
     assert not {"stairs", "preset switches"} & {c.group for c in conditions(WALK, quick=True)}

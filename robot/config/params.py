@@ -13,6 +13,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
+from robot.config.balance_params import BALANCE_GAINS
 from robot.config.stairs_params import STAIRS
 from robot.config.toml_io import show
 from robot.errors import ConfigError
@@ -100,64 +101,9 @@ SPECS: dict[str, ParamSpec] = {
                              "in and out", False),
     # --- a staircase the user describes (robot/config/stairs_params.py) -----------------------
     **{n: ParamSpec(d, lo, hi, u, ROBOT, doc, False) for n, (d, lo, hi, u, doc) in STAIRS.items()},
-    # --- balance feedback (robot/balance/stage.py; used only with an IMU and balance on) --------
-    "bal_ankle_pd": ParamSpec(0.05, 0.0, 1.0, "s", BALANCE, "ankle pitch/roll per torso "
-                              "tilt rate [rad per rad/s] (gyro damping)", False),
-    "bal_hip_pd": ParamSpec(0.0, 0.0, 1.0, "s", BALANCE, "hip pitch/roll per torso tilt "
-                            "rate [rad per rad/s] (gyro damping)", False),
-    "bal_ankle_pp": ParamSpec(0.0, 0.0, 3.0, "-", BALANCE, "ankle pitch/roll per rad of "
-                              "torso tilt from upright", False),
-    "bal_lean_i": ParamSpec(1.0, 0.0, 5.0, "1/s", BALANCE, "rate at which the pelvis learns "
-                            "the lean a slope needs [rad/s per rad of tilt]", False),
-    "bal_lean_max": ParamSpec(0.15, 0.0, 0.4, "rad", BALANCE, "largest learned lean (pelvis "
-                              "roll/pitch relative to the feet)", False),
-    "bal_step_gain": ParamSpec(0.0, 0.0, 3.0, "-", BALANCE, "capture step: the swinging "
-                               "foot lands this many times the capture-point error at "
-                               "touchdown further toward the fall (1: the capture step; 0: "
-                               "no stepping)", False),
-    "bal_step_max": ParamSpec(0.04, 0.0, 0.1, "m", BALANCE, "largest capture step (each "
-                              "way forward, back and outward) from the gait's own footstep",
-                              False),
-    "bal_step_dead": ParamSpec(0.02, 0.0, 0.1, "m", BALANCE, "capture-point error ignored "
-                               "by stepping and tempo (the walk's own unlearned rocking)",
-                               False),
-    "bal_brace_xi": ParamSpec(0.0, 0.0, 0.2, "m", BALANCE, "capture-point error at which "
-                              "the swinging foot is put down and the gait holds still (a "
-                              "mostly forward error waits for the foot to land; 0: never)",
-                              False),
-    "bal_brace_s": ParamSpec(0.5, 0.0, 3.0, "s", BALANCE, "the gait holds still this long "
-                             "after the error was last that large", False),
-    "bal_brace_max_s": ParamSpec(0.0, 0.0, 3.0, "s", BALANCE, "a brace that has held this "
-                                 "long and still sees the error is given up: the gait steps "
-                                 "(capture step, no brace or hold) until the error is back "
-                                 "under bal_brace_xi (0: the brace holds as long as the "
-                                 "error does)", False),
-    "bal_hold_xi": ParamSpec(0.0, 0.0, 0.2, "m", BALANCE, "lateral capture-point error "
-                             "toward the foot that lifts next at which the gait holds in "
-                             "double support (a loaded foot is not lifted; 0: never)", False),
-    "bal_tempo_max": ParamSpec(0.5, 0.0, 3.0, "-", BALANCE, "largest phase speed-up when a "
-                               "capture step is out of reach (0.5: the swing ends up to 1.5 x "
-                               "sooner)", False),
-    "bal_swing_level": ParamSpec(0.0, 0.0, 1.5, "-", BALANCE, "the swinging foot turned "
-                                 "with this share of the torso's unexpected tilt (1: kept "
-                                 "level with the ground, so it lands where the step was "
-                                 "planned)", False),
-    "bal_kin_xi": ParamSpec(0.0, 0.0, 1.0, "-", BALANCE, "share of the capture-point "
-                            "error taken from the legs' kinematics (joint angles and IMU "
-                            "tilt: where the body stands over its feet) rather than from "
-                            "the torso's tilt alone (0: tilt only)", False),
-    "bal_learn_cycles": ParamSpec(4.0, 0.0, 50.0, "cycle", BALANCE, "time constant of the "
-                                  "learned gait rhythm the stepping ignores (0: none)", False),
-    "bal_heading_p": ParamSpec(0.5, 0.0, 2.0, "1/step", BALANCE, "turn trim per rad of "
-                               "heading error [rad/step per rad]", False),
-    "bal_heading_i": ParamSpec(0.2, 0.0, 2.0, "1/(step s)", BALANCE, "turn trim per rad*s "
-                               "of heading error", False),
-    "bal_turn_max": ParamSpec(0.2, 0.0, 0.5, "rad/step", BALANCE, "largest turn trim the "
-                              "heading loop may add", False),
-    "bal_stride_turn": ParamSpec(0.0, -2.0, 2.0, "-", BALANCE, "5-DoF legs (no hip yaw): "
-                                 "the heading loop's turn trim steers by step length x "
-                                 "this; 1 where `--set turn=0.05` turns the robot left, -1 "
-                                 "where it turns it right, 0: not steered", False),
+    # --- balance feedback (robot/config/balance_params.py) ----------------------------------
+    **{n: ParamSpec(d, lo, hi, u, BALANCE, doc, False)
+       for n, (d, lo, hi, u, doc) in BALANCE_GAINS.items()},
 }
 
 ALIASES: dict[str, str] = {

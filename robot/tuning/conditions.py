@@ -164,10 +164,11 @@ def scaled_params(params: GaitParams) -> list[Condition]:
 
 #: The stairs group: steps [m] and their number (up, a landing, as many down), the walk's
 #: length [s] (room for a walk at 0.06 m/s to cross them) and how far it must get [m]: the
-#: torso past the last riser down (sim.mujoco.world_stairs: 1.20 m for these).
+#: torso 5 cm past the last riser down (sim.mujoco.world_stairs.stairs_end_m: 1.60 m for
+#: these with the default 0.25 m treads).
 STAIRS = (0.015, 3)
 STAIRS_S = 30.0
-STAIRS_REACH_M = 1.25
+STAIRS_REACH_M = 1.65
 #: The preset-transition group: the issue's walk -> jog -> crouch -> walk, each switch a
 #: blend (robot.gait.blend), then 2.8 s on the last preset.
 SWITCHES = ((4.0, "jog"), (7.0, "crouch"), (10.0, "walk"))

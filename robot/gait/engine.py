@@ -9,7 +9,6 @@ never NaN.
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import math
 from collections.abc import Mapping
@@ -18,12 +17,13 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.config.joint_names import JOINT_NAMES
-from robot.config.params import SPECS, GaitParams
+from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.gait import expressions as gait
 from robot.gait import vectorised
 from robot.gait.blend import PARAM_TAU_S, PRESET_BLEND_S, STEER_RATE, Blend, follow
 from robot.gait.stair_steps import StairPlan, StairSteps
+from robot.gait.steering import STEER_BUDGET, within_steering_budget
 from robot.gait.targets import NO_TRIM, BodyTrim, body_targets
 from robot.gait.tick import TickKernel
 from robot.gait.vectorised import solve
@@ -34,30 +34,9 @@ log = logging.getLogger(__name__)
 __all__ = ["PARAM_TAU_S", "PRESET_BLEND_S", "STEER_BUDGET", "STEER_RATE", "GaitEngine",
            "within_steering_budget"]
 
-#: Steering is limited jointly: each of speed, turn and side step may reach the end of
-#: its range alone, but |speed| / its end + |turn| / its end + |side_step| / its end
-#: may not exceed this; a combination beyond it is scaled down (all three alike). Measured
-#: in MuJoCo with balance on: 1.25 walked every combination tried on both 18-joint robots
-#: (30 s each), 1.5 fell on the Feetech one (speed 1.125 with turn 0.375, and backward
-#: -0.75 with turn 0.375).
-STEER_BUDGET = 1.25
 #: The envelope's slowest rate [-] relative to its own while a feedback loop holds the
 #: phase: a stop braced again and again still ends, in at most 1 / this the time.
 ENVELOPE_MIN_RATE = 0.25
-
-
-def within_steering_budget(p: GaitParams) -> GaitParams:
-    """``p`` with speed, turn and side_step scaled down together to ``STEER_BUDGET``
-    (``p`` itself when inside it)."""
-    used = 0.0
-    for name in ("speed", "turn", "side_step"):
-        v, spec = getattr(p, name), SPECS[name]
-        end = spec.hi if v > 0 else -spec.lo
-        used += abs(v) / end if end > 0 else 0.0
-    if used <= STEER_BUDGET:
-        return p
-    k = STEER_BUDGET / used
-    return dataclasses.replace(p, speed=p.speed * k, turn=p.turn * k, side_step=p.side_step * k)
 
 
 def _plain(values: tuple[Num, ...]) -> bool:

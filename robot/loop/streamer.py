@@ -43,6 +43,7 @@ from robot.loop.clock import Clock, MonotonicClock, Pacer
 from robot.loop.ending import arm_failsafe, end, explain_stop
 from robot.loop.latency import SampleStats
 from robot.loop.pending import PendingParams
+from robot.loop.read_state import read_state
 from robot.loop.source import (
     ClampReporter,
     Feedback,
@@ -255,18 +256,9 @@ class Streamer(Generic[SourceT]):
         tel.tick, tel.state, tel.q_cmd = self._ticks, state, q_list
         tel.amplitude = self.source.amplitude
         tel.fresh, tel.clamped = False, clamped
-        if self._ticks % self.read_every == 0:
-            try:
-                states = self.bus.read_state(self.map.ids)
-                self.watchdog.bus_ok("read")
-                tel.servo = states
-                tel.q_present = self.map.from_positions(
-                    {i: s.position for i, s in states.items()}).tolist()
-                tel.fresh = True
-                self.watchdog.check(states, q)
-            except BusError as e:
-                self._bus_errors += 1
-                self.watchdog.bus_failed("read", e)
+        if self._ticks % self.read_every == 0 and not read_state(self.bus, self.map,
+                                                                  self.watchdog, tel, q):
+            self._bus_errors += 1
         self._notify()
 
     def _feed_back(self, q: JointVector) -> JointVector:

@@ -32,7 +32,7 @@ from robot.config.bundled import ROBOTS_DIR
 from robot.config.robot import JointConfig, RobotConfig
 from robot.config.robot_file import load_robot
 from robot.config.servo_file import physics_for
-from robot.errors import ConfigError, SafetyStop
+from robot.errors import BusError, ConfigError, SafetyStop
 from robot.run.signals import shield, stop_on_signals
 from robot.servo.firmware import LOG_GAIN_REGISTERS
 from robot.servo.models import MODELS
@@ -43,6 +43,10 @@ log = logging.getLogger(__name__)
 
 PERIOD_S = 0.01           # one goal write and one read-back every 10 ms
 RAMP_S = 1.5              # from where the arm is to 0 before each run
+#: Read-backs in a row that may be lost (each already retried by the bus) before a run
+#: stops: a real bus drops a reply now and then, and a lost sample is only a gap in the
+#: log (every row carries its time); 5 in a row (50 ms) is a wiring or power fault.
+LOST_READS_MAX = 5
 BUNDLED = {"dynamixel": "biped18-dynamixel", "dynamixel1": "biped18-ax12",
            "feetech": "biped18-feetech"}
 JOINT = "bench"
@@ -104,10 +108,10 @@ def record(bus: Bus, robot: RobotConfig, traj: Trajectory, *, seconds: float,
     bus.set_torque([sid], enabled=True)
     _ticks(RAMP_S, stop, lambda t: goal(start * (1 - min_jerk(t / RAMP_S))))
     rows: list[tuple[float, ...]] = []
-    on = True
+    on, lost, lost_all = True, 0, 0
 
     def tick(t: float) -> None:
-        nonlocal on
+        nonlocal on, lost, lost_all
         g, want = traj.goal(t), traj.enable(t)
         if want != on:
             if want:
@@ -116,11 +120,20 @@ def record(bus: Bus, robot: RobotConfig, traj: Trajectory, *, seconds: float,
             on = want
         if on:
             goal(g)
-        s = bus.read_state([sid])[sid]
+        try:
+            s = bus.read_state([sid])[sid]
+        except BusError:
+            lost, lost_all = lost + 1, lost_all + 1
+            if lost >= LOST_READS_MAX:
+                raise
+            return
+        lost = 0
         rows.append((t, g, angle(s.position), s.load or 0.0,
                      s.voltage or 0.0, s.temperature or 0.0, float(on)))
 
     _ticks(seconds, stop, tick)
+    if lost_all:
+        log.warning("%s: %d read-backs lost (gaps in the log)", traj.name, lost_all)
     a = np.array(rows) if rows else np.zeros((0, 7))
     speed = np.gradient(a[:, 2], a[:, 0]) if len(a) > 1 else np.zeros(len(a))
     volts = float(np.median(a[:, 4])) if len(a) else 0.0

@@ -143,3 +143,20 @@ def test_the_planned_footsteps_go_up_and_down_wholly_on_the_treads() -> None:
     assert levels[:first_top] == sorted(levels[:first_top])            # up, then
     assert levels[first_top:] == sorted(levels[first_top:], reverse=True)  # down
     assert max(x for _, x, _ in steps) > 1.65                          # past the stairs
+
+
+def test_the_planner_goes_when_the_staircase_does() -> None:
+    """The staircase set to 0 steps mid-walk (the panel, a preset switch): the planner
+    and its phase rate go with it, and the gait is the plain one again."""
+    p = load_gait("climb").for_robot(ROBOT)
+    eng = GaitEngine(ROBOT, p)
+    eng.start()
+    for _ in range(200):
+        eng.tick(0.005)
+    assert eng.stairs is not None
+    eng.replace_params(p.replace({"stairs_count": 0.0}))
+    for _ in range(2000):                  # the live value follows the set one
+        eng.tick(0.005)
+        if eng.live_params.stairs_count == 0.0:
+            break
+    assert eng.live_params.stairs_count == 0.0 and eng.stairs is None

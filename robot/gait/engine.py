@@ -188,10 +188,13 @@ class GaitEngine:
         a = self.amplitude if amplitude is None else amplitude
         p, ph, trim = self._live, self.phase, self.trim
         q: list[Num]
-        plan = StairPlan.of(p) if self._ticking and p.stairs_count > 0 else None
-        if plan is not None:    # a known staircase, walk ticks only: planned footsteps
-            if self.stairs is None or self.stairs.plan != plan:
+        if self._ticking:       # a walk tick: the staircase's planner, while there is one
+            plan = StairPlan.of(p) if p.stairs_count > 0 else None
+            if plan is None:
+                self.stairs = None
+            elif self.stairs is None or self.stairs.plan != plan:
                 self.stairs = StairSteps(plan, self.robot, self._leg_yaw, p.stairs_odometry)
+        if self._ticking and self.stairs is not None:    # planned footsteps
             targets = self.stairs.targets(ph, p, a, trim)
             lift_r, lift_l = float(targets.lift_r), float(targets.lift_l)
             q, ok = solve(targets, self.robot)
@@ -253,8 +256,8 @@ class GaitEngine:
         # The envelope runs in gait time (ramp_cycles are cycles of the phase): while a
         # feedback loop holds the phase (a brace, tempo -1) it holds too, at least at
         # ENVELOPE_MIN_RATE, so the stride does not shrink under two planted feet.
-        rate = 1.0 + self.trim.tempo
-        gait_dt = dt if rate == 1.0 else dt * max(rate, ENVELOPE_MIN_RATE)
+        tempo = 1.0 + self.trim.tempo
+        gait_dt = dt if tempo == 1.0 else dt * max(tempo, ENVELOPE_MIN_RATE)
         step = 1.0 if not math.isfinite(ramp_s) or ramp_s <= 0 else gait_dt / ramp_s
         if self._running:
             self._ramp = min(1.0, self._ramp + step)
@@ -263,7 +266,7 @@ class GaitEngine:
         if self._ramp > 0.0:
             theta = self.phase.theta
             rate = 1.0 if self.stairs is None else self.stairs.rate   # x 1.0: same bits
-            self.phase = gait.advance(self.phase, p, dt * ((1.0 + self.trim.tempo) * rate))
+            self.phase = gait.advance(self.phase, p, dt * (tempo * rate))
             if p.turn != 0.0:
                 self.asked_yaw += self.amplitude * p.turn * (self.phase.theta - theta) / math.pi
         else:

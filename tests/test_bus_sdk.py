@@ -208,7 +208,9 @@ def test_wrong_baud_names_the_rate_that_answers(bus_factory: Factory, emu: Emula
         robot: RobotConfig) -> None:
     other = 57600 if emu.protocol == "dynamixel" else 500000
     emu.set_baud(other)
-    b = bus_factory(emu, robot, open=False)
+    # A ping is not retried, and a starved emulator (the suite beside two busy loops)
+    # missed 100 ms for each of the three ids probed at 57600: a patient timeout here.
+    b = bus_factory(emu, robot, open=False, timeout_ms=250.0)
     with pytest.raises(BusError, match=rf"answers? at {other} baud.*--baud {other}"):
         b.open()
     assert not b.is_open

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from bus_harness import TEST_TIMEOUT_MS, open_bus
+from bus_harness import open_bus
 from waiting import wait_for
 
 import robot.cli as cli
@@ -37,6 +37,11 @@ from robot.run.spec import RunOptions, RunSpec
 from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
+
+#: Reply timeout [ms] of this module's buses and robot files (the harness reads it): no test
+#: here makes a servo silent, and with the suite's workers beside two busy loops a run's
+#: last read waited past 3 x 100 ms for the starved emulator (the end then read as a fault).
+REPLY_TIMEOUT_MS = 250.0
 
 RESOLUTION = 4096
 WRITES = ("write", "sync_write", "reg_write", "bulk_write", "action")
@@ -195,7 +200,7 @@ def test_second_signal_while_the_hold_is_finished_turns_torque_off(
             super().disarm_failsafe(ids)
 
     bus = SignalOnDisarm(emu.port, baud=robot.bus.baud, robot=robot,
-                         timeout_ms=TEST_TIMEOUT_MS)
+                         timeout_ms=REPLY_TIMEOUT_MS)
     run = posing(robot, bus, first_signal_at=5)
     with run:
         run.stream()
@@ -210,7 +215,8 @@ def test_second_signal_after_the_run_ended_holding_turns_torque_off(
         emu: Emulator, robot: RobotConfig, command_latch: SignalLatch) -> None:
     """Item 4's second window: the loop has returned holding, the command has not yet
     closed the bus (its handlers were restored there: -2/-15, or ignored)."""
-    run = posing(robot, open_bus(emu, robot), first_signal_at=5)
+    run = posing(robot, open_bus(emu, robot, timeout_ms=REPLY_TIMEOUT_MS),
+                 first_signal_at=5)
     with run:
         assert run.stream().holding and wire_torque(emu, robot) == {1}
         os.kill(os.getpid(), signal.SIGTERM)
@@ -298,7 +304,8 @@ def test_second_signal_after_the_run_closed_turns_torque_off_at_the_end(
     still printing when the second signal lands (it raises there: the first was the
     loop's). At the command's end (``SignalLatch.settle``, which ``end`` runs before the
     exit) the bus opens again and torque goes off, and the operator is told."""
-    run = posing(robot, open_bus(emu, robot), first_signal_at=5)
+    run = posing(robot, open_bus(emu, robot, timeout_ms=REPLY_TIMEOUT_MS),
+                 first_signal_at=5)
     with run:
         run.stream()
     assert run.result.stats.holding and wire_torque(emu, robot) == {1}

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from bus_harness import TEST_TIMEOUT_MS
 
 import robot.cli as cli
 from robot.config.bundled import ROBOTS_DIR
@@ -33,9 +34,6 @@ from robot.errors import BusError
 from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
-
-#: Reply timeout [ms] for a busy test machine (as tests/bus_harness.py's).
-TEST_TIMEOUT_MS = 100.0
 
 #: Gain register addresses, from the manuals.
 ADDRESS = {"position_d_gain": 80, "position_i_gain": 82, "position_p_gain": 84,

@@ -33,8 +33,10 @@ KP = 400
 #: identify check's mean |q_sim - q_log| must stay under this [rad]. Measured 0.009 over
 #: the five logs (3 s runs): the logs' time stamps are the loop's ticks on the wall clock,
 #: the emulator's servo moves on its own; the two implementations agree to 0.002 on one
-#: clock (tests/test_emulator_dynamics.py).
-CHECK_RAD = 0.03
+#: clock (tests/test_emulator_dynamics.py). With the suite's two workers beside two busy
+#: loops on 2 cores it measured 0.033, hence the margin; a wrong model is off by far more
+#: (the rigid servo of before issue 20: 0.45 rad on real recordings).
+CHECK_RAD = 0.05
 FIELDS = {"mass", "length", "kp", "vin", "motor", "trajectory", "entries"}
 ENTRY = {"timestamp", "goal_position", "position", "speed", "load", "input_volts", "temp",
          "torque_enable"}

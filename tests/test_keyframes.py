@@ -30,6 +30,11 @@ from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
 
+#: Reply timeout [ms] of this module's robot files (the harness reads it): no servo is made
+#: silent here, and with the suite's workers beside two busy loops the capture's hold
+#: waited past 3 x 100 ms for the starved emulator.
+REPLY_TIMEOUT_MS = 250.0
+
 WAVE = """name = "wave"
 [[keyframe]]
 t = 0.0

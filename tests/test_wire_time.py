@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 import serial
+from bus_harness import TEST_TIMEOUT_MS
 from waiting import sleep_until, wait_for
 
 import robot.cli as cli
@@ -29,7 +30,6 @@ from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)
 
-TEST_TIMEOUT_MS = 100.0
 N = 18
 #: Hand calculation, [bytes] per tick part, from the manuals' packet layouts:
 #: Protocol 2.0 instruction = FF FF FD 00 + id + len(2) + inst + params + CRC(2) = 10 + p;

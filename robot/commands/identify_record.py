@@ -112,6 +112,7 @@ def record(bus: Bus, robot: RobotConfig, traj: Trajectory, *, seconds: float,
 
     def tick(t: float) -> None:
         nonlocal on, lost, lost_all
+        called = time.monotonic()
         g, want = traj.goal(t), traj.enable(t)
         if want != on:
             if want:
@@ -120,6 +121,10 @@ def record(bus: Bus, robot: RobotConfig, traj: Trajectory, *, seconds: float,
             on = want
         if on:
             goal(g)
+        # The sample's time: the goal has just reached the servo, the read-back goes out
+        # now. Stamping the tick's start instead logs a goal and a position the late part
+        # of a tick (a busy host, a slow adapter) put later than the log says.
+        stamp = t + (time.monotonic() - called)
         try:
             s = bus.read_state([sid])[sid]
         except BusError:
@@ -128,7 +133,7 @@ def record(bus: Bus, robot: RobotConfig, traj: Trajectory, *, seconds: float,
                 raise
             return
         lost = 0
-        rows.append((t, g, angle(s.position), s.load or 0.0,
+        rows.append((stamp, g, angle(s.position), s.load or 0.0,
                      s.voltage or 0.0, s.temperature or 0.0, float(on)))
 
     _ticks(seconds, stop, tick)

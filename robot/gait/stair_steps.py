@@ -38,8 +38,9 @@ from robot.gait.xmath import Vec
 STEP_AHEAD = 0.02
 #: ... or beside it (a closing step, at most CLOSE_BEHIND [m] behind it), when it stands
 #: within ``stairs_close`` of a riser edge and the lifting foot is more than CLOSE_BEHIND
-#: behind it.
+#: behind it; at most MAX_CLOSINGS closing steps in a row.
 CLOSE_BEHIND = 0.01
+MAX_CLOSINGS = 2
 #: Footsteps shorter than this [m] teach ``reach_gain`` nothing; each longer one moves it
 #: ``stairs_learn`` of the way to what it saw, inside GAIN_RANGE.
 LEARN_MIN_M = 0.03
@@ -98,6 +99,7 @@ class StairSteps:
     #: servos land a long step short); each step is sent that much further.
     reach_gain: float = 1.0
     learn: float = 0.0      # stairs_learn of the walk's parameters [-]
+    closings: int = 0       # closing steps in a row so far (_least)
 
     @property
     def geometry(self) -> Geometry:
@@ -190,7 +192,9 @@ class StairSteps:
         """The rearmost floor x [m] foot ``f`` may land at: STEP_AHEAD past the standing
         foot ``other``, or beside it (a closing step: up to CLOSE_BEHIND behind it) when
         ``f`` is behind it by more than CLOSE_BEHIND and it stands within
-        ``stairs_close`` [m] of a riser edge.
+        ``stairs_close`` [m] of a riser edge, at most MAX_CLOSINGS in a row (two feet
+        that close on each other, each landing a little short, would shuffle before the
+        riser for ever).
         Before a riser the closing step puts ``f`` with its toe a margin short of it,
         beside ``other``, and the riser is crossed from two feet side by side: a swing
         of the crossing's length (10 cm up, 7 cm down with 1 cm margins) rather than that
@@ -198,7 +202,7 @@ class StairSteps:
         tol = p.stairs_close
         near = tol > 0.0 and not self.plan.stands(
             other.x, back, front, p.stairs_margin + tol, behind=p.stairs_margin_back + tol)
-        if near and f.x < other.x - CLOSE_BEHIND:
+        if near and f.x < other.x - CLOSE_BEHIND and self.closings < MAX_CLOSINGS:
             return other.x - CLOSE_BEHIND
         return other.x + STEP_AHEAD
 
@@ -228,6 +232,8 @@ class StairSteps:
         dx = self.plan.placement(land, back, front, p.stairs_margin, p.stairs_reach,
                                  least=self._least(f, other, back, front, p) - land,
                                  behind=p.stairs_margin_back)
+        closed = land + dx < other.x + STEP_AHEAD - 1e-6
+        self.closings = self.closings + 1 if closed else 0
         # The pelvis ends over the middle of what the new sole rests on: the foot that
         # lands goes ``support`` further back under it (and the standing one with it).
         support = self.plan.support_shift(land + dx, back, front)

@@ -15,7 +15,7 @@ from robot.config.gait_file import load_gait
 from robot.config.params import GaitParams
 from robot.config.robot_file import load_robot
 from robot.gait.engine import GaitEngine
-from robot.gait.stair_steps import ground_at, smooth, swing_end
+from robot.gait.stair_swing import ground_at, smooth, swing_end
 from robot.gait.stairs import StairPlan
 from sim.mujoco.world_stairs import stair_boxes
 
@@ -160,3 +160,36 @@ def test_the_planner_goes_when_the_staircase_does() -> None:
         if eng.live_params.stairs_count == 0.0:
             break
     assert eng.live_params.stairs_count == 0.0 and eng.stairs is None
+
+
+def test_a_riser_is_crossed_from_two_feet_side_by_side() -> None:
+    """Closing steps (stairs_close): before each riser up both feet stand side by side,
+    their toes 1 cm short of the riser (ankle at riser - 8 cm toe - 1 cm: 0.21, 0.46,
+    0.71 m), and the next footstep crosses from there to the ankle 1 cm past it (0.31,
+    0.56, 0.81 m). The swing that crosses is then the crossing (10 cm up, 5 cm heel + 1 + 1 cm
+    margins = 7 cm down) plus at most STEP_AHEAD (2 cm) the gait left the crossing foot
+    behind the other; without closing steps it also carries the gait's step (a 15.8 cm
+    swing up the first riser, 10.1 cm down the first riser down)."""
+    p = load_gait("climb").for_robot(ROBOT)
+    assert p.stairs_close > 0.0
+    eng = GaitEngine(ROBOT, p)
+    eng.start()
+    for _ in range(4000):      # 100 Hz, 40 s
+        eng.tick(0.01)
+    assert eng.stairs is not None
+    steps = eng.stairs.steps
+    xs = [round(x, 6) for _, x, _ in steps]
+    for short, past in ((0.21, 0.31), (0.46, 0.56), (0.71, 0.81)):
+        k = xs.index(past)
+        assert xs[k - 2:k] == pytest.approx([short, short], abs=1e-6)   # side by side
+        assert steps[k - 2][0] != steps[k - 1][0]
+    last: dict[bool, tuple[float, float]] = {}
+    levels = [0.0]
+    for right, x, level in steps:
+        if level != levels[-1]:        # the first foot onto another level: the crossing
+            levels.append(level)
+            travel = x - last[right][0]
+            limit = (0.10 if level > last[right][1] else 0.07) + 0.02
+            assert 0.0 < travel <= limit + 1e-9, (x, level, travel)
+        last[right] = (x, level)
+    assert len(levels) == 7      # the floor, three levels up, two down, the floor

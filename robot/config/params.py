@@ -174,6 +174,7 @@ class GaitParams:
     stairs_odometry: float = SPECS["stairs_odometry"].default
     stairs_learn: float = SPECS["stairs_learn"].default
     stairs_slow: float = SPECS["stairs_slow"].default
+    stairs_close: float = SPECS["stairs_close"].default
     stairs_reach: float = SPECS["stairs_reach"].default
     bal_ankle_pd: float = SPECS["bal_ankle_pd"].default
     bal_hip_pd: float = SPECS["bal_hip_pd"].default

@@ -23,6 +23,8 @@ STAIRS: dict[str, tuple[float, float, float, str, str]] = {
                      "they should land)"),
     "stairs_slow": (0.0, 0.0, 0.2, "m", "stairs: a footstep shifted this far swings at "
                     "half the gait's rate (0: never slowed)"),
+    "stairs_close": (0.0, 0.0, 0.1, "m", "stairs: a foot behind the standing one may land "
+                     "beside it when that stands this near a riser edge (0: never)"),
     "stairs_reach": (0.04, 0.0, 0.15, "m", "stairs: largest shift of a planned footstep "
                      "from the gait's own"),
 }

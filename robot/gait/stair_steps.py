@@ -10,9 +10,9 @@ stride would land it (the gait's own footstep at the end of this swing) and plan
 - a shift ``dx`` [m] of that footstep, the smallest within ``stairs_reach`` that keeps the
   sole ``stairs_margin`` from every riser edge (``StairPlan.placement``), moved in over the
   swing and held while the foot stands;
-- the ground under the planned sole: a step up is climbed in the first ``RISE_END`` of the
-  swing (the foot lifts first and moves forward high), a step down is descended in the
-  swing's last ``1 - DROP_START`` (the foot moves forward high, then descends).
+- the ground under the planned sole (robot.gait.stair_swing): a step up is climbed in the
+  first ``RISE_END`` of the swing (the foot lifts first and moves forward high), a step
+  down is descended in the swing's last ``1 - DROP_START`` (forward high, then down).
 
 Both soles are moved by their ground less the mean of the two, so the pelvis rides at
 the gait's height over the mean of the feet's levels. Offsets are in the level frame
@@ -21,7 +21,6 @@ under the pelvis (x forward, z up) [m], turned into the pelvis frame by the tors
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 from robot.config.joint_names import LEG_JOINTS, SIDES
@@ -30,61 +29,22 @@ from robot.config.robot import Geometry, RobotConfig
 from robot.gait import expressions as gait
 from robot.gait import xmath as xm
 from robot.gait.ik import leg_fk_full
+from robot.gait.stair_swing import ground_at, smooth, swing_end
 from robot.gait.stairs import StairPlan
 from robot.gait.targets import BodyTargets, BodyTrim, body_targets
 from robot.gait.xmath import Vec
 
 #: A shifted footstep lands at least this far [m] ahead of the standing foot.
 STEP_AHEAD = 0.02
+#: ... or beside it (a closing step, at most CLOSE_BEHIND [m] behind it), when it stands
+#: within ``stairs_close`` of a riser edge and the lifting foot is more than CLOSE_BEHIND
+#: behind it; at most MAX_CLOSINGS closing steps in a row.
+CLOSE_BEHIND = 0.01
+MAX_CLOSINGS = 2
 #: Footsteps shorter than this [m] teach ``reach_gain`` nothing; each longer one moves it
 #: ``stairs_learn`` of the way to what it saw, inside GAIN_RANGE.
 LEARN_MIN_M = 0.03
 GAIN_RANGE = (0.5, 1.2)
-#: A step up is climbed over this share of the swing's phase, from lift-off.
-RISE_END = 0.4
-#: A step down is descended from this share of the swing's phase to touchdown.
-DROP_START = 0.7
-
-
-def smooth(u: float) -> float:
-    """Minimum-jerk 0 -> 1 over ``u`` in [0, 1] (clipped outside)."""
-    u = min(max(u, 0.0), 1.0)
-    return u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
-
-
-def swing_end(theta: float, delta_f: float, right: bool) -> float:
-    """The phase [rad] at which the swing going on at ``theta`` ends: the right foot lifts
-    while sin(theta) > -delta_f, the left while sin(theta) < delta_f (eq 8 and its
-    anti-phase), so they land at pi - asin(-delta_f) and 2 pi - asin(-delta_f) (mod 2 pi),
-    the first such phase after ``theta``."""
-    land = (math.pi if right else 2.0 * math.pi) - math.asin(min(max(-delta_f, -1.0), 1.0))
-    base = theta - math.fmod(theta, 2.0 * math.pi)
-    end = base + land
-    while end <= theta:
-        end += 2.0 * math.pi
-    while end - 2.0 * math.pi > theta:
-        end -= 2.0 * math.pi
-    return end
-
-
-def lift_off_after(theta: float, delta_f: float, right: bool) -> float:
-    """The phase [rad] of the first lift-off of that foot after ``theta``: the right foot
-    lifts where sin(theta) rises through -delta_f, the left where it falls through
-    delta_f (asin(-delta_f) and pi + asin(-delta_f), mod 2 pi)."""
-    return swing_end(theta, delta_f, right) - math.pi + 2.0 * math.asin(
-        min(max(-delta_f, -1.0), 1.0))
-
-
-def ground_at(u: float, start: float, end: float) -> float:
-    """The ground level [m] a swing from ``start`` to ``end`` [m] carries its foot over at
-    phase share ``u``: up early (``RISE_END``), down late (``DROP_START``)."""
-    if end > start:
-        return start + (end - start) * smooth(u / RISE_END)
-    if end < start:
-        return start + (end - start) * smooth((u - DROP_START) / (1.0 - DROP_START))
-    return start
-
-
 @dataclass
 class _Foot:
     """One foot's state: where it stands (floor frame), its level and its shift."""
@@ -139,6 +99,7 @@ class StairSteps:
     #: servos land a long step short); each step is sent that much further.
     reach_gain: float = 1.0
     learn: float = 0.0      # stairs_learn of the walk's parameters [-]
+    closings: int = 0       # closing steps in a row so far (_least)
 
     @property
     def geometry(self) -> Geometry:
@@ -226,6 +187,25 @@ class StairSteps:
         l_off = xm.apply_t(rot, (feet[1].now_dx, 0.0, feet[1].now_ground - ref))
         return replace_soles(t, r_off, l_off)
 
+    def _least(self, f: _Foot, other: _Foot, back: float, front: float,
+               p: GaitParams) -> float:
+        """The rearmost floor x [m] foot ``f`` may land at: STEP_AHEAD past the standing
+        foot ``other``, or beside it (a closing step: up to CLOSE_BEHIND behind it) when
+        ``f`` is behind it by more than CLOSE_BEHIND and it stands within
+        ``stairs_close`` [m] of a riser edge, at most MAX_CLOSINGS in a row (two feet
+        that close on each other, each landing a little short, would shuffle before the
+        riser for ever).
+        Before a riser the closing step puts ``f`` with its toe a margin short of it,
+        beside ``other``, and the riser is crossed from two feet side by side: a swing
+        of the crossing's length (10 cm up, 7 cm down with 1 cm margins) rather than that
+        plus the gait's step."""
+        tol = p.stairs_close
+        near = tol > 0.0 and not self.plan.stands(
+            other.x, back, front, p.stairs_margin + tol, behind=p.stairs_margin_back + tol)
+        if near and f.x < other.x - CLOSE_BEHIND and self.closings < MAX_CLOSINGS:
+            return other.x - CLOSE_BEHIND
+        return other.x + STEP_AHEAD
+
     def _learn(self, f: _Foot) -> None:
         """Update ``reach_gain`` from a footstep that landed: the travel it made over the
         travel it was aimed at (steps under LEARN_MIN_M are too short to tell)."""
@@ -250,8 +230,10 @@ class StairSteps:
         back = g.foot_length / 2 - g.foot_forward
         front = g.foot_length / 2 + g.foot_forward
         dx = self.plan.placement(land, back, front, p.stairs_margin, p.stairs_reach,
-                                 least=other.x + STEP_AHEAD - land,
+                                 least=self._least(f, other, back, front, p) - land,
                                  behind=p.stairs_margin_back)
+        closed = land + dx < other.x + STEP_AHEAD - 1e-6
+        self.closings = self.closings + 1 if closed else 0
         # The pelvis ends over the middle of what the new sole rests on: the foot that
         # lands goes ``support`` further back under it (and the standing one with it).
         support = self.plan.support_shift(land + dx, back, front)

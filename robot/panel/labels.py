@@ -33,6 +33,7 @@ LABELS: dict[str, str] = {
     "stairs_odometry": "Stairs: step length actually made",
     "stairs_learn": "Stairs: learn how short steps land",
     "stairs_slow": "Stairs: slow down long steps", "stairs_reach": "Stairs: largest step change",
+    "stairs_close": "Stairs: close up at a riser",
     "bal_ankle_pd": "Ankle damping", "bal_hip_pd": "Hip damping",
     "bal_ankle_pp": "Ankle stiffness", "bal_lean_i": "Slope learning",
     "bal_lean_max": "Largest learned lean", "bal_step_gain": "Step toward a fall",

@@ -29,6 +29,7 @@ from robot.config.bundled import resolve_robot_path
 from robot.config.gait_file import load_gait
 from robot.config.params import GaitParams
 from robot.config.robot_file import load_robot
+from robot.config.world import PUSH_PHASES
 from robot.errors import ConfigError
 from robot.tuning.conditions import AFTER_PUSH_S, push_grid
 from robot.tuning.robustness import Outcome, WalkJob, run_condition, worker_init
@@ -59,6 +60,18 @@ def parse_pairs(option: str, items: list[str], kind: type[float] | type[int]
             what = "an integer register value" if kind is int else "a number"
             raise ConfigError(f"{option} {item}: give NAME=VALUE, VALUE {what}") from None
     return out
+
+
+def parse_phases(text: str) -> tuple[float, ...]:
+    """Comma-separated fractions of the gait cycle, each in [0, 1) (ConfigError else)."""
+    try:
+        phases = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        phases = ()
+    if not phases or not all(0.0 <= p < 1.0 for p in phases):
+        raise ConfigError(f"--phases {text}: give fractions of the cycle in [0, 1), "
+                          "comma-separated (e.g. 0,0.125,0.25)")
+    return phases
 
 
 def with_leg_gains(robot: str, gains: dict[str, float], folder: Path) -> str:
@@ -92,6 +105,9 @@ def main() -> int:
                     help="a gain register on every leg servo (repeatable)")
     ap.add_argument("--open-loop", action="store_true", help="balance off")
     ap.add_argument("--only", default="", help="run only cases whose name contains this")
+    ap.add_argument("--phases", default="", metavar="P,P,...",
+                    help="push at these fractions of the cycle instead of the suite's "
+                         "0, 0.25, 0.5, 0.75 (a finer map of the step)")
     a = ap.parse_args()
     worker_init()
     with tempfile.TemporaryDirectory() as folder:
@@ -102,16 +118,19 @@ def main() -> int:
             params = load_gait(a.gait).for_robot(robot)
             if a.set:
                 params = params.replace(parse_pairs("--set", a.set, float), where="--set")
+            phases = parse_phases(a.phases) if a.phases else PUSH_PHASES
         except ConfigError as e:
             return fail(str(e))
-        return walk_grid(a, path, params)
+        return walk_grid(a, path, params, phases)
 
 
-def walk_grid(a: argparse.Namespace, path: str, params: GaitParams) -> int:
-    """Walk the grid for the parsed options ``a`` on robot file ``path``; print it."""
+def walk_grid(a: argparse.Namespace, path: str, params: GaitParams,
+              phases: tuple[float, ...]) -> int:
+    """Walk the grid for the parsed options ``a`` on robot file ``path`` at ``phases``
+    (fractions of the cycle); print it."""
     robot = load_robot(path)
     line = WALK_LINE.get(robot.name, 0.0)
-    conds = [c for c in push_grid(params.cycle_s, a.impulse) if a.only in c.name]
+    conds = [c for c in push_grid(params.cycle_s, a.impulse, phases=phases) if a.only in c.name]
     jobs = []
     for c in conds:
         assert c.world is not None

@@ -74,7 +74,7 @@ def _preset(robot_name: str, gait_name: str, seconds: float) -> dict[str, Any]:
 #: paper's equations verbatim, with no weight shift): walked and reported, not counted.
 PREVIS_ONLY = frozenset({"paper", "run"})
 #: Presets not made for some bundled robots: walked and reported there, not counted
-#: (`jog` falls 7.5 s into the gait on the 12 cm-legged ROBOTIS MINI; docs/gait.md).
+#: (`jog` falls 13.7 s into a 60 s walk on the 12 cm-legged ROBOTIS MINI; docs/gait.md).
 NOT_FOR: dict[str, frozenset[str]] = {"jog": frozenset({"robotis-mini"})}
 
 

@@ -76,6 +76,11 @@ PREVIS_ONLY = frozenset({"paper", "run"})
 #: Presets not made for some bundled robots: walked and reported there, not counted
 #: (`jog` falls 13.7 s into a 60 s walk on the 12 cm-legged ROBOTIS MINI; docs/gait.md).
 NOT_FOR: dict[str, frozenset[str]] = {"jog": frozenset({"robotis-mini"})}
+#: Presets planned for a world the flat is not: walked and reported, not counted. `climb`
+#: plans footsteps for the staircase its `stairs_*` parameters describe (3 x 1.5 cm), and
+#: on the flat the steps it shortens and closes for risers that are not there tip the
+#: 12-joint robot over 7.4 s in (docs/gait.md, "climb").
+NEEDS_ITS_WORLD = frozenset({"climb"})
 
 
 def run_presets(*, quick: bool = False) -> dict[str, Any]:
@@ -87,8 +92,8 @@ def run_presets(*, quick: bool = False) -> dict[str, Any]:
     for robot in robot_names():
         for gait in gait_names():
             row = out[f"{robot} {gait}"] = _preset(robot, gait, seconds)
-            walked = walked and (gait in PREVIS_ONLY or robot in NOT_FOR.get(gait, ())
-                                 or not row["fell"])
+            walked = walked and (gait in PREVIS_ONLY or gait in NEEDS_ITS_WORLD
+                                 or robot in NOT_FOR.get(gait, ()) or not row["fell"])
     out["all_walked"] = walked
     return out
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import pytest
+from bus_harness import PATIENT_TIMEOUT_MS
 from waiting import wait_for
 
 from robot.bus import health
@@ -208,9 +209,8 @@ def test_wrong_baud_names_the_rate_that_answers(bus_factory: Factory, emu: Emula
         robot: RobotConfig) -> None:
     other = 57600 if emu.protocol == "dynamixel" else 500000
     emu.set_baud(other)
-    # A ping is not retried, and a starved emulator (the suite beside two busy loops)
-    # missed 100 ms for each of the three ids probed at 57600: a patient timeout here.
-    b = bus_factory(emu, robot, open=False, timeout_ms=250.0)
+    # A ping is not retried: a starved emulator missed 100 ms for each id probed at 57600.
+    b = bus_factory(emu, robot, open=False, timeout_ms=PATIENT_TIMEOUT_MS)
     with pytest.raises(BusError, match=rf"answers? at {other} baud.*--baud {other}"):
         b.open()
     assert not b.is_open

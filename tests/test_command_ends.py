@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from bus_harness import patient_copy
+from bus_harness import PATIENT_TIMEOUT_MS, patient_copy
 from test_fault_matrix import goal_writes, rest_ticks, tick_window
 from test_keyframes import WAVE
 from waiting import sleep_until, wait_for
@@ -114,10 +114,9 @@ class Biped:
 
 
 #: Reply timeout of these tests' robot file [ms] (bus_harness's robot_toml): each test runs
-#: a whole `biped` process beside its emulator, and at a load average of 10 on 2 cores the
-#: harness's 100 ms was seen missed three times in a row (a failed arm of the Bus
-#: Watchdog, exit 1).
-REPLY_TIMEOUT_MS = 250.0
+#: a whole `biped` process beside its emulator (the harness's 100 ms was missed three
+#: times in a row at load: a failed arm of the Bus Watchdog, exit 1).
+REPLY_TIMEOUT_MS = PATIENT_TIMEOUT_MS
 
 
 def bus_args(emu: Emulator, robot_toml: Path) -> list[str]:

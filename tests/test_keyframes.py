@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from bus_harness import PATIENT_TIMEOUT_MS
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -31,9 +32,8 @@ from sim.emulator.chain import Emulator
 pytest_plugins = ("bus_harness",)
 
 #: Reply timeout [ms] of this module's robot files (the harness reads it): no servo is made
-#: silent here, and with the suite's workers beside two busy loops the capture's hold
-#: waited past 3 x 100 ms for the starved emulator.
-REPLY_TIMEOUT_MS = 250.0
+#: silent here (the capture's hold missed 100 ms at load).
+REPLY_TIMEOUT_MS = PATIENT_TIMEOUT_MS
 
 WAVE = """name = "wave"
 [[keyframe]]

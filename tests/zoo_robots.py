@@ -8,12 +8,12 @@ import re
 from pathlib import Path
 from typing import NamedTuple
 
+from bus_harness import PATIENT_TIMEOUT_MS
+
 from robot.config.bundled import ROBOTS_DIR
 
-#: Reply timeout [ms] for the emulator on a shared machine: no zoo test makes a servo
-#: silent, and with the suite's workers beside two busy loops a starved emulator missed
-#: 3 x 100 ms (bus_harness.TEST_TIMEOUT_MS, kept short for the tests that drop replies).
-PATIENT_MS = 250.0
+#: Reply timeout [ms] for the emulator on a shared machine: no zoo test makes a servo silent.
+PATIENT_MS = PATIENT_TIMEOUT_MS
 
 
 class Variant(NamedTuple):

@@ -68,7 +68,9 @@ def test_record_on_the_emulator_then_check(tmp_path: Path, capsys: pytest.Captur
         regs = emu.registers(1)
         dropped = emu.counters()["dropped"]
     assert code == 0
-    assert dropped >= 3 and "read-backs lost" in caplog.text
+    lost = {r.args[0]: r.args[1] for r in caplog.records
+            if "read-backs lost" in r.msg and isinstance(r.args, tuple)}
+    assert dropped >= 3 and lost.get("sine_slow", 0) >= 1, lost
     assert regs["torque_enable"] == 0                      # left safe
     assert regs["position_p_gain"] == KP                   # the gain writer set it
     paths = sorted(out.glob("*.json"))
@@ -79,8 +81,12 @@ def test_record_on_the_emulator_then_check(tmp_path: Path, capsys: pytest.Captur
         assert FIELDS <= set(raw) and ENTRY <= set(raw["entries"][0])
         assert raw["kp"] == KP and raw["motor"] == MOTOR and raw["mass"] == 0.3
         log = read_log(p)
-        # 2 s runs; the first lost 0.3 s to the lost read-back (3 attempts x 100 ms)
-        assert log.t[-1] >= (1.5 if p.name.startswith("sine_slow") else 1.9)
+        # 2 s runs. A lost read-back costs up to 3 attempts x the reply timeout; one lost
+        # at a run's end (the first run's on purpose, any run's on a starved host) ends
+        # its rows that much early, and the recorder's warning counts every one of them.
+        name = p.name.removesuffix(f"_kp{KP}.json")
+        allowance = lost.get(name, 0) * (3 * TEST_TIMEOUT_MS / 1000 + 0.05)
+        assert log.t[-1] >= 1.9 - allowance, (name, lost)
         assert abs(log.position).max() > 0.1               # the arm swung
     drop = read_log(out / f"lift_drop_kp{KP}.json")
     assert drop.torque_enable[0] and not drop.torque_enable[-1]

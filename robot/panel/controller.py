@@ -24,9 +24,9 @@ from typing import Any
 
 from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
-from robot.errors import BipedError
 from robot.loop.telemetry import LoopStats
 from robot.panel.loop_process import LoopProcess, LoopUnavailable
+from robot.panel.loop_state import LoopStateReader
 from robot.panel.options import (
     DEFAULT_OPTIONS,
     BusSpec,
@@ -65,9 +65,7 @@ class PanelController:
         self._lock = threading.Lock()         # movers and e-stops, in arrival order
         self._estop_at = -math.inf            # arrival of the last e-stop handled [s]
         self._closing = False
-        self._state: dict[str, Any] = {"running": False, "tel": {"state": "idle"}, "runs": 0}
-        self._state_at = -math.inf
-        self._state_lock = threading.Lock()
+        self._reader = LoopStateReader(STATE_TIMEOUT_S)
 
     # -- the loop process ----------------------------------------------------------------
     def open(self) -> None:
@@ -128,7 +126,7 @@ class PanelController:
         try:
             return pending.wait(MOVE_TIMEOUT_S)
         finally:
-            self._state_at = -math.inf
+            self._reader.expire()
 
     def start(self, *, run: RunKind | None = None, received: float | None = None) -> None:
         """Start a run (the gait, or ``run``: a recording, a take, a sequence) with the
@@ -156,7 +154,7 @@ class PanelController:
         """Safe stop: ramp the gait out, go to rest, torque off (or hold). Idempotent:
         without a run it only answers the state."""
         state = self.loop.call("stop", timeout=STATE_TIMEOUT_S)["state"]
-        self._state_at = -math.inf
+        self._reader.expire()
         return str(state)
 
     def emergency_stop(self, *, received: float | None = None) -> list[str]:
@@ -170,23 +168,14 @@ class PanelController:
         try:
             return list(pending.wait(ESTOP_TIMEOUT_S)["failed"])
         finally:
-            self._state_at = -math.inf
+            self._reader.expire()
 
     # -- the loop's state ----------------------------------------------------------------
     def loop_state(self, *, max_age: float = STATE_MAX_AGE_S) -> dict[str, Any]:
         """The loop's own report (robot.panel.loop_watch), at most ``max_age`` old [s]:
         one request to the loop however many callers ask. If the loop does not answer,
-        the last report with a ``fault`` saying so."""
-        with self._state_lock:
-            if time.monotonic() - self._state_at <= max_age:
-                return self._state
-            try:
-                state = self.loop.call("state", timeout=STATE_TIMEOUT_S)
-            except BipedError as e:             # not answering, or gone
-                return {**self._state, "running": False, "fault": str(e),
-                        "tel": {**self._state.get("tel", {}), "state": "fault"}}
-            self._state, self._state_at = state, time.monotonic()
-            return state
+        the last report with a ``fault`` saying so (robot.panel.loop_state)."""
+        return self._reader.read(self.loop, max_age)
 
     @property
     def running(self) -> bool:

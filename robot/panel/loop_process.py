@@ -74,6 +74,10 @@ class Pending:
         self._event = threading.Event()
         self._answer: tuple[str, Any] = ("internal", "no answer")
 
+    @property
+    def answered(self) -> bool:
+        return self._event.is_set()
+
     def set(self, answer: tuple[str, Any]) -> None:
         self._answer = answer
         self._event.set()
@@ -101,6 +105,10 @@ class LoopProcess:
     @property
     def pid(self) -> int | None:
         return self._proc.pid if self._proc is not None else None
+
+    def in_flight(self, op: str) -> int:
+        """How many ``op`` commands sent are still unanswered."""
+        return sum(1 for slot in list(self._pending.values()) if slot.op == op)
 
     def start(self) -> None:
         parent_sock, child_sock = socket.socketpair()

@@ -32,8 +32,13 @@ system-deps:
 # Three workers on the machine's two cores, a test file per worker at a time: module fixtures
 # (a panel, a browser) are built once, and most tests wait on a pty, a socket or a child
 # process (two workers kept the load near 1.4: 615 s; three: 488 s, measured back to back).
+#
+# Bytecode is cached for the run (PYTHONDONTWRITEBYTECODE emptied: some shells set it): the
+# suite starts hundreds of Python processes (the servo emulator, `biped` commands, the
+# panel's loop), and each compiled the project's sources again (0.1-0.35 CPU-s apiece).
+# The files go to the __pycache__ folders git ignores.
 unit: $(STAMP) system-deps
-	MUJOCO_GL=egl $(BIN)/python -m pytest -n 3 --dist loadfile
+	PYTHONDONTWRITEBYTECODE= MUJOCO_GL=egl $(BIN)/python -m pytest -n 3 --dist loadfile --no-loadscope-reorder
 
 # Property tests with fresh random draws and 2000 examples each (make test repeats one draw).
 fuzz: $(STAMP)

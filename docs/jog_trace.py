@@ -32,11 +32,13 @@ from robot.bus.factory import make_bus  # noqa: E402
 from robot.config.gait_file import load_gait  # noqa: E402
 from robot.config.robot_file import load_robot  # noqa: E402
 from robot.config.world import Push, World  # noqa: E402
+from robot.imu.tilt import tilt_from_quat  # noqa: E402
 from robot.loop.telemetry import Telemetry  # noqa: E402
 from robot.run.run import execute  # noqa: E402
 from robot.run.spec import RunOptions  # noqa: E402
 from robot.run.walk import walk_imu, walk_spec, walk_summary  # noqa: E402
 from sim.mujoco.bus import MujocoBus  # noqa: E402
+from sim.mujoco.foot_contact import FEET  # noqa: E402
 
 HEADER = ("t th liftR liftL roll pitch tx ty tz rfx rfy rfz lfx lfy lfz rC lC "
           "rdx rdy ldx ldy tempo land")
@@ -83,16 +85,15 @@ def main() -> int:
             return
         m, d = bus.model, bus.data
         torso = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "torso")
-        feet = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, n) for n in ("r_foot", "l_foot")]
+        feet = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, n) for n in FEET]
         touch: dict[int, set[str]] = {f: set() for f in feet}
         for c in d.contact[: d.ncon]:
             for f, o in ((int(c.geom1), int(c.geom2)), (int(c.geom2), int(c.geom1))):
                 if f in touch and m.geom_bodyid[o] == 0:
                     name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, o) or str(o)
                     touch[f].add(f"B:{name}" if name.startswith("bump") else "F")
-        w, x, y, z = d.xquat[torso]
-        roll = math.degrees(math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y)))
-        pitch = math.degrees(math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x)))))
+        tilt = tilt_from_quat(tuple(d.xquat[torso]))
+        roll, pitch = math.degrees(tilt.roll), math.degrees(tilt.pitch)
         e = spec.source
         tr = e.trim
         nums = (tel.t, float(e.phase.theta) % (2 * math.pi), *e.lift, roll, pitch,

@@ -25,8 +25,10 @@ import tempfile
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+from robot.commands.common import parse_sets
 from robot.config.bundled import resolve_robot_path
 from robot.config.gait_file import load_gait
+from robot.config.joint_names import LEG_NAMES
 from robot.config.params import GaitParams
 from robot.config.robot_file import load_robot
 from robot.config.world import PUSH_PHASES
@@ -37,10 +39,6 @@ from robot.tuning.robustness import Outcome, WalkJob, run_condition, worker_init
 #: The walking line per robot [m/s]: a pushed run slower than this over the whole run
 #: stood after the push (docs/robustness.md, issue 22, second pass).
 WALK_LINE = {"biped18-dynamixel": 0.082, "biped18-feetech": 0.075}
-
-
-#: The joints whose servos ``--leg-gain`` sets (by name: every bundled leg layout).
-LEG_JOINTS = ("hip", "knee", "ankle")
 
 
 def fail(message: str) -> int:
@@ -79,8 +77,7 @@ def with_leg_gains(robot: str, gains: dict[str, float], folder: Path) -> str:
     joints' servos get ``gains`` (register values; a ``[joints.<name>.gains]`` table per
     leg joint), checked by loading it; its path."""
     text = resolve_robot_path(robot).read_text(encoding="utf-8")
-    joints = [j.name for j in load_robot(robot).joints
-              if any(part in j.name for part in LEG_JOINTS)]
+    joints = [j.name for j in load_robot(robot).joints if j.name in LEG_NAMES]
     tables = "".join(f"\n[joints.{j}.gains]  # push_grid --leg-gain\n"
                      + "".join(f"{k} = {int(v)}\n" for k, v in gains.items())
                      for j in joints)
@@ -117,7 +114,7 @@ def main() -> int:
             robot = load_robot(path)
             params = load_gait(a.gait).for_robot(robot)
             if a.set:
-                params = params.replace(parse_pairs("--set", a.set, float), where="--set")
+                params = params.replace(parse_sets(a.set), where="--set")
             phases = parse_phases(a.phases) if a.phases else PUSH_PHASES
         except ConfigError as e:
             return fail(str(e))

@@ -20,9 +20,6 @@ from typing import Any
 from robot.errors import BipedError
 from robot.panel.loop_process import LoopProcess, LoopUnavailable, Pending
 
-#: The report before the loop has given one.
-IDLE: dict[str, Any] = {"running": False, "tel": {"state": "idle"}, "runs": 0}
-
 
 class LoopStateReader:
     """``read(loop, max_age)``: the loop's last report at most ``max_age`` old [s], or,
@@ -31,7 +28,7 @@ class LoopStateReader:
 
     def __init__(self, timeout_s: float) -> None:
         self.timeout_s = timeout_s
-        self._state: dict[str, Any] = dict(IDLE)
+        self._state: dict[str, Any] = {"running": False, "tel": {"state": "idle"}, "runs": 0}
         self._at = -math.inf                  # when ``_state`` was answered [s, monotonic]
         self._asked: Pending | None = None    # the request still unanswered, if any
         self._asked_at = -math.inf

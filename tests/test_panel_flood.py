@@ -18,7 +18,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from bus_harness import TEST_TIMEOUT_MS, robot_for
+from bus_harness import PATIENT_TIMEOUT_MS, robot_for
 from panel_wire import Panel, launched
 from waiting import sleep_until, wait_for
 
@@ -57,7 +57,7 @@ def served(chain: tuple[Emulator, RobotConfig], tmp_path: Path) -> Iterator[Pane
     emu, _ = chain
     text = (ROBOTS_DIR / "biped18-dynamixel.toml").read_text()
     toml = tmp_path / "robot.toml"
-    toml.write_text(text.replace("timeout_ms = 20.0", f"timeout_ms = {TEST_TIMEOUT_MS}"))
+    toml.write_text(text.replace("timeout_ms = 20.0", f"timeout_ms = {PATIENT_TIMEOUT_MS}"))
     with launched(emu, toml, tmp_path, "--token", TOKEN, start=True) as panel:
         panel.token = TOKEN
         assert wait_for(lambda: panel.state()["state"] == "walking"), panel.state()

@@ -4,7 +4,9 @@ Connect one servo at a time (alone on the bus). For each joint it is found at an
 any standard baud of the family, given the joint's id, the robot's baud rate and return
 delay 0 (torque off; EEPROM), and checked at the new baud. ``--joint NAME --yes`` does one
 joint without prompts. Refuses, with one line and nothing written, when more than one
-servo answers or the servo is not the robot's model.
+servo answers or the servo is not the robot's model. A servo that answers as another
+joint's id at the robot's baud was set up earlier (left on the chain, or the new servo's
+reply was lost): it is taken only when the user says so at a prompt; ``--yes`` refuses.
 """
 
 from __future__ import annotations
@@ -25,11 +27,13 @@ from robot.run.signals import shield
 from robot.servo.models import factory_baud
 from robot.setup.dual_setup import assign_case
 from robot.setup.motor_setup import (
+    SetupRefused,
     answered,
     assign,
     check_model,
     find_servos,
     joints_to_set,
+    set_up_already,
 )
 
 Ask = Callable[[str], str]
@@ -67,9 +71,12 @@ def _bus(args: argparse.Namespace, robot: RobotConfig) -> SdkBus | LxBus:
                retries=robot.bus.retries, timeout_ms=robot.bus.timeout_ms, check_health=False)
 
 
-def _set_up(bus: SdkBus | LxBus, robot: RobotConfig, case: tuple[JointConfig, ...]) -> None:
+def _set_up(bus: SdkBus | LxBus, robot: RobotConfig, case: tuple[JointConfig, ...], *,
+            ask: Ask | None) -> bool:
     """Find the servo (a dual-axis case: both axes) connected alone, check its model, give
-    it its joint's id (ids), the robot's baud and return delay 0."""
+    it its joint's id (ids), the robot's baud and return delay 0. A servo set up earlier
+    for another joint is taken only if ``ask`` (None: ``--yes``, refused) gets a yes;
+    False when the user said no (nothing written)."""
     found = find_servos(bus, robot, len(case), progress=lambda m: print(f"  {m}", flush=True))
     for f, joint in zip(sorted(found, key=lambda f: f.id), case, strict=True):
         note = check_model(f, robot, joint)
@@ -77,12 +84,25 @@ def _set_up(bus: SdkBus | LxBus, robot: RobotConfig, case: tuple[JointConfig, ..
             print(f"  note: {note}")
     where = ", ".join(f"id {f.id}" for f in sorted(found, key=lambda f: f.id))
     print(f"  found: {robot.servo(case[0]).name} at {where}, {found[0].baud} baud")
+    taken = set_up_already(found, robot, case)
+    if taken:
+        names = " and ".join(j.name for j in case)
+        whose = ", ".join(f"id {f.id} is {j.name}'s" for f, j in taken)
+        seen = (f"the servo found answers at the robot's baud as another joint's id ({whose}):"
+                " it looks set up already")
+        if ask is None:
+            raise SetupRefused(f"{seen}; nothing was written: connect only the servo for "
+                               f"{names}, or run without --yes to be asked")
+        if ask(f"  {seen}. Give it to {names}? [y/N] ").strip().lower() not in ("y", "yes"):
+            print("  not given: nothing was written")
+            return False
     with shield():           # id, baud, return delay: all of them or a signal waits
         changes = (assign(bus, found[0], case[0], robot) if len(case) == 1 else
                    assign_case(bus, found, case, robot))
     done = "; ".join(changes) if changes else "already set, nothing changed"
     ids = ", ".join(f"{j.name}: id {j.servo_id}" for j in case)
     print(f"{ids} at {robot.bus.baud} baud, checked ({done})")
+    return True
 
 
 def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
@@ -112,7 +132,9 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
                 if reply.strip().lower() == "q":
                     print("stopped")
                     return 1
-            _set_up(bus, robot, case)
+            if not _set_up(bus, robot, case, ask=None if args.yes else ask):
+                print("stopped")
+                return 1
     if not args.joint:
         print(f"done: connect the chain and check with `biped scan --robot {args.robot} "
               f"--bus {robot.bus.kind} --port {bus.port_name}`")

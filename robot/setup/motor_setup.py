@@ -9,7 +9,10 @@ Only one servo may be on the bus. ``find_servo`` looks for it in two passes, che
    id: Dynamixel Protocol 1.0, Feetech), stopping at the first baud that answers.
 
 More than one servo, or a garbled reply (two servos sharing an id answer at once), refuses
-before anything is written; no answer at all says "no servo answered". ``assign`` then
+before anything is written; no answer at all says "no servo answered". A lone servo that
+answers as another joint's id at the robot's baud (``set_up_already``) is a servo set up
+earlier: the command asks before it takes it (refuses under ``--yes``), because a lost
+ping of the new servo would otherwise leave the old one looking alone. ``assign`` then
 writes, torque off first (EEPROM): return delay 0, the id, the baud rate; re-opens at the
 new baud and checks the id and model answer.
 """
@@ -34,7 +37,7 @@ FACTORY_ID = 1
 # the MX series on Protocol 1.0 ships at 57600 where the AX ships at 1 Mbps). LX servos
 # have one rate (no Baud Rate register) and find a lone servo by a broadcast ID read
 # (robot/bus/lx.py).
-__all__ = ["FACTORY_BAUD", "find_servo", "assign"]
+__all__ = ["FACTORY_BAUD", "find_servo", "set_up_already", "assign"]
 #: The buses setup-motors drives (LX: the same calls, on its own protocol).
 SetupBus = SdkBus | LxBus
 ALL_IDS = range(int(SERVO_ID.lo), int(SERVO_ID.hi) + 1)
@@ -160,6 +163,22 @@ def find_servos(bus: SetupBus, robot: RobotConfig, count: int, *,
                            f"dual-axis case answers at {count} ids of one model and baud; "
                            "nothing was written: connect only the case to set up")
     return found
+
+
+def set_up_already(found: Sequence[Found], robot: RobotConfig,
+                   case: Sequence[JointConfig]) -> list[tuple[Found, JointConfig]]:
+    """The servos in ``found`` that answer as another joint's id at the robot's baud: set
+    up earlier for that joint. A factory id (1, or 1 and 2 for a dual-axis case) is not
+    counted: a new servo answers there too, so it cannot be told apart."""
+    own = {j.servo_id for j in case}
+    factory = range(FACTORY_ID, FACTORY_ID + len(case))
+    taken = []
+    for f in found:
+        other = robot.joint_by_id(f.id)
+        if (other is not None and f.baud == robot.bus.baud and f.id not in own
+                and f.id not in factory):
+            taken.append((f, other))
+    return taken
 
 
 def check_model(found: Found, robot: RobotConfig, joint: JointConfig) -> str | None:

@@ -509,3 +509,28 @@ def test_biped_emulate_prints_a_pingable_port() -> None:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+def test_a_starved_emulator_runs_what_the_host_sent_before_it_answers_a_test(
+        link: Link) -> None:
+    """A stalled emulator (SIGSTOP: a loaded machine) with goal packets waiting on the pty,
+    more than one 4 kB read of them: a register read the test asks for after they were sent
+    sees the last goal, not one from the middle of the backlog."""
+    ids = IDS[:4]
+    below = {i: near_max_limit(link, i) - 100 for i in ids}   # inside every servo's limits
+    count = 350 if link.sdk is dxl else 600                   # 34 and 20 bytes a packet
+    pid = link.emu.pid
+    assert pid is not None
+    os.kill(pid, signal.SIGSTOP)
+    try:
+        for k in range(count):     # sync writes of 4 servos: about 12 kB waiting (a pty
+            #                           takes 20 kB before the writer blocks)
+            assert sync_write(link, "goal_position", {i: below[i] + k % 100 for i in ids}) == 0
+        asked: list[dict[int, int]] = []
+        reader = threading.Thread(target=lambda: asked.append(
+            {i: link.emu.registers(i)["goal_position"] for i in ids}), daemon=True)
+        reader.start()             # its request waits on the control socket meanwhile
+    finally:
+        os.kill(pid, signal.SIGCONT)
+    reader.join(TEST_TIMEOUT_S)
+    assert asked == [{i: below[i] + (count - 1) % 100 for i in ids}]

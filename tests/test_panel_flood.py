@@ -13,6 +13,7 @@ wire, so it runs against any version of the panel."""
 
 from __future__ import annotations
 
+import json
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -60,7 +61,8 @@ def served(chain: tuple[Emulator, RobotConfig], tmp_path: Path) -> Iterator[Pane
     toml.write_text(text.replace("timeout_ms = 20.0", f"timeout_ms = {PATIENT_TIMEOUT_MS}"))
     with launched(emu, toml, tmp_path, "--token", TOKEN, start=True) as panel:
         panel.token = TOKEN
-        assert wait_for(lambda: panel.state()["state"] == "walking"), panel.state()
+        assert wait_for(lambda: panel.state()["state"] == "walking"), (
+            json.dumps(panel.state()), "".join(panel.err))
         yield panel
 
 

@@ -9,7 +9,8 @@ starts and ends the same way:
 
 start: read the present pose → refuse (nothing moves, torque untouched) if a joint is
   outside its limits by more than one slew step → goal := present → torque on → arm the
-  servos' own bus watchdog where they have one.
+  servos' own bus watchdog where they have one; on servos the thread's priority is raised
+  until the run has ended (robot.loop.priority).
 end, by cause (docs/hardware.md, "What happens when"):
   completed / operator stop (``request_stop``, first Ctrl-C or SIGTERM): ramp the gait out,
     ramp to rest (a pose move: stop where it is), then torque off, or hold with
@@ -43,6 +44,7 @@ from robot.loop.clock import Clock, MonotonicClock, Pacer
 from robot.loop.ending import arm_failsafe, end, explain_stop
 from robot.loop.latency import SampleStats
 from robot.loop.pending import PendingParams
+from robot.loop.priority import loop_priority
 from robot.loop.read_state import read_state
 from robot.loop.source import (
     ClampReporter,
@@ -91,10 +93,8 @@ class Streamer(Generic[SourceT]):
         self._bus_dead = False
         self._q_last: JointVector = np.zeros(len(robot_map.ids))
         self._lateness = SampleStats()
-        self._overruns = 0
-        self._bus_errors = 0
+        self._overruns = self._bus_errors = self._ticks = 0
         self._pacer = Pacer(self.clock, self.dt)
-        self._ticks = 0
 
     @property
     def engine(self) -> SourceT:
@@ -102,8 +102,7 @@ class Streamer(Generic[SourceT]):
         return self.source
 
     # -- control from other threads ------------------------------------------------------
-    def set_params(self, changes: Mapping[str, float], *, where: str = "parameter"
-                   ) -> GaitParams:
+    def set_params(self, changes: Mapping[str, float], *, where: str = "parameter") -> GaitParams:
         """Validate ``changes`` now (ConfigError, nothing changes) and apply them at the next
         tick. Returns the parameters as they will be."""
         return self._pending.add(self.source, changes, where=where)
@@ -137,6 +136,14 @@ class Streamer(Generic[SourceT]):
         present = self.map.from_positions(self.bus.read_positions(ids))
         q0 = check_inside_limits(self.map, present, tolerance=self._step,  # StartRefused:
                                  source=self.source.robot.source)  # nothing moved or written
+        with loop_priority(wall_clock=isinstance(self.clock, MonotonicClock)):
+            torque = self._drive(ids, q0, seconds)    # servos (a wall clock): raised nice
+        reason = self._fault or self.telemetry.stop_reason or "completed"
+        self.telemetry.stop_reason = reason
+        return self._stats(t_start, wall0, reason, torque=torque)
+
+    def _drive(self, ids: list[int], q0: JointVector, seconds: float | None) -> str:
+        """Torque on, stream, end (robot.loop.ending.end); what is known of the torque."""
         try:
             self.bus.write_goals(self.map.goals(q0.tolist()))  # no snap to a stale goal
             self.bus.set_torque(ids, enabled=True)
@@ -153,14 +160,9 @@ class Streamer(Generic[SourceT]):
         except BaseException:                    # KeyboardInterrupt, SystemExit: no ramp
             self._finish(hold=False)
             raise
-        torque = self._finish(hold=self.hold_at_end and self._fault is None
-                              and not self._estop.is_set())
-        reason = self._fault or self.telemetry.stop_reason or "completed"
-        self.telemetry.stop_reason = reason
-        return self._stats(t_start, wall0, reason, torque=torque)
+        return self._finish(hold=self.hold_at_end and self._fault is None and not self._estop.is_set())
 
-    def _stats(self, t_start: float, wall0: float, reason: str | None, *, torque: str
-               ) -> LoopStats:
+    def _stats(self, t_start: float, wall0: float, reason: str | None, *, torque: str) -> LoopStats:
         return loop_stats(self._lateness, ticks=self._ticks, rate_hz=self.rate_hz,
                           duration_s=max(self.clock.now() - t_start, 1e-9),
                           overruns=self._overruns, bus_errors=self._bus_errors,
@@ -262,8 +264,7 @@ class Streamer(Generic[SourceT]):
         self._notify()
 
     def _feed_back(self, q: JointVector) -> JointVector:
-        """``q`` corrected by the feedback stage; if it fails, the walk ends as a fault
-        and goes on open loop (the servos are fine; only the sensor is not)."""
+        """``q`` corrected by feedback; if that fails: a fault, open loop from here (sensor)."""
         assert self.feedback is not None
         try:
             return self.feedback(q, self.dt)
@@ -285,9 +286,8 @@ class Streamer(Generic[SourceT]):
         else:
             self.watchdog.on_time()
         self._lateness.add(late)
-        self.telemetry.t = now
-        self.telemetry.period_error_ms = late * 1e3
-        self.telemetry.overruns = self._overruns
+        tel = self.telemetry
+        tel.t, tel.period_error_ms, tel.overruns = now, late * 1e3, self._overruns
 
     def _notify(self) -> None:
         if self.observer is None:

@@ -109,10 +109,9 @@ class Emulator:
     def start(self) -> str:
         """Start the child; return the pty slave path (e.g. ``/dev/pts/5``).
 
-        The child is a fresh interpreter (``python -c``), not a ``multiprocessing`` spawn,
-        so callers need no ``if __name__ == "__main__"`` guard; the control channel is a
-        socketpair in a ``multiprocessing`` Connection. It runs in ``ROOT`` (``-c`` puts the
-        working directory first on sys.path, where another checkout's ``sim`` may be)."""
+        A fresh interpreter (``python -c``, sim.emulator.child: callers need no ``__main__``
+        guard) with a socketpair for a Connection, run in ``ROOT`` (``-c`` puts the working
+        directory first on sys.path, where another checkout's ``sim`` may be)."""
         if self._port is not None:
             return self._port
         parent_sock, child_sock = socket.socketpair()
@@ -121,7 +120,7 @@ class Emulator:
         env["PYTHONPATH"] = os.pathsep.join(
             p for p in (str(ROOT), env.get("PYTHONPATH", "")) if p)
         self._proc = subprocess.Popen(
-            [sys.executable, "-c", f"import sim.emulator.server as s; s.child_main({fd})"],
+            [sys.executable, "-c", f"import sim.emulator.child as c; c.child_main({fd})"],
             pass_fds=[fd], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, env=env, cwd=ROOT)
         child_sock.close()
         self._conn = Connection(parent_sock.detach())
@@ -149,8 +148,7 @@ class Emulator:
     def stop(self) -> None:
         """Stop the child and close the pty. Idempotent."""
         conn, proc = self._conn, self._proc
-        self._conn = self._proc = None
-        self._port = None
+        self._conn, self._proc, self._port = None, None, None
         if conn is not None:
             try:
                 conn.send(("stop", ()))
@@ -171,6 +169,11 @@ class Emulator:
         if self._port is None:
             raise EmulatorError("the emulator is not running; call start() first")
         return self._port
+
+    @property
+    def pid(self) -> int | None:
+        """The child's process id while it runs (a test may SIGSTOP it: a starved chain)."""
+        return None if self._proc is None else self._proc.pid
 
     @property
     def alive(self) -> bool:
@@ -260,10 +263,7 @@ class Emulator:
 
     def plug(self, index: int | None) -> None:
         """Connect servo number ``index`` (0-based) alone, unplugging the others; None: none.
-
-        A servo that was unplugged powers on: it keeps what was saved in its EEPROM (id,
-        baud rate, ...) and its RAM (torque, goals, ...) starts from the power-on values.
-        """
+        A servo plugged in powers on: it keeps its EEPROM (id, baud, ...); RAM restarts."""
         if index is not None:
             self._check_index(index)
         self._call("plug", [] if index is None else [index])

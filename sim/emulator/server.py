@@ -1,9 +1,8 @@
 """The emulator's child process: owns the pty, the servos, the fault state and the log.
 
-Started by :class:`sim.emulator.chain.Emulator` as ``python -c "...; child_main(fd)"``; ``fd`` is
-a socketpair end carrying ``multiprocessing`` Connection messages: first the
-:class:`ChainSpec`, then requests ``(cmd, args)`` each answered ``("ok", payload)`` or
-``("error", message)``. The child exits on ``stop`` or when the parent goes away.
+Run by ``sim.emulator.child`` in the child process: ``conn`` carries ``multiprocessing``
+Connection messages, requests ``(cmd, args)`` each answered ``("ok", payload)`` or
+``("error", message)``. It serves until ``stop`` or until the parent goes away.
 """
 
 from __future__ import annotations
@@ -13,7 +12,6 @@ import gc
 import os
 import random
 import select
-import signal
 import time
 import tty
 from multiprocessing.connection import Connection
@@ -27,7 +25,7 @@ from sim.emulator.records import ChainSpec, EmulatorError, Packet
 from sim.emulator.servo import EmulatedServo
 from sim.emulator.servo_dynamics import ServoDynamics
 
-__all__ = ["ChainSpec", "EmulatorError", "Packet", "child_main"]
+__all__ = ["ChainSpec", "EmulatorError", "Packet", "ChainServer"]
 
 LOG_MAX = 200_000            # packets kept in the child
 #: Packets between two ``gc.freeze()`` calls: the log's records are never garbage, and a
@@ -45,7 +43,7 @@ CODECS: dict[str, ModuleType] = {"dynamixel": dxl_protocol, "dynamixel1": dxl1_p
                                  "feetech": sts_protocol, "lx": lx_protocol}
 
 
-class _ChainServer:
+class ChainServer:
     """Runs in the child: owns the pty, the servos and the fault state."""
 
     def __init__(self, spec: ChainSpec, conn: Connection) -> None:
@@ -169,6 +167,17 @@ class _ChainServer:
             self.counters["tx_bytes"] += n
             self.counters["tx_packets"] += 1
 
+    def read_wire(self, now: float) -> bool:
+        """Read and execute what the host sent (up to 4 kB); False when nothing was there."""
+        assert self.master is not None
+        try:
+            data = os.read(self.master, 4096)
+        except OSError:      # EAGAIN, EINTR; EIO: nobody has the slave open
+            data = b""
+        if data:
+            self.on_bytes(data, now)
+        return bool(data)
+
     def close_port(self) -> None:
         self.outbox.clear()
         for fd in (self.master, self.slave):
@@ -256,17 +265,17 @@ class _ChainServer:
             if self.master not in readable:
                 self.quiet_at = now
             if self.master is not None and self.master in readable:
-                try:
-                    data = os.read(self.master, 4096)
-                except OSError:      # EAGAIN, EINTR; EIO: nobody has the slave open
-                    data = b""
-                if data:
-                    self.on_bytes(data, now)
+                self.read_wire(now)
             self.release(time.monotonic())
             if self.counters["rx_packets"] >= self.frozen_at + FREEZE_EVERY:
                 self.frozen_at = self.counters["rx_packets"]
                 gc.freeze()
             if self.conn in readable:
+                # Everything the host wrote before it asked is on the wire: a starved
+                # emulator (a loaded machine) executes it before it answers, so a test
+                # that reads registers after its command returned sees its last writes.
+                while self.master is not None and self.read_wire(time.monotonic()):
+                    self.release(time.monotonic())
                 try:
                     cmd, args = self.conn.recv()
                 except (EOFError, OSError):
@@ -278,21 +287,3 @@ class _ChainServer:
                     self.conn.send(("ok", self.on_request(cmd, args)))
                 except Exception as e:  # noqa: BLE001 - report every failure to the parent
                     self.conn.send(("error", f"{type(e).__name__}: {e}"))
-
-
-def child_main(fd: int) -> None:
-    """Child-process entry point: ``fd`` is the control socket; the spec comes first."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)   # the parent decides when to stop
-    conn = Connection(fd)
-    try:
-        spec = conn.recv()
-        server = _ChainServer(spec, conn)
-    except Exception as e:  # noqa: BLE001 - tell the parent why we could not start
-        conn.send(("error", f"{type(e).__name__}: {e}"))
-        conn.close()
-        return
-    try:
-        server.serve()
-    finally:
-        server.close_port()
-        conn.close()

@@ -13,6 +13,7 @@ import logging
 import os
 import signal
 import sys
+from collections.abc import Sequence
 from importlib.metadata import PackageNotFoundError, version
 
 from robot.commands.common import one_line_errors
@@ -56,14 +57,30 @@ def installed_version() -> str:
         return "unknown (not installed; pip install .)"
 
 
-def build_parser() -> argparse.ArgumentParser:
+def command_of(argv: Sequence[str]) -> str | None:
+    """The command module ``argv`` names (``setup-motors``: ``setup_motors``), or None: no
+    command, an option first (``--help``, ``--version``) or a name no command has, which
+    the whole parser answers."""
+    i = 0
+    while i < len(argv) and argv[i] == "--log-level":
+        i += 2
+    if i >= len(argv) or argv[i].startswith("-"):
+        return None
+    name = argv[i].replace("-", "_")
+    return next((c for c in (name, f"{name}_") if c in COMMANDS), None)
+
+
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The parser of every command, or of ``only`` (a module name in COMMANDS): a command
+    then imports what it needs and not what the others do (mujoco, the glTF writer, ...):
+    it starts sooner, on a Raspberry Pi by a second or more."""
     parser = argparse.ArgumentParser(
         prog="biped", description="Trigonometric-gait driver for hobby servo bipeds.")
     parser.add_argument("--version", action="version", version=f"biped {installed_version()}")
     parser.add_argument("--log-level", default="WARNING",
                         choices=["DEBUG", "INFO", "WARNING", "ERROR"], help="stderr log level")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name in COMMANDS:
+    for name in COMMANDS if only is None else (only,):
         module = importlib.import_module(f"robot.commands.{name}")
         p = one_line_errors(module.add_parser(sub))
         p.set_defaults(_run=module.run)
@@ -91,7 +108,7 @@ def main(argv: list[str] | None = None) -> int:
 def _main(argv: list[str] | None) -> int:
     os.environ.setdefault("MUJOCO_GL", "egl")
     try:
-        parser = build_parser()
+        parser = build_parser(command_of(sys.argv[1:] if argv is None else argv))
         args = parser.parse_args(argv)
     except SystemExit as e:   # --help (0) or a refused option (2, one line on stderr)
         return e.code if isinstance(e.code, int) else 2

@@ -29,20 +29,19 @@ LOOP_NICE = -10
 
 
 @contextmanager
-def loop_priority(nice: int = LOOP_NICE, *, wall_clock: bool = True) -> Iterator[int | None]:
-    """Run the calling thread at ``nice`` (never lower than it already is) for the block;
-    yields the nice value in effect, or None where the OS keeps none per thread or the
-    loop runs on a simulation's clock (``wall_clock`` False: nothing waits on servos, and
-    a loop that steps physics flat out would take the CPU from everything else). Put back
-    on exit."""
+def loop_priority(nice: int = LOOP_NICE, *, wall_clock: bool = True) -> Iterator[None]:
+    """Run the calling thread at ``nice`` (never lower than it already is) for the block,
+    where the OS allows it; put back on exit. Nothing changes on a simulation's clock
+    (``wall_clock`` False: nothing waits on servos, and a loop that steps physics flat out
+    would take the CPU from everything else) or where the OS keeps no per-thread nice."""
     if not wall_clock:
-        yield None
+        yield
         return
     tid = threading.get_native_id()
     try:
         before = os.getpriority(os.PRIO_PROCESS, tid)
     except (AttributeError, OSError):         # no per-thread nice here
-        yield None
+        yield
         return
     wanted = min(before, nice)
     raised = False
@@ -55,7 +54,7 @@ def loop_priority(nice: int = LOOP_NICE, *, wall_clock: bool = True) -> Iterator
                      "CAP_SYS_NICE (a loop kept off the CPU for 0.1 s trips the servos' "
                      "bus watchdog)", before, wanted)
     try:
-        yield wanted if raised else before
+        yield
     finally:
         if raised:
             os.setpriority(os.PRIO_PROCESS, tid, before)

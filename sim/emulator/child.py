@@ -8,13 +8,13 @@ goes away.
 
 from __future__ import annotations
 
-import os
 import signal
 from multiprocessing.connection import Connection
 
+from robot.loop.priority import loop_priority
 from sim.emulator.server import ChainServer
 
-__all__ = ["NICE", "child_main"]
+__all__ = ["NICE", "child_main", "serve"]
 
 #: The emulator's scheduling priority (nice) where the system allows it (root, or
 #: CAP_SYS_NICE; elsewhere it keeps the parent's). Servos have processors of their own: on
@@ -26,11 +26,12 @@ NICE = -10
 def child_main(fd: int) -> None:
     """Child-process entry point: ``fd`` is the control socket; the spec comes first."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)   # the parent decides when to stop
-    try:
-        os.setpriority(os.PRIO_PROCESS, 0, NICE)
-    except PermissionError:
-        pass
-    conn = Connection(fd)
+    with loop_priority(NICE):    # this process's one thread: the servos' replies
+        serve(Connection(fd))
+
+
+def serve(conn: Connection) -> None:
+    """Build the chain from the spec ``conn`` brings, then serve it until it ends."""
     try:
         spec = conn.recv()
         server = ChainServer(spec, conn)

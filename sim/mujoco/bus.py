@@ -33,6 +33,7 @@ from robot.config.world import World
 from robot.errors import BusError
 from sim.mujoco.mjcf import FOOT_GEOMS, build_mjcf, standing_qpos
 from sim.mujoco.observation import BodyObservation
+from sim.mujoco.push_state import body_state
 from sim.mujoco.run_watch import SimRunWatch
 from sim.mujoco.servo_law import ChainLaw, robot_servos
 from sim.mujoco.servos import AMBIENT_C, SimServos
@@ -270,18 +271,22 @@ class MujocoBus(BodyObservation, Bus):
         self._servos.release_due(now)
         self._forces.end_due(now, self.data.xfrc_applied[self._torso])
 
-    def push(self, jx: float, jy: float, *, window_s: float = PUSH_WINDOW_S) -> None:
+    def push(self, jx: float, jy: float, *, window_s: float = PUSH_WINDOW_S
+             ) -> dict[str, Any]:
         """An impulse on the torso starting now: jx forward, jy left in the torso's
         heading frame (yaw only) [N*s], as a constant force at its centre of mass
-        J / window_s [N] for window_s [s] of sim time."""
+        J / window_s [N] for window_s [s] of sim time. Returns the body's state just
+        before it (sim.mujoco.push_state: what the capture limit needs)."""
         if not window_s > 0:
             raise BusError(f"sim bus: push window must be > 0 s, got {window_s}")
         d = self.data
+        state = body_state(self.model, d, self.contacts_feet())
         w, x, y, z = d.qpos[3:7].tolist()
         yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
         c, s = math.cos(yaw), math.sin(yaw)
         force = np.array([c * jx - s * jy, s * jx + c * jy, 0.0]) / window_s
         self._forces.start(d.time + window_s, force, d.xfrc_applied[self._torso])
+        return state
 
     def _physics_to(self, stop: float) -> None:
         """Physics steps up to ``stop`` [s]: the setpoints slew before each step until they

@@ -24,6 +24,7 @@ from typing import NamedTuple
 import mujoco
 import numpy as np
 
+from robot.balance.capturability import hull
 from robot.bus.servo_map import ServoMap
 from robot.config.gait_file import load_gait
 from robot.config.robot_file import load_robot
@@ -31,6 +32,7 @@ from robot.config.world import PUSH_AT_S, PUSH_PHASES
 from robot.gait.engine import GaitEngine
 from robot.loop.streamer import Streamer, Telemetry
 from sim.mujoco.bus import FOOT_GEOMS, MujocoBus
+from sim.mujoco.push_state import sole_corners
 from sim.mujoco.world import PUSH_WINDOW_S
 
 GRAVITY = 9.81  # [m/s^2]
@@ -50,27 +52,6 @@ class Capture(NamedTuple):
     steppable: bool
 
 
-def _hull(points: np.ndarray) -> np.ndarray:
-    """Convex hull (counter-clockwise) of 2-D points (monotone chain)."""
-    pts = sorted(map(tuple, points))
-    if len(pts) < 3:
-        return np.array(pts)
-
-    def cross(o: Sequence[float], a: Sequence[float], b: Sequence[float]) -> float:
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-    lower: list[tuple[float, ...]] = []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    upper: list[tuple[float, ...]] = []
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return np.array(lower[:-1] + upper[:-1])
-
-
 def outside_distance(point: np.ndarray, hull: np.ndarray) -> float:
     """Signed distance of ``point`` from the convex polygon ``hull`` [m]: > 0 outside (to
     the nearest edge), <= 0 inside (minus the distance to the nearest edge)."""
@@ -86,16 +67,6 @@ def outside_distance(point: np.ndarray, hull: np.ndarray) -> float:
         t = min(1.0, max(0.0, float(np.dot(rel, edge) / np.dot(edge, edge))))
         best = min(best, float(np.linalg.norm(point - (a + t * edge))))
     return -best if inside else best
-
-
-def sole_corners(model: mujoco.MjModel, data: mujoco.MjData, geom: int) -> np.ndarray:
-    """The four bottom corners of a box sole in the world, x-y [m]."""
-    sx, sy, sz = model.geom_size[geom]
-    rot = data.geom_xmat[geom].reshape(3, 3)
-    centre = data.geom_xpos[geom]
-    corners = [centre + rot @ np.array([ux * sx, uy * sy, -sz])
-               for ux in (-1, 1) for uy in (-1, 1)]
-    return np.array([c[:2] for c in corners])
 
 
 def capture_after_push(robot_name: str, direction: str, phase: float,
@@ -136,7 +107,7 @@ def capture_after_push(robot_name: str, direction: str, phase: float,
     xi = com[:2] + vel[:2] / w0
     if not corners:
         return Capture(direction, phase, touching, math.inf, False)
-    out = outside_distance(xi, _hull(np.vstack(corners)))
+    out = outside_distance(xi, hull(np.vstack(corners)))
     # A foot in the air can reach xi if it is on xi's side of the standing foot.
     steppable = False
     for g, on in zip(feet, touching, strict=True):

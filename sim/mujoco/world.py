@@ -8,7 +8,7 @@ from __future__ import annotations
 import dataclasses
 import heapq
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -29,15 +29,18 @@ _TIME_EPS = 1e-9  # [s]
 class PushTarget(Protocol):
     """What PushScheduler needs of the bus (``sim.mujoco.bus.MujocoBus``)."""
 
-    def push(self, jx: float, jy: float, *, window_s: float = PUSH_WINDOW_S) -> None: ...
+    def push(self, jx: float, jy: float, *, window_s: float = PUSH_WINDOW_S
+             ) -> Mapping[str, Any] | None: ...
 
 
 @dataclass(frozen=True)
 class AppliedPush:
-    """A push as applied: the request and the sim time it started [s]."""
+    """A push as applied: the request, the sim time it started [s] and the body's state
+    just before it (sim.mujoco.push_state; None if the target gave none)."""
 
     push: Push
     sim_t_s: float
+    state: Mapping[str, Any] | None = None
 
 
 class PushScheduler:
@@ -66,12 +69,15 @@ class PushScheduler:
             p = self.pushes[len(self.applied)]
             if p.at_s > gait_t + _TIME_EPS:
                 break
-            self.bus.push(p.jx, p.jy, window_s=self.window_s)
-            self.applied.append(AppliedPush(p, tel.t))
+            state = self.bus.push(p.jx, p.jy, window_s=self.window_s)
+            self.applied.append(AppliedPush(p, tel.t, state))
 
     def as_list(self) -> list[dict[str, Any]]:
-        """JSON-ready: each applied push with its sim start time."""
-        return [{**dataclasses.asdict(a.push), "sim_t_s": a.sim_t_s} for a in self.applied]
+        """JSON-ready: each applied push with its sim start time and, where the bus gave
+        it, the body's state just before it (``state``)."""
+        return [{**dataclasses.asdict(a.push), "sim_t_s": a.sim_t_s,
+                 **({"state": dict(a.state)} if a.state is not None else {})}
+                for a in self.applied]
 
 
 class TimedForces:

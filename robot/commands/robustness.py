@@ -10,6 +10,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
+from robot.commands import push_map
 from robot.commands.common import (
     add_robot_args,
     add_set_arg,
@@ -19,6 +20,7 @@ from robot.commands.common import (
     robot_from,
     seconds,
 )
+from robot.errors import ConfigError
 from robot.tuning.robustness import (
     STRAIGHT_DEG,
     STRAIGHT_DRIFT,
@@ -53,11 +55,16 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--out", type=output_file, default=None, metavar="PNG",
                    help="write the survival picture here")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    push_map.add_args(p)
     return p
 
 
 def run(args: argparse.Namespace) -> int:
     gait, params = params_from(args, robot_from(args))   # validates names before any run
+    if args.push_map:
+        return push_map.run_map(args, gait, params)
+    if args.directions or args.phases:
+        raise ConfigError("--directions and --phases go with --push-map")
     secs = args.seconds if args.seconds is not None else (12.0 if args.quick else 30.0)
     conds = conditions(params, quick=args.quick)
     check_seconds(conds, secs)

@@ -8,9 +8,12 @@ are shared: compare ratios measured in one run, never absolute numbers across ma
 
 ``presets``: every bundled gait preset walked for 60 s on the flat on every bundled robot
 (5 s with ``quick``), as `biped walk` runs it (balance on where the robot has an IMU):
-whether it fell, its speed and heading change. The simulated servos are the identified
-ones at the robot file's gains (docs/servos.md), so this is where a gain choice that
-makes a preset sag or fall shows.
+whether it fell, its speed and heading change, its heading drift per minute and its speed
+against its own (``planned_speed``); ``flags`` says which walking preset turns more than
+DRIFT_DEG_MIN per minute or walks under WALK_SHARE of its speed, and why. The simulated
+servos are the identified ones at the robot file's gains (docs/servos.md), so this is
+where a gain choice that makes a preset sag or fall shows. ``stops``: the stop study
+(robot.bench.stops).
 """
 
 from __future__ import annotations
@@ -20,14 +23,18 @@ import time
 from typing import Any
 
 from robot.balance.stage import Balance, attitude_reader
+from robot.bench.stops import run_stops
 from robot.bus.factory import make_bus
 from robot.bus.servo_map import ServoMap
 from robot.config.bundled import gait_names, robot_names
 from robot.config.gait_file import load_gait
+from robot.config.params import GaitParams
+from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from robot.gait.engine import GaitEngine
 from robot.imu import open_imu
 from robot.loop.streamer import Streamer
+from robot.previs.travel import Efficiency, unit_travel
 
 
 def _walk(robot_name: str, seconds: float, *, balance: bool) -> tuple[float, float]:
@@ -54,6 +61,13 @@ def _walk(robot_name: str, seconds: float, *, balance: bool) -> tuple[float, flo
     return stats.duration_s / wall, physics / wall
 
 
+def planned_speed(robot: RobotConfig, params: GaitParams) -> float:
+    """The preset's own speed on ``robot`` [m/s]: its stance foot's travel under the pelvis
+    per second (2 x stride amplitude per step, robot.previs.travel.unit_travel, with no
+    slip) x ``speed``."""
+    return unit_travel(robot, params, Efficiency(forward=1.0))[0] * params.speed
+
+
 def _preset(robot_name: str, gait_name: str, seconds: float) -> dict[str, Any]:
     from robot.run.run import execute
     from robot.run.spec import RunOptions
@@ -61,13 +75,59 @@ def _preset(robot_name: str, gait_name: str, seconds: float) -> dict[str, Any]:
 
     robot = load_robot(robot_name)
     gait = load_gait(gait_name)
+    params = gait.for_robot(robot)
     bus: Any = make_bus("sim", robot=robot)
-    spec = walk_spec(robot, gait.for_robot(robot), bus, gait=gait_name,
+    spec = walk_spec(robot, params, bus, gait=gait_name,
                      imu=walk_imu(robot, bus), options=RunOptions(seconds=seconds))
     r = walk_summary(spec, execute(spec), gait=gait_name)
+    planned = planned_speed(robot, params)
     return {"fell": r["fell"], "fell_at_s": r["fell_at_s"],
             "speed_m_s": round(r["speed_m_s"], 3),
-            "heading_change_deg": round(r["heading_change_deg"], 1)}
+            "heading_change_deg": round(r["heading_change_deg"], 1),
+            "heading_drift_deg_min": round(r.get("heading_drift_deg_min", 0.0), 1),
+            "planned_speed_m_s": round(planned, 3),
+            "speed_share": round(r["speed_m_s"] / planned, 2) if abs(planned) > 1e-9 else None,
+            "ik_unreachable_s": round(r["ik_unreachable_s"], 1),
+            "clamped_joints_s": {k: round(v, 1) for k, v in r["clamped_joints_s"].items()
+                                 if v >= 1.0},
+            "braced_s": round(r["braced_s"], 1)}
+
+
+#: A walking preset holds its heading within this [deg per minute] beyond what it asks,
+#: and walks at least WALK_SHARE of its own speed (``planned_speed``) on the robot; a
+#: preset that marches in place stays within IN_PLACE_M_S of its start (issue 32 item 4).
+DRIFT_DEG_MIN = 10.0
+WALK_SHARE = 0.5
+IN_PLACE = frozenset({"march"})
+IN_PLACE_M_S = 0.005
+
+
+def flags(row: dict[str, Any], gait: str) -> list[str]:
+    """What is wrong with a 60 s walk of ``gait`` (a ``_preset`` row), each with the
+    figures that say why; empty: it walked straight at its speed."""
+    out = []
+    if row["fell"]:
+        return [f"fell at {row['fell_at_s']:.1f} s"]
+    drift = row["heading_drift_deg_min"]
+    if abs(drift) > DRIFT_DEG_MIN:
+        out.append(f"turns {drift:+.1f} deg/min unasked (over {DRIFT_DEG_MIN:g})")
+    v, planned = row["speed_m_s"], row["planned_speed_m_s"]
+    if gait in IN_PLACE:
+        if abs(v) > IN_PLACE_M_S:
+            out.append(f"marches off the spot at {v:+.3f} m/s (in place: within "
+                       f"{IN_PLACE_M_S:g})")
+    elif v < WALK_SHARE * planned:
+        out.append(f"walks {v:.3f} m/s, {100 * v / planned:.0f} % of its {planned:.3f} m/s "
+                   f"(under {100 * WALK_SHARE:.0f} %)")
+    if out:      # what the walk's summary says of the cause
+        why = [f"{k} at its limit {t:.0f} s" for k, t in row["clamped_joints_s"].items()]
+        if row["ik_unreachable_s"] >= 1.0:
+            why.append(f"IK out of reach {row['ik_unreachable_s']:.0f} s")
+        if row["braced_s"] >= 1.0:
+            why.append(f"braced {row['braced_s']:.0f} s")
+        if why:
+            out.append("; ".join(why))
+    return out
 
 
 #: Presets for previs only, not for a robot to walk (their files say so: "paper" is the
@@ -85,16 +145,23 @@ NEEDS_ITS_WORLD = frozenset({"climb"})
 
 def run_presets(*, quick: bool = False) -> dict[str, Any]:
     """Every bundled preset on every bundled robot: 60 s on the flat (5 s quick);
-    ``all_walked``: no preset meant for a robot fell."""
+    ``all_walked``: no preset meant for a robot fell; ``all_straight``: none meant for a
+    robot has ``flags`` (judged on 60 s walks only: a 5 s heading says little of a
+    minute's)."""
     seconds = 5.0 if quick else 60.0
     out: dict[str, Any] = {"seconds": seconds}
-    walked = True
+    walked = straight = True
     for robot in robot_names():
         for gait in gait_names():
             row = out[f"{robot} {gait}"] = _preset(robot, gait, seconds)
-            walked = walked and (gait in PREVIS_ONLY or gait in NEEDS_ITS_WORLD
-                                 or robot in NOT_FOR.get(gait, ()) or not row["fell"])
+            counted = not (gait in PREVIS_ONLY or gait in NEEDS_ITS_WORLD
+                           or robot in NOT_FOR.get(gait, ()))
+            walked = walked and (not counted or not row["fell"])
+            if counted and not quick:
+                row["flags"] = flags(row, gait)
+                straight = straight and not row["flags"]
     out["all_walked"] = walked
+    out["all_straight"] = None if quick else straight
     return out
 
 
@@ -111,4 +178,5 @@ def run_sim_bench(*, quick: bool = False) -> dict[str, Any]:
                 "mj_step_share_of_loop": round(statistics.median(r[1] for r in runs), 3),
             }
     out["presets"] = run_presets(quick=quick)
+    out["stops"] = run_stops(quick=quick)
     return out

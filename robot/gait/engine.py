@@ -90,6 +90,10 @@ class GaitEngine:
         #: Poses in which each joint (robot order) was held at its limit, and the joints
         #: (indices) held there in the last pose.
         self.clamp_ticks = [0] * len(robot.joints)
+        #: Ticks a feedback loop held the gait braced (trim.land over 0.5: both feet down,
+        #: the phase held), and of those the ones after ``stop()``.
+        self.braced_ticks = 0
+        self.stop_braced_ticks = 0
         self.clamped: tuple[int, ...] = ()
         self._kernel = TickKernel(robot)
         self._plain_p: GaitParams | None = None   # the last parameters found _plain
@@ -257,6 +261,9 @@ class GaitEngine:
         # feedback loop holds the phase (a brace, tempo -1) it holds too, at least at
         # ENVELOPE_MIN_RATE, so the stride does not shrink under two planted feet.
         tempo = 1.0 + self.trim.tempo
+        if self.trim.land > 0.5:
+            self.braced_ticks += 1
+            self.stop_braced_ticks += not self._running
         gait_dt = dt if tempo == 1.0 else dt * max(tempo, ENVELOPE_MIN_RATE)
         step = 1.0 if not math.isfinite(ramp_s) or ramp_s <= 0 else gait_dt / ramp_s
         if self._running:

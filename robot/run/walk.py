@@ -91,7 +91,8 @@ def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *,
     the result (RunResult.as_dict) and, where the bus measured the heading (simulation),
     the heading the gait asked for, the drift beyond it per minute and whether that is
     more than ``HEADING_DRIFT_DEG_MIN``; the time [s, at the loop's rate] the IK met an
-    unreachable target (``ik_unreachable_s``) and each joint was held at a limit
+    unreachable target (``ik_unreachable_s``), the balance held the gait braced
+    (``braced_s``; ``stop_braced_s``: of it after the stop) and each joint was held at a limit
     (``clamped_joints_s``: only those that were); where the bus counted the feet on the
     ground (simulation), the flight time per gait cycle (``flight_s_per_cycle``); the
     preset switches made (``switches``)."""
@@ -105,6 +106,8 @@ def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *,
         out["flight_s_per_cycle"] = feet["flight_share"] * spec.source.params.cycle_s
     engine, rate = spec.source, result.stats.rate_hz
     out["ik_unreachable_s"] = engine.unreachable_ticks / rate if rate else 0.0
+    out["braced_s"] = engine.braced_ticks / rate if rate else 0.0
+    out["stop_braced_s"] = engine.stop_braced_ticks / rate if rate else 0.0
     out["clamped_joints_s"] = {name: n / rate for name, n in
                                zip(spec.robot.joint_names, engine.clamp_ticks, strict=True)
                                if n and rate}

@@ -104,6 +104,26 @@ def verdict(o: Outcome, line: float) -> str:
     return "walks" if o.speed_m_s >= line else "stood"
 
 
+def largest(ok: Callable[[float], bool], hi: float, resolution: float) -> float:
+    """The largest impulse [N*s] on the ``resolution`` grid with ``ok`` true, taking ok
+    true at 0 and false from some impulse on: from [0, hi] (hi rounded up to the grid),
+    widened (doubled) while ok(hi) up to PUSH_MAX_N_S, halved until ``resolution`` wide."""
+    lo = 0.0
+    hi = round(min(resolution * max(1, math.ceil(hi / resolution - 1e-9)), PUSH_MAX_N_S), 6)
+    up = ok(hi)
+    while up and hi < PUSH_MAX_N_S:
+        lo, hi = hi, round(min(2.0 * hi, PUSH_MAX_N_S), 6)
+        up = ok(hi)
+    if up:
+        return hi
+    while hi - lo > resolution + 1e-9:
+        mid = round(resolution * round(0.5 * (lo + hi) / resolution), 6)
+        if mid <= lo or mid >= hi:
+            mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
+    return round(lo, 6)
+
+
 def bisect(job: MapJob, line: float, hi: float, resolution: float) -> Cell:
     """The cell's largest impulse that walks on (module doc), from the bracket [0, hi]."""
     cell = Cell(job.direction_deg, 0.0, job.at_s, job.balance)
@@ -116,18 +136,7 @@ def bisect(job: MapJob, line: float, hi: float, resolution: float) -> Cell:
             cell.walks.append((j, v))
             cache[j] = v == "walks"
         return cache[j]
-    lo = 0.0
-    hi = min(resolution * max(1, math.ceil(hi / resolution - 1e-9)), PUSH_MAX_N_S)
-    while ok(hi) and hi < PUSH_MAX_N_S:
-        lo, hi = hi, min(2.0 * hi, PUSH_MAX_N_S)
-    if ok(hi):
-        lo = hi
-    while hi - lo > resolution + 1e-9:
-        mid = resolution * round(0.5 * (lo + hi) / resolution)
-        if mid <= lo or mid >= hi:
-            mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
-    cell.survived_n_s = round(lo, 6)
+    cell.survived_n_s = largest(ok, hi, resolution)
     return cell
 
 
@@ -157,7 +166,7 @@ def push_map(robot: str, gait: str, params: GaitParams, *,
         tasks, cells = [], []
         for (ref, o), ph in zip(walked, [ph for _ in balance_modes for ph in phases],
                                 strict=True):
-            state = _state(o)
+            state = state_of(o)
             for deg in directions:
                 lim = limits(state, n, deg) if state is not None else dict.fromkeys((0, 1, 2), 0.0)
                 job = MapJob(robot, gait, params, ref.balance, ref.at_s, deg)
@@ -176,7 +185,7 @@ def push_map(robot: str, gait: str, params: GaitParams, *,
     return done
 
 
-def _state(o: Outcome) -> PushState | None:
+def state_of(o: Outcome) -> PushState | None:
     """The body's state at the (0 N*s) push of a reference walk, if it got there."""
     applied = o.summary.get("world", {}).get("pushes_applied", [])
     return PushState.of(applied[0]["state"]) if applied and "state" in applied[0] else None

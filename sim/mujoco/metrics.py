@@ -47,6 +47,14 @@ class WalkMonitor:
     fell_at: float | None = None
     min_height: float = math.inf
     max_tilt: float = 0.0
+    stop_heading: float | None = None  # the heading when the walk was told to stop [rad]
+    stop_at: float | None = None
+
+    def mark_stop(self, t: float) -> None:
+        """The walk was told to stop at ``t`` [s] (its ramp-out begins): the heading
+        change from here to the end is the stop's."""
+        if self.stop_heading is None:
+            self.stop_heading, self.stop_at = self.heading, t
 
     def update_qpos(self, t: float, qpos: Sequence[float]) -> None:
         """``update`` from the free joint's qpos (x, y, z, qw, qx, qy, qz) as Python floats
@@ -94,4 +102,8 @@ class WalkMonitor:
             "fell_at_s": self.fell_at,
             "min_torso_height_m": self.min_height,
             "max_tilt_deg": math.degrees(self.max_tilt),
+            # The stop's own turn: from the stop request to the end (None: no stop).
+            "stop_heading_change_deg": (None if self.stop_heading is None
+                                        else math.degrees(self.heading - self.stop_heading)),
+            "stop_at_s": self.stop_at,
         }

@@ -5,7 +5,9 @@ and hip are and the corners of its sole.
 
 Everything is in the torso's heading frame (its yaw only: x forward, y left, as the push
 itself), horizontal, relative to the centre of mass's ground point; the height is over
-the lowest sole corner of the feet on the ground (of both feet when none is down).
+the lowest sole corner of the feet on the ground (of both feet when none is down);
+``push_above_com_m``: how far above the whole robot's centre of mass the push acts (the
+torso's own centre of mass, where the simulation applies it).
 Read from MuJoCo (``mj_subtreeVel`` for the velocity), JSON-ready.
 """
 
@@ -61,7 +63,9 @@ def body_state(model: mujoco.MjModel, data: mujoco.MjData,
         lowest = [float(min(sole_corners(model, data, model.geom(n).id)[:, 2].min()
                             for n in FOOT_GEOMS))]
     v = rot @ vel[:2]
+    torso = float(data.xipos[root][2])        # the push's point: the torso's own centre
     return {"com_height_m": float(com[2] - min(lowest)),
+            "push_above_com_m": torso - float(com[2]),
             "com_velocity_m_s": [float(v[0]), float(v[1])],
             "mass_kg": float(model.body_subtreemass[root]),
             "yaw_rad": yaw, "feet": feet}

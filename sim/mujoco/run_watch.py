@@ -35,12 +35,16 @@ class SimRunWatch:
         self.pushes = (PushScheduler(push_target, world.pushes)
                        if world is not None and world.pushes else None)
         self._qpos = data.qpos
+        self._walked = False
 
     def __call__(self, tel: Telemetry) -> None:
         self.monitor.update_qpos(tel.t, self._qpos[:7].tolist())
         self.effort.update(tel.t)
         if tel.state == "walking" and not self.monitor.fell:   # on its feet, walking
             self.feet.update(tel.t)
+            self._walked = True
+        elif tel.state == "ramp_out" and self._walked:
+            self.monitor.mark_stop(tel.t)
         if self.pushes is not None:
             self.pushes(tel)
 

@@ -128,7 +128,7 @@ class Balance:
         self._theta = theta
         gap = g.hip_width + 2.0 * p.foot_spread - g.foot_width
         return GaitPhase(theta=theta, dtheta=dtheta if math.isfinite(dtheta) else 0.0,
-                         amplitude=e.amplitude,
+                         amplitude=e.amplitude, stopping=not e.running,
                          swinging=(e.lift[0] > 0.0, e.lift[1] > 0.0),
                          height=p.stance * g.leg_length + g.ankle_height,
                          inward=max(0.0, 0.5 * (gap - FOOT_GAP_M)))
@@ -189,7 +189,7 @@ class Balance:
         self.engine.trim = BodyTrim(corr.pelvis_roll, corr.pelvis_pitch, *corr.feet,
                                     turn=corr.turn, tempo=corr.tempo, land=corr.land,
                                     r_roll=r_roll, r_pitch=r_pitch, l_roll=l_roll,
-                                    l_pitch=l_pitch)
+                                    l_pitch=l_pitch, close=p.bal_stop_close)
         self.last = corr
         out = apply(q, corr, self.slots)
         self._sent = out

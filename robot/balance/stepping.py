@@ -57,6 +57,8 @@ LEVEL_OUT_S = 0.2
 #: than a foot falls, out over about a quarter of a step.
 BRACE_IN_S = 0.02
 BRACE_OUT_S = 0.1
+#: While the gait stops, a brace needs this many times ``bal_brace_xi``.
+STOP_BRACE = 2.0
 Quad = tuple[float, float, float, float]
 
 
@@ -64,7 +66,8 @@ class GaitPhase(NamedTuple):
     """What the loop needs from the gait engine. theta: main phase [rad]; dtheta: its
     advance this tick [rad]; amplitude: the start/stop envelope [0, 1]; swinging: (right,
     left) foot lifted; height: pendulum length, the hip's height over the soles [m];
-    inward: how far a foot may move toward the other one [m]."""
+    inward: how far a foot may move toward the other one [m]; stopping: the gait was told
+    to stop (its ramp-out)."""
 
     theta: float = 0.0
     dtheta: float = 0.0
@@ -72,6 +75,7 @@ class GaitPhase(NamedTuple):
     swinging: tuple[bool, bool] = (False, False)
     height: float = 0.23
     inward: float = 0.0
+    stopping: bool = False
 
 
 class StepState(NamedTuple):
@@ -264,7 +268,9 @@ def step(state: StepState, values: tuple[float, float, float, float], p: GaitPar
     # robot only tips slower over the edge of its feet while it stands (docs/robustness.md,
     # issue 22, third pass); the gait steps instead (the capture step, sooner), with no
     # brace or hold until the error is back under the brace's threshold.
-    large = 0.0 < p.bal_brace_xi < size
+    # A stop's closing swing moves the body as the learned rhythm does not (the sway goes
+    # within one swing): while the gait stops, a brace needs STOP_BRACE x the error.
+    large = 0.0 < p.bal_brace_xi * (STOP_BRACE if g.stopping else 1.0) < size
     released = state.released and large
     braced_for = state.braced_for + dt if state.brace_s > 0.0 else 0.0
     if 0.0 < p.bal_brace_max_s <= braced_for and large:

@@ -55,6 +55,10 @@ BALANCE_GAINS: dict[str, tuple[float, float, float, str, str]] = {
                       "of heading error"),
     "bal_turn_max": (0.2, 0.0, 0.5, "rad/step", "largest turn trim the "
                      "heading loop may add"),
+    "bal_stop_close": (1.0, 0.0, 1.0, "-", "a stop finishes the swing in "
+                       "progress and brings the other foot beside it in the next one "
+                       "(1; the envelope holds while both feet are down), or shrinks the "
+                       "stride over ramp_cycles as without balance (0)"),
     "bal_stride_turn": (0.0, -2.0, 2.0, "-", "5-DoF legs (no hip yaw): "
                         "the heading loop's turn trim steers by step length x "
                         "this; 1 where `--set turn=0.05` turns the robot left, -1 "

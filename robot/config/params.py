@@ -195,6 +195,7 @@ class GaitParams:
     bal_heading_p: float = SPECS["bal_heading_p"].default
     bal_heading_i: float = SPECS["bal_heading_i"].default
     bal_turn_max: float = SPECS["bal_turn_max"].default
+    bal_stop_close: float = SPECS["bal_stop_close"].default
     bal_stride_turn: float = SPECS["bal_stride_turn"].default
 
     def replace(self, changes: Mapping[str, Any], *, where: str = "parameter") -> GaitParams:

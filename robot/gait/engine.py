@@ -24,6 +24,7 @@ from robot.gait import vectorised
 from robot.gait.blend import PARAM_TAU_S, PRESET_BLEND_S, STEER_RATE, Blend, follow
 from robot.gait.stair_steps import StairPlan, StairSteps
 from robot.gait.steering import STEER_BUDGET, within_steering_budget
+from robot.gait.stop_close import ramp_out
 from robot.gait.targets import NO_TRIM, BodyTrim, body_targets
 from robot.gait.tick import TickKernel
 from robot.gait.vectorised import solve
@@ -41,10 +42,7 @@ ENVELOPE_MIN_RATE = 0.25
 
 def _plain(values: tuple[Num, ...]) -> bool:
     """Every value a Python float or int (not a numpy scalar or array)."""
-    for v in values:
-        if type(v) is not float and type(v) is not int:
-            return False
-    return True
+    return all(type(v) is float or type(v) is int for v in values)
 
 
 def _smoothstep(x: float) -> float:
@@ -55,8 +53,9 @@ def _smoothstep(x: float) -> float:
 class GaitEngine:
     """Live gait state for one robot.
 
-    The envelope ramps the gait amplitude in after ``start()`` and out after ``stop()``,
-    over ``ramp_cycles`` gait cycles; the phase starts at 0 (start of the right swing).
+    The envelope ramps the gait amplitude in after ``start()`` and out after ``stop()``
+    over ``ramp_cycles`` gait cycles (out within one swing when the trim's ``close`` asks:
+    robot.gait.stop_close); the phase starts at 0 (start of the right swing).
     Parameter changes while the gait moves are followed smoothly (``PARAM_TAU_S``; a
     preset switch, ``blend_to``, over ``PRESET_BLEND_S``): ``params`` is what was set,
     ``live_params`` what the last tick used.
@@ -74,6 +73,7 @@ class GaitEngine:
         self.phase = gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0)
         self.time = 0.0
         self._ramp = 0.0          # linear ramp variable in [0, 1]
+        self._stop: str | None = None   # a closing stop's stage (gait.stop_close)
         self._running = False
         self.unreachable_ticks = 0
         #: The heading change [rad] the gait's ``turn`` asked for so far: ``turn`` per step,
@@ -90,10 +90,8 @@ class GaitEngine:
         #: Poses in which each joint (robot order) was held at its limit, and the joints
         #: (indices) held there in the last pose.
         self.clamp_ticks = [0] * len(robot.joints)
-        #: Ticks a feedback loop held the gait braced (trim.land over 0.5: both feet down,
-        #: the phase held), and of those the ones after ``stop()``.
-        self.braced_ticks = 0
-        self.stop_braced_ticks = 0
+        #: Ticks a feedback held the gait braced (trim.land > 0.5), all and after ``stop()``.
+        self.braced_ticks = self.stop_braced_ticks = 0
         self.clamped: tuple[int, ...] = ()
         self._kernel = TickKernel(robot)
         self._plain_p: GaitParams | None = None   # the last parameters found _plain
@@ -152,6 +150,7 @@ class GaitEngine:
     # -- envelope ---------------------------------------------------------------------
     def start(self) -> None:
         self._running = True
+        self._stop = None
 
     def stop(self) -> None:
         self._running = False
@@ -268,6 +267,9 @@ class GaitEngine:
         step = 1.0 if not math.isfinite(ramp_s) or ramp_s <= 0 else gait_dt / ramp_s
         if self._running:
             self._ramp = min(1.0, self._ramp + step)
+        elif self.trim.close > 0.5:      # a stop that finishes its step (a feedback's)
+            lifted = self.lift != (0.0, 0.0)
+            self._stop, self._ramp = ramp_out(self._stop, self._ramp, gait_dt, lifted, p)
         else:
             self._ramp = max(0.0, self._ramp - step)
         if self._ramp > 0.0:

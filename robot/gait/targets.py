@@ -72,7 +72,9 @@ class BodyTrim(NamedTuple):
     r_pitch, l_roll, l_pitch: the pelvis turned further relative to that foot only [rad]
     (a swinging foot kept level with the ground while the torso tilts: position and sole
     turn about the pelvis origin; the pelvis relative to the foot is then
-    rz_ry(yaw, pitch + foot pitch) rx(roll + foot roll)).
+    rz_ry(yaw, pitch + foot pitch) rx(roll + foot roll)); close: over 0.5, a stop
+    finishes the swing in progress and closes the feet in the next one (read by
+    robot.gait.engine: robot.gait.stop_close; 0: the stride shrinks over ramp_cycles).
     """
 
     roll: float = 0.0
@@ -88,6 +90,7 @@ class BodyTrim(NamedTuple):
     r_pitch: float = 0.0
     l_roll: float = 0.0
     l_pitch: float = 0.0
+    close: float = 0.0
 
 
 NO_TRIM = BodyTrim()

@@ -271,19 +271,14 @@ class MujocoBus(BodyObservation, Bus):
         self._servos.release_due(now)
         self._forces.end_due(now, self.data.xfrc_applied[self._torso])
 
-    def push(self, jx: float, jy: float, *, window_s: float = PUSH_WINDOW_S
-             ) -> dict[str, Any]:
-        """An impulse on the torso starting now: jx forward, jy left in the torso's
-        heading frame (yaw only) [N*s], as a constant force at its centre of mass
-        J / window_s [N] for window_s [s] of sim time. Returns the body's state just
-        before it (sim.mujoco.push_state: what the capture limit needs)."""
+    def push(self, jx: float, jy: float, *, window_s: float = PUSH_WINDOW_S) -> dict[str, Any]:
+        """An impulse on the torso now: jx forward, jy left in its heading frame (yaw only)
+        [N*s], a force J / window_s [N] at its centre of mass for window_s [s] of sim
+        time. Returns the body's state before it (sim.mujoco.push_state)."""
         if not window_s > 0:
             raise BusError(f"sim bus: push window must be > 0 s, got {window_s}")
-        d = self.data
-        state = body_state(self.model, d, self.contacts_feet())
-        w, x, y, z = d.qpos[3:7].tolist()
-        yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-        c, s = math.cos(yaw), math.sin(yaw)
+        d, state = self.data, body_state(self.model, self.data, self.contacts_feet())
+        c, s = math.cos(state["yaw_rad"]), math.sin(state["yaw_rad"])
         force = np.array([c * jx - s * jy, s * jx + c * jy, 0.0]) / window_s
         self._forces.start(d.time + window_s, force, d.xfrc_applied[self._torso])
         return state

@@ -23,6 +23,7 @@ class FootContacts:
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
         self.data = data
         self.feet = {mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n) for n in FEET}
+        self._right = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, FEET[0])
         if min(self.feet) < 0:
             raise ValueError(f"the model has no foot geoms named {FEET}")
         #: per geom: a sole, and a part of the robot (anything not on the world body)
@@ -43,6 +44,12 @@ class FootContacts:
         soles = np.concatenate((g1[self._sole[g1] & ~self._robot[g2]],
                                 g2[self._sole[g2] & ~self._robot[g1]]))
         return len(np.unique(soles))
+
+    def right_down(self) -> bool:
+        """Whether the right sole touches something that is not the robot, now."""
+        g1, g2 = self.data.contact.geom1, self.data.contact.geom2
+        return bool(((g1 == self._right) & ~self._robot[g2]).any()
+                    or ((g2 == self._right) & ~self._robot[g1]).any())
 
     def update(self, t: float) -> None:
         n = self.feet_down()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -47,14 +47,27 @@ class WalkMonitor:
     fell_at: float | None = None
     min_height: float = math.inf
     max_tilt: float = 0.0
-    stop_heading: float | None = None  # the heading when the walk was told to stop [rad]
+    stop_heading: float | None = None  # the heading it walked when told to stop [rad]
     stop_at: float | None = None
+    _cycle: list[float] = field(default_factory=list)    # headings since a touchdown
+    _last_cycle: list[float] = field(default_factory=list)
+
+    def walking(self, right_landed: bool) -> None:
+        """A walking tick (after ``update``): the heading joins the current cycle's, which
+        ends when the right foot lands (``right_landed``)."""
+        if right_landed and self._cycle:
+            self._last_cycle, self._cycle = self._cycle, []
+        self._cycle.append(self.heading)
 
     def mark_stop(self, t: float) -> None:
-        """The walk was told to stop at ``t`` [s] (its ramp-out begins): the heading
-        change from here to the end is the stop's."""
+        """The walk was told to stop at ``t`` [s] (its ramp-out begins). The heading it
+        walked then is the mean over its last whole cycle (right touchdown to right
+        touchdown; what it has if none: a walk's torso yaws back and forth with its
+        steps, so the heading of one tick is not the walk's); the change from it to the
+        end is the stop's."""
         if self.stop_heading is None:
-            self.stop_heading, self.stop_at = self.heading, t
+            cycle = self._last_cycle or self._cycle or [self.heading]
+            self.stop_heading, self.stop_at = sum(cycle) / len(cycle), t
 
     def update_qpos(self, t: float, qpos: Sequence[float]) -> None:
         """``update`` from the free joint's qpos (x, y, z, qw, qx, qy, qz) as Python floats

@@ -19,14 +19,10 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from sim.mujoco.metrics import yaw_of
 from sim.mujoco.mjcf import FOOT_GEOMS
 
 SIDES = ("r", "l")
-
-
-def _yaw(quat: np.ndarray) -> float:
-    w, x, y, z = (float(v) for v in quat)
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
 def sole_corners(model: mujoco.MjModel, data: mujoco.MjData, geom: int) -> np.ndarray:
@@ -43,7 +39,7 @@ def body_state(model: mujoco.MjModel, data: mujoco.MjData,
     root = model.body("torso").id
     com = np.array(data.subtree_com[root])
     vel = np.array(data.subtree_linvel[root])
-    yaw = _yaw(data.qpos[3:7])
+    yaw = yaw_of(data.qpos[3:7])
     c, s = math.cos(yaw), math.sin(yaw)
     rot = np.array([[c, s], [-s, c]])                   # world -> heading frame
 

@@ -36,12 +36,16 @@ class SimRunWatch:
                        if world is not None and world.pushes else None)
         self._qpos = data.qpos
         self._walked = False
+        self._right = True
 
     def __call__(self, tel: Telemetry) -> None:
         self.monitor.update_qpos(tel.t, self._qpos[:7].tolist())
         self.effort.update(tel.t)
         if tel.state == "walking" and not self.monitor.fell:   # on its feet, walking
             self.feet.update(tel.t)
+            right = self.feet.right_down()
+            self.monitor.walking(right and not self._right)
+            self._right = right
             self._walked = True
         elif tel.state == "ramp_out" and self._walked:
             self.monitor.mark_stop(tel.t)

@@ -157,6 +157,20 @@ def test_the_quick_suite_counts_a_push_only_if_it_walks_on(quick: tuple[dict, Pa
             assert cell == {"survived": sum(r["survived"] for r in mine), "runs": len(mine)}
 
 
+def test_the_quick_suite_gives_each_push_as_a_share_of_its_capture_limit(
+        quick: tuple[dict, Path]) -> None:
+    """Every pushed run (1 N*s) has the 0-, 1-, 2-step limits of its moment, in order, and
+    its share of the 1-step one is 1 N*s over it; no other run has them."""
+    for r in quick[0]["runs"]:
+        if not r["group"].startswith("push"):
+            assert "limit_n_s" not in r
+            continue
+        lim = r["limit_n_s"]
+        assert 0.0 <= lim["0"] <= lim["1"] <= lim["2"] and lim["1"] > 0.3, r
+        assert r["push_n_s"] == pytest.approx(1.0)
+        assert r["share_of_1_step"] == pytest.approx(1.0 / lim["1"])
+
+
 def test_the_5_deg_uphill_needs_the_balance_loop(quick: tuple[dict, Path]) -> None:
     """Open loop the walk falls on a 5 deg uphill (the issue's measurement); with the
     learned lean it walks on."""

@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+from robot.balance.heading_sign import SignCheck, look
 from robot.balance.rhythm import Rhythm
 from robot.balance.stepping import LEARN_CLIP, LEARNED, GaitPhase, StepState, phase_rate, step
 from robot.config.params import GaitParams
@@ -73,6 +74,7 @@ class BalanceState(NamedTuple):
     turn: float = 0.0
     stepping: StepState = StepState()
     started: bool = False
+    sign: SignCheck = SignCheck()
 
     @property
     def rhythm(self) -> Rhythm:
@@ -119,8 +121,11 @@ def commanded_yaw_rate(p: GaitParams, amplitude: float) -> float:
 
 
 def _heading(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float,
-             amplitude: float) -> tuple[float, float, float, float]:
-    """(heading, heading_ref, heading_i, turn trim) after one tick of the PI loop."""
+             gait: GaitPhase) -> tuple[float, float, float, float, SignCheck]:
+    """(heading, heading_ref, heading_i, turn trim, sign check) after one tick of the PI
+    loop; on legs steered by stride length (``gait.by_stride``) the trim's sign is checked
+    (robot.balance.heading_sign)."""
+    amplitude = gait.amplitude
     heading = (tilt.heading if tilt.heading is not None
                else wrap(state.heading + tilt.yaw_rate * dt))
     heading_ref = wrap(state.heading_ref + commanded_yaw_rate(p, amplitude) * dt)
@@ -133,7 +138,12 @@ def _heading(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float,
     want = _clip(p.bal_heading_p * error + p.bal_heading_i * heading_i, p.bal_turn_max)
     step_s = 0.5 * p.cycle_s if math.isfinite(p.cycle_s) else 0.0
     turn = want if step_s <= dt else state.turn + (want - state.turn) * dt / step_s
-    return heading, heading_ref, heading_i, turn
+    sign = state.sign
+    if gait.by_stride and amplitude >= 0.999:
+        sign, flipped = look(sign, error, want, p.cycle_s, dt)
+        if flipped:
+            heading_i, turn = 0.0, 0.0
+    return heading, heading_ref, heading_i, turn, sign
 
 
 def balance_step(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float,
@@ -153,7 +163,7 @@ def balance_step(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float,
     # torso leans back), relative to the feet's plane.
     lean_pitch = _clip(state.lean_pitch - p.bal_lean_i * e_pitch * dt, p.bal_lean_max)
     lean_roll = _clip(state.lean_roll - p.bal_lean_i * e_roll * dt, p.bal_lean_max)
-    heading, heading_ref, heading_i, turn = _heading(state, tilt, p, dt, a)
+    heading, heading_ref, heading_i, turn, sign = _heading(state, tilt, p, dt, gait)
     values = (tilt.roll, tilt.pitch, tilt.roll_rate, tilt.pitch_rate)
     stepping, capture = step(state.stepping, values, p, gait, dt, kin)
     feet, level = stepping.feet, stepping.level
@@ -162,9 +172,9 @@ def balance_step(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float,
         ankle_roll=p.bal_ankle_pd * tilt.roll_rate + p.bal_ankle_pp * e_roll,
         hip_pitch=p.bal_hip_pd * tilt.pitch_rate,
         hip_roll=p.bal_hip_pd * tilt.roll_rate,
-        turn=a * turn, pelvis_roll=lean_roll, pelvis_pitch=lean_pitch,
+        turn=a * sign.sign * turn, pelvis_roll=lean_roll, pelvis_pitch=lean_pitch,
         feet=(a * feet[0], a * feet[1], a * feet[2], a * feet[3]),
         tempo=phase_rate(stepping, a) - 1.0, land=stepping.brace, capture=capture,
         level=(a * level[0], a * level[1], a * level[2], a * level[3]))
     return BalanceState(lean_pitch, lean_roll, heading, heading_ref, heading_i, turn,
-                        stepping, True), corr
+                        stepping, True, sign), corr

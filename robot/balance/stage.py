@@ -129,6 +129,7 @@ class Balance:
         gap = g.hip_width + 2.0 * p.foot_spread - g.foot_width
         return GaitPhase(theta=theta, dtheta=dtheta if math.isfinite(dtheta) else 0.0,
                          amplitude=e.amplitude, stopping=not e.running,
+                         by_stride=not e.robot.has_hip_yaw and p.bal_stride_turn != 0.0,
                          swinging=(e.lift[0] > 0.0, e.lift[1] > 0.0),
                          height=p.stance * g.leg_length + g.ankle_height,
                          inward=max(0.0, 0.5 * (gap - FOOT_GAP_M)))

@@ -67,7 +67,8 @@ class GaitPhase(NamedTuple):
     advance this tick [rad]; amplitude: the start/stop envelope [0, 1]; swinging: (right,
     left) foot lifted; height: pendulum length, the hip's height over the soles [m];
     inward: how far a foot may move toward the other one [m]; stopping: the gait was told
-    to stop (its ramp-out)."""
+    to stop (its ramp-out); by_stride: the heading trim steers by step length (no hip
+    yaw, ``bal_stride_turn`` set)."""
 
     theta: float = 0.0
     dtheta: float = 0.0
@@ -76,6 +77,7 @@ class GaitPhase(NamedTuple):
     height: float = 0.23
     inward: float = 0.0
     stopping: bool = False
+    by_stride: bool = False
 
 
 class StepState(NamedTuple):

@@ -10,7 +10,7 @@ goal: within STOP_HEADING_DEG, never braced, on flat ground with no push.
 from __future__ import annotations
 
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -32,11 +32,15 @@ QUICK_PHASES = (0.0, 0.5)
 STOP_HEADING_DEG = 2.0
 
 
-def stop_walk(robot: str, phase: float, *, gait: str = "walk") -> dict[str, Any]:
-    """One walk of robot ``robot`` (name or path) stopped at STOP_AT_S + ``phase`` cycles:
-    its stop's heading change [deg], braced time after the stop [s], fall."""
+def stop_walk(robot: str, phase: float, *, gait: str = "walk",
+              changes: Mapping[str, float] | None = None) -> dict[str, Any]:
+    """One walk of robot ``robot`` (name or path) stopped at STOP_AT_S + ``phase`` cycles
+    (``changes``: gait parameters set on the preset): its stop's heading change [deg],
+    braced time after the stop [s], fall."""
     r = load_robot(robot)
     params = load_gait(gait).for_robot(r)
+    if changes:
+        params = params.replace(changes, where="stop study")
     seconds = float(f"{STOP_AT_S + phase * params.cycle_s:.3f}")
     bus = make_bus("sim", robot=r, realtime=False, view=False)
     spec = walk_spec(r, params, bus, gait=gait, imu=walk_imu(r, bus),

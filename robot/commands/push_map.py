@@ -145,7 +145,7 @@ def plot_map(cells: Sequence[Cell], out: str | Path, *, title: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 4, subplot_kw={"projection": "polar"}, figsize=(16, 4.6))
+    fig, axes = plt.subplots(1, 4, subplot_kw={"projection": "polar"}, figsize=(16, 5.2))
     colours = plt.get_cmap("viridis")
     top = max([c.limit_n_s.get(1, 0.0) for c in cells] + [c.survived_n_s for c in cells]
               + [0.5])
@@ -161,7 +161,7 @@ def plot_map(cells: Sequence[Cell], out: str | Path, *, title: str) -> None:
                 ang = [math.radians(c.direction_deg) for c in row]
                 ang, surv = ang + ang[:1], [c.survived_n_s for c in row]
                 ax.plot(ang, surv + surv[:1], style, color=colour, marker="o", ms=3,
-                        label=f"{ph:.3f} {'balance' if balance else 'open loop'}")
+                        label=f"phase {ph:.3f}" if balance else None)
                 if balance:
                     lim = [c.limit_n_s.get(1, 0.0) for c in row]
                     ax.plot(ang, lim + lim[:1], "--", color=colour, lw=0.8)
@@ -170,9 +170,9 @@ def plot_map(cells: Sequence[Cell], out: str | Path, *, title: str) -> None:
         ax.set_title(f"phase {q / 4:g}-{(q + 1) / 4:g} of the cycle", fontsize=9)
         ax.tick_params(labelsize=7)
         if group:
-            ax.legend(loc="lower left", bbox_to_anchor=(-0.15, -0.28), fontsize=6, ncol=2)
+            ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), fontsize=7, ncol=2)
     fig.suptitle(f"{title}: survived push [N*s] (solid: balance, dotted: open loop) and "
                  "the 1-step capture limit (dashed)", fontsize=10)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.03, right=0.97, top=0.84, bottom=0.2, wspace=0.35)
     fig.savefig(out, dpi=80)
     plt.close(fig)

@@ -5,11 +5,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
+from robot.balance.capture_limit import Numbers, numbers
 from robot.commands import push_map
 from robot.commands.common import (
     add_robot_args,
@@ -20,7 +23,9 @@ from robot.commands.common import (
     robot_from,
     seconds,
 )
+from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
+from robot.tuning.push_map import limits_of
 from robot.tuning.robustness import (
     STRAIGHT_DEG,
     STRAIGHT_DRIFT,
@@ -84,6 +89,8 @@ def run(args: argparse.Namespace) -> int:
                          balance_modes=modes, jobs=args.jobs, progress=progress)
     wall = time.perf_counter() - wall0
     table = survival_table(outcomes)
+    shares = push_shares(outcomes, numbers(load_robot(args.robot), params.stance,
+                                           params.foot_spread))
     if args.out:
         plot_survival(table, args.out, title=f"{args.robot}, gait {gait.name}, {secs:g} s runs")
     errors = [o for o in outcomes if o.fell is None]
@@ -97,13 +104,15 @@ def run(args: argparse.Namespace) -> int:
                       "balance": o.balance, "fell": o.fell, "fell_at_s": o.fell_at_s,
                       "distance_m": o.distance_m, "speed_m_s": o.speed_m_s,
                       "heading_deg": o.heading_deg, "walk_on": o.condition.walk_on,
-                      "stood": o.stood, "survived": o.survived, "error": o.error}
+                      "stood": o.stood, "survived": o.survived, "error": o.error,
+                      **shares.get(id(o), {})}
                      for o in outcomes],
             "walk_on_share": WALK_ON_SHARE,
             "straightness": {("balance" if b else "open_loop"): v
                              for b, v in straight.items()}}))
     else:
         print(format_table(table, modes))
+        print(format_pushes(outcomes, shares))
         falls = [o for o in outcomes if o.balance and o.fell]
         if falls:
             print("fell with balance: " + "; ".join(
@@ -123,6 +132,36 @@ def run(args: argparse.Namespace) -> int:
         if args.out:
             print(f"wrote {args.out}")
     return 1 if errors else 0
+
+
+def push_shares(outcomes: Sequence[Outcome], n: Numbers) -> dict[int, dict[str, Any]]:
+    """Per pushed run (by id): its impulse [N*s], the capture limits of its moment in its
+    direction (robot.balance.capture_limit) and the push as a share of the 1-step one."""
+    out: dict[int, dict[str, Any]] = {}
+    for o in outcomes:
+        applied = o.summary.get("world", {}).get("pushes_applied", [])
+        lim = limits_of(o, n)
+        if not applied or lim is None:
+            continue
+        j = math.hypot(float(applied[0]["jx"]), float(applied[0]["jy"]))
+        out[id(o)] = {"push_n_s": j, "limit_n_s": {str(k): v for k, v in lim.items()},
+                      "share_of_1_step": j / lim[1] if lim[1] > 0 else None}
+    return out
+
+
+def format_pushes(outcomes: Sequence[Outcome], shares: dict[int, dict[str, Any]]) -> str:
+    """Each pushed run: walked on, stood or fell, and the push against its 1-step limit."""
+    lines = [f"{'push':<36}{'mode':<10}{'outcome':<8}{'1-step limit':>13}{'share':>8}"]
+    for o in outcomes:
+        sh = shares.get(id(o))
+        if sh is None:
+            continue
+        state = "walks" if o.survived else "stood" if o.stood else "fell"
+        share = sh["share_of_1_step"]
+        lines.append(f"{o.condition.name:<36}{'balance' if o.balance else 'open':<10}"
+                     f"{state:<8}{sh['limit_n_s']['1']:>9.2f} N*s"
+                     f"{'' if share is None else f'{100 * share:7.0f}%'}")
+    return "\n".join(lines) if len(lines) > 1 else ""
 
 
 def format_table(table: Sequence[tuple[str, dict[bool, tuple[int, int]]]],

@@ -38,9 +38,10 @@ def test_a_run_a_servo_fault_stops_is_not_survived() -> None:
     cycle: the left knee's
     overload trips the servos' watchdog before the torso falls; the run stops there and
     the suite counts it as not survived (the servos went limp), not as a walk that went on."""
-    # With the capture step at the gain the robot file had for the old law.
+    # With the capture step at the gain the robot file had for the old law, and its brace
+    # as it was before issue 32 (2.3 cm): the case this test needs, a run the watchdog stops.
     params = load_gait("robust").for_robot(load_robot(ROBOT)).replace(
-        {"bal_step_gain": 0.238})
+        {"bal_step_gain": 0.238, "bal_brace_xi": 0.023})
     cond = next(c for c in push_grid(params.cycle_s, PUSH_NS)
                 if c.name == f"push {PUSH_NS:g} N*s left at phase 0.5")
     assert cond.world is not None

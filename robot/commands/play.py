@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -191,7 +192,8 @@ def run(args: argparse.Namespace) -> int:
                 writer.event(stop, stop=True)
             with play_show_control(shows, playing, joints=tuple(robot.joint_names),
                                    take=Path(args.file).name, show_time=lambda: engine.time,
-                                   rate_hz=rate):
+                                   rate_hz=rate, announce=lambda line: print(
+                                       f"biped play: {line}", file=sys.stderr, flush=True)):
                 playing.stream()
     finally:
         if soundtrack is not None:

@@ -86,10 +86,11 @@ class PlayTarget:
 
 @contextmanager
 def play_show_control(options: ShowOptions, run: Run[Any], *, joints: tuple[str, ...],
-                      take: str, show_time: Callable[[], float], rate_hz: float
-                      ) -> Iterator[None]:
+                      take: str, show_time: Callable[[], float], rate_hz: float,
+                      announce: Callable[[str], None]) -> Iterator[None]:
     """OSC in (and status out) for an open ``run`` while the block streams it; nothing
-    without ``--osc``. The port opens before the play moves (ConfigError, one line)."""
+    without ``--osc``. The port opens before the play moves (ConfigError, one line);
+    ``announce(line)`` tells where it listens."""
     osc = options.osc
     if osc is None:
         yield
@@ -106,7 +107,7 @@ def play_show_control(options: ShowOptions, run: Run[Any], *, joints: tuple[str,
         feed.start()
         if reply is not None:
             reply.start()
-        log.warning("OSC on %s:%d (stop, take stop, estop, cues)", osc.host, listener.port)
+        announce(f"OSC on {osc.host}:{listener.port} (stop, take stop, estop, cues)")
         yield
     finally:
         listener.close()

@@ -13,6 +13,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 import pytest
+from panel_wire import osc_datagram as osc
 from pythonosc.osc_bundle_builder import IMMEDIATELY, OscBundleBuilder
 from pythonosc.osc_message_builder import OscMessageBuilder
 from pythonosc.osc_packet import OscPacket
@@ -54,11 +55,6 @@ class Recorder:
         return [c[1] for c in list(self.calls) if c[0] == kind]
 
 
-def osc(address: str, *args: float | str) -> bytes:
-    b = OscMessageBuilder(address)
-    for a in args:
-        b.add_arg(a)
-    return b.build().dgram
 
 
 @pytest.fixture
@@ -222,7 +218,7 @@ def test_beyond_loopback_needs_an_allow_list() -> None:
     assert Sources().allows("::1") and not Sources().allows("192.168.1.20")
 
 
-def test_status_goes_out_as_osc() -> None:
+def test_status_goes_out_asosc() -> None:
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as rx:
         rx.bind(("127.0.0.1", 0))
         rx.settimeout(5)

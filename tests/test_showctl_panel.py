@@ -18,12 +18,11 @@ from pathlib import Path
 import mido
 import mido.sockets
 import pytest
-from bus_harness import PATIENT_TIMEOUT_MS, robot_for
-from panel_wire import REPO, Panel, assert_estop_held, is_goal, launched, torque_now
-from pythonosc.osc_message_builder import OscMessageBuilder
+from bus_harness import robot_for
+from panel_wire import REPO, Panel, assert_estop_held, is_goal, launched, patient_robot_file, torque_now
+from panel_wire import osc_datagram as osc
 from waiting import wait_for
 
-from robot.config.bundled import ROBOTS_DIR
 from robot.config.robot import RobotConfig
 from robot.showctl.midi_map import load_map
 from sim.emulator.chain import Emulator
@@ -60,11 +59,6 @@ def chain() -> Iterator[tuple[Emulator, RobotConfig]]:
         yield emu, robot
 
 
-def _toml(tmp: Path) -> Path:
-    text = (ROBOTS_DIR / "biped18-dynamixel.toml").read_text()
-    path = tmp / "robot.toml"
-    path.write_text(text.replace("timeout_ms = 20.0", f"timeout_ms = {PATIENT_TIMEOUT_MS}"))
-    return path
 
 
 def _free_port() -> int:
@@ -82,7 +76,7 @@ def test_midi_drives_the_panel_and_learn_writes_the_mapping(
     port = _free_port()
     server = mido.sockets.PortServer("127.0.0.1", port)
     try:
-        with launched(emu, _toml(tmp_path), tmp_path, "--midi", f"socket:127.0.0.1:{port}",
+        with launched(emu, patient_robot_file(tmp_path), tmp_path, "--midi", f"socket:127.0.0.1:{port}",
                       "--midi-map", str(mapping), "--cues", str(cues)) as panel:
             # The panel connects; mido's PortServer.poll() blocks (mido 1.3.3), accept does not.
             client: list[mido.ports.BaseIOPort] = []
@@ -167,11 +161,6 @@ r_shoulder_pitch = 0.0
 """
 
 
-def _osc(address: str, *args: float | str) -> bytes:
-    b = OscMessageBuilder(address)
-    for a in args:
-        b.add_arg(a)
-    return b.build().dgram
 
 
 def _play(emu: Emulator, tmp: Path, *extra: str
@@ -182,7 +171,7 @@ def _play(emu: Emulator, tmp: Path, *extra: str
     cues.write_text(CUES)
     proc = subprocess.Popen(
         [sys.executable, "-m", "robot.cli", "play", str(seq), "--bus", "dynamixel", "--port",
-         emu.port, "--robot", str(_toml(tmp)), "--seconds", "60", "--json", "--osc", "0",
+         emu.port, "--robot", str(patient_robot_file(tmp)), "--seconds", "60", "--json", "--osc", "0",
          "--cues", str(cues), *extra], cwd=REPO, stdout=subprocess.PIPE,
         stderr=subprocess.PIPE, text=True)
     assert proc.stderr is not None
@@ -216,10 +205,10 @@ def test_play_stops_on_a_cue_and_on_the_estop(chain: tuple[Emulator, RobotConfig
         assert wait_for(lambda: _moving(emu)), "".join(err)
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
             for _ in range(20):                   # what a play does not take: logged once
-                s.sendto(_osc("/biped/param/speed", 0.5), ("127.0.0.1", port))
-                s.sendto(_osc("/biped/cue", "faster"), ("127.0.0.1", port))
+                s.sendto(osc("/biped/param/speed", 0.5), ("127.0.0.1", port))
+                s.sendto(osc("/biped/cue", "faster"), ("127.0.0.1", port))
             sent = time.monotonic()
-            s.sendto(_osc("/biped/cue", 5) if how == "cue" else _osc("/biped/estop"),
+            s.sendto(osc("/biped/cue", 5) if how == "cue" else osc("/biped/estop"),
                      ("127.0.0.1", port))
         out, _ = proc.communicate(timeout=60)
         reader.join(10)
@@ -237,6 +226,7 @@ def test_play_stops_on_a_cue_and_on_the_estop(chain: tuple[Emulator, RobotConfig
         assert result["stop_reason"] == "show control: stop" and result["exit_code"] == 0
         goals = [p for p in log if p.t >= sent and is_goal(p, "dynamixel")]
         assert len(goals) >= 0.3 * 200 - 1, "a cue's stop ramps to rest (0.3 s at least)"
-    ignored = [e for e in err if "does nothing during biped play" in e or
-               "/biped/param/... is ignored" in e]
-    assert len(ignored) == 2, "".join(err)
+    if how == "cue":        # queued before the cue (an e-stop goes before everything)
+        ignored = [e for e in err if "does nothing during biped play" in e or
+                   "/biped/param/... is ignored" in e]
+        assert len(ignored) == 2, "".join(err)

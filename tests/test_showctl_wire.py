@@ -18,12 +18,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from bus_harness import PATIENT_TIMEOUT_MS, robot_for
-from panel_wire import TORQUE_ADDRESS, Panel, assert_estop_held, is_goal, launched, torque_now
-from pythonosc.osc_message_builder import OscMessageBuilder
+from bus_harness import robot_for
+from panel_wire import (
+    TORQUE_ADDRESS,
+    Panel,
+    assert_estop_held,
+    is_goal,
+    launched,
+    patient_robot_file,
+    torque_now,
+)
+from panel_wire import osc_datagram as osc
 from waiting import sleep_until, wait_for
 
-from robot.config.bundled import ROBOTS_DIR
 from robot.config.robot import RobotConfig
 from sim.emulator.chain import Emulator, Packet
 
@@ -36,11 +43,6 @@ FLOOD_HZ = 10_000
 LEG = ("hip", "knee", "ankle")                 # the legs follow the main phase only
 
 
-def osc(address: str, *args: float | str) -> bytes:
-    b = OscMessageBuilder(address)
-    for a in args:
-        b.add_arg(a)
-    return b.build().dgram
 
 
 @pytest.fixture(scope="module")
@@ -50,11 +52,6 @@ def chain() -> Iterator[tuple[Emulator, RobotConfig]]:
         yield emu, robot
 
 
-def _toml(tmp: Path) -> Path:
-    text = (ROBOTS_DIR / "biped18-dynamixel.toml").read_text()
-    path = tmp / "robot.toml"
-    path.write_text(text.replace("timeout_ms = 20.0", f"timeout_ms = {PATIENT_TIMEOUT_MS}"))
-    return path
 
 
 @pytest.fixture
@@ -62,7 +59,7 @@ def served(chain: tuple[Emulator, RobotConfig], tmp_path: Path
            ) -> Iterator[tuple[Panel, int]]:
     """The panel (not walking) and its OSC port."""
     emu, _ = chain
-    with launched(emu, _toml(tmp_path), tmp_path, "--osc", "0", "--set", f"fps={FPS!r}",
+    with launched(emu, patient_robot_file(tmp_path), tmp_path, "--osc", "0", "--set", f"fps={FPS!r}",
                   rate=RATE) as panel:
         assert panel.proc.stdout is not None
         line = panel.proc.stdout.readline()

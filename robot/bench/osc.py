@@ -129,26 +129,35 @@ def _param_latencies(log: list[Any], leg_ids: list[int], sends: list[float]) -> 
     return out
 
 
-def _trials(emu: Any, base: str, port: int, leg_ids: list[int], n_param: int,
-            n_estop: int) -> dict[str, list[float]]:
-    tx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+def _walk(base: str) -> int:
+    """Walking with the amplitude ramped in (start it if it is not): 1 if it was started."""
+    if panel_state(base)["state"] == "walking":
+        return 0
     panel_post(base, "/api/start")
     _wait_state(base, "walking")
     time.sleep(4.3 * CYCLE_TICKS / RATE_HZ)             # the amplitude's ramp in
-    emu.log(clear=True)
-    sends = []
+    return 1
+
+
+def _trials(emu: Any, base: str, port: int, leg_ids: list[int], n_param: int,
+            n_estop: int) -> dict[str, Any]:
+    """The latencies [ms]; ``starts``: walks started (after the first: the rate guard
+    stopped one, a loaded machine)."""
+    tx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    starts = _walk(base)
+    param: list[float] = []
     for k in range(n_param):
+        starts += _walk(base)
+        emu.log(clear=True)
         time.sleep(1.0 + 1.2 * CYCLE_TICKS / RATE_HZ)    # the follow settles, a cycle more
-        sends.append(time.monotonic())
+        ts = time.monotonic()
         tx.sendto(osc("/biped/param/torso_lean", LEAN if k % 2 == 0 else 0.0),
                   ("127.0.0.1", port))
-    time.sleep(0.2)
-    param = _param_latencies(emu.log(clear=True), leg_ids, sends)
+        time.sleep(0.3)
+        param += _param_latencies(emu.log(), leg_ids, [ts])
     estop = []
     for _ in range(n_estop):
-        if panel_state(base)["state"] != "walking":
-            panel_post(base, "/api/start")
-            _wait_state(base, "walking")
+        starts += _walk(base)
         time.sleep(0.5)
         emu.log(clear=True)
         ts = time.monotonic()
@@ -158,7 +167,8 @@ def _trials(emu: Any, base: str, port: int, leg_ids: list[int], n_param: int,
         if off:
             estop.append((min(off) - ts) * 1e3)
     tx.close()
-    return {"param": param, "estop": estop}
+    return {"param": param, "estop": estop, "starts": starts,
+            "missed": n_param - len(param)}
 
 
 def measure_osc(*, n_param: int = 30, n_estop: int = 10) -> dict[str, Any]:
@@ -185,6 +195,8 @@ def measure_osc(*, n_param: int = 30, n_estop: int = 10) -> dict[str, Any]:
     out["estop_flood"] = _stats(flood["estop"])
     out["flood"] = {"sent": flooder.sent, "received": showctl["osc"]["datagrams"],
                     "param_updates": showctl["feed"]["param_updates"]}
+    out["walks_started"] = {"quiet": quiet["starts"], "flood": flood["starts"]}
+    out["changes_not_seen"] = {"quiet": quiet["missed"], "flood": flood["missed"]}
     return out
 
 

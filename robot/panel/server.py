@@ -17,6 +17,8 @@ Endpoints (JSON in and out; errors are ``{"error": "..."}``, never an empty repl
   POST /api/record {"name"?} | /api/play {"name"}   record a take (ends with stop), replay
   POST /api/pose/release {"limb"} | /api/pose/capture | /api/pose/clear | /api/pose/save
        {"name"} | /api/sequence/play {"name", "layer": bool}: posing by hand (panel.studio)
+  GET  /api/showctl | POST /api/midi/learn {"param"}   show control, with --osc or --midi
+                     (robot.panel.show_control)
 
 The endpoints are a table (``robot.panel.routes``); this module is the HTTP plumbing
 around it: the server (its connection caps and deadlines, robot.panel.admission) and one

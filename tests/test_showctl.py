@@ -130,12 +130,14 @@ def test_commands_keep_their_order_with_the_changes_before_them(
         fed: tuple[Recorder, Feed]) -> None:
     target, feed = fed
     for a in (SetParam("speed", 0.3), Command("start"), Command("start"),
-              SetParam("speed", 0.4), Named("preset", "jog"), SetParam("turn", 0.1)):
+              SetParam("speed", 0.4), Named("preset", "jog"), Command("go"), Command("go"),
+              SetParam("turn", 0.1)):
         feed.put(a, time.monotonic())
-    assert wait_for(lambda: len(target.calls) == 5)
+    assert wait_for(lambda: len(target.calls) == 7)
     assert [(c[0], c[1]) for c in target.calls] == [
         ("params", {"speed": 0.3}), ("act", Command("start")),   # the repeat: one start
         ("params", {"speed": 0.4}), ("act", Named("preset", "jog")),
+        ("act", Command("go")), ("act", Command("go")),          # each GO: the next cue
         ("params", {"turn": 0.1})]
 
 

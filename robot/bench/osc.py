@@ -141,13 +141,14 @@ def _walk(base: str) -> int:
 
 def _trials(emu: Any, base: str, port: int, leg_ids: list[int], n_param: int,
             n_estop: int) -> dict[str, Any]:
-    """The latencies [ms]; ``starts``: walks started (after the first: the rate guard
-    stopped one, a loaded machine)."""
+    """The latencies [ms]; ``restarts``: walks started again during the parameter trials
+    (the rate guard stopped one: a loaded machine)."""
     tx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    starts = _walk(base)
+    _walk(base)
     param: list[float] = []
+    restarts = 0
     for k in range(n_param):
-        starts += _walk(base)
+        restarts += _walk(base)
         emu.log(clear=True)
         time.sleep(1.0 + 1.2 * CYCLE_TICKS / RATE_HZ)    # the follow settles, a cycle more
         ts = time.monotonic()
@@ -157,7 +158,7 @@ def _trials(emu: Any, base: str, port: int, leg_ids: list[int], n_param: int,
         param += _param_latencies(emu.log(), leg_ids, [ts])
     estop = []
     for _ in range(n_estop):
-        starts += _walk(base)
+        _walk(base)
         time.sleep(0.5)
         emu.log(clear=True)
         ts = time.monotonic()
@@ -167,7 +168,7 @@ def _trials(emu: Any, base: str, port: int, leg_ids: list[int], n_param: int,
         if off:
             estop.append((min(off) - ts) * 1e3)
     tx.close()
-    return {"param": param, "estop": estop, "starts": starts,
+    return {"param": param, "estop": estop, "restarts": restarts,
             "missed": n_param - len(param)}
 
 
@@ -195,7 +196,7 @@ def measure_osc(*, n_param: int = 30, n_estop: int = 10) -> dict[str, Any]:
     out["estop_flood"] = _stats(flood["estop"])
     out["flood"] = {"sent": flooder.sent, "received": showctl["osc"]["datagrams"],
                     "param_updates": showctl["feed"]["param_updates"]}
-    out["walks_started"] = {"quiet": quiet["starts"], "flood": flood["starts"]}
+    out["walk_restarts"] = {"quiet": quiet["restarts"], "flood": flood["restarts"]}
     out["changes_not_seen"] = {"quiet": quiet["missed"], "flood": flood["missed"]}
     return out
 

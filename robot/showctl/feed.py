@@ -3,7 +3,8 @@
 Any number of senders (OSC, MIDI) ``put`` actions as they arrive; a flood never reaches
 the control loop as a flood. Parameter changes are merged (the last value of each wins)
 and handed to the target at most once per control tick; other commands wait in a short
-queue (a repeat of the one before it is the same command) and go one per tick, in the
+queue (a repeat of the one before it is the same command, except GO: each fires the next
+cue) and go one per tick, in the
 order they came, after the parameter changes that came before them. The e-stop never
 waits in that queue: ``estop`` wakes a thread of its own, which asks the target at once
 (an e-stop asked while one is being handled is the same e-stop).
@@ -28,6 +29,7 @@ from robot.showctl.once import OnceLog
 
 log = logging.getLogger(__name__)
 
+GO = Command("go")   # each GO fires the next cue: never merged with the one before
 #: Commands waiting at most (a flood of commands beyond it is dropped and counted).
 QUEUE = 64
 
@@ -113,7 +115,8 @@ class Feed:
             if isinstance(action, SetParam):
                 self._params[action.name] = action.value
                 self._params_at = received
-            elif self._queue and self._queue[-1][0] == action and not self._params:
+            elif (self._queue and self._queue[-1][0] == action and not self._params
+                  and action != GO):
                 pass                               # the same command again: one command
             elif len(self._queue) >= QUEUE:
                 self.stats.dropped += 1

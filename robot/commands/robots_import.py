@@ -13,9 +13,9 @@ import argparse
 import tomllib
 from pathlib import Path
 
-from robot.body.importer import build, check_servo, summary
 from robot.body.mjcf_read import read_mjcf
-from robot.body.write import robot_file_text
+from robot.config.model_import import build, check_servo, summary
+from robot.config.model_text import robot_file_text
 from robot.config.robot_file import parse_robot
 from robot.config.toml_io import read_toml
 from robot.errors import ConfigError
@@ -71,7 +71,7 @@ def read_model(path: Path, *, mesh_dir: str | None, missing: str) -> tuple[objec
 def read_map(path: str | None) -> dict[str, dict[str, object]]:
     if path is None:
         return {}
-    from robot.body.importer import MAP_KEYS
+    from robot.config.model_import import MAP_KEYS
 
     data = read_toml(Path(path))
     joints = data.get("joints", {})

@@ -9,7 +9,6 @@ from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
 
-from robot.body.toml_body import parse_model
 from robot.config.bundled import DEFAULT_ROBOT, resolve_robot_path
 from robot.config.checks import (
     check_bus,
@@ -22,6 +21,7 @@ from robot.config.checks import (
 from robot.config.gains_file import check_fits, parse_gains, split_gains
 from robot.config.imu_file import parse_imu
 from robot.config.joint_names import ARM_NAMES, HIP_YAW_NAMES, JOINT_NAMES
+from robot.config.model_file import parse_model
 from robot.config.params import BALANCE, SPECS, canonical_name, check_value
 from robot.config.robot import ANGLE, BusConfig, Geometry, JointConfig, Masses, RobotConfig
 from robot.config.servo_file import servo_files

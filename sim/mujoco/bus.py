@@ -31,8 +31,7 @@ from robot.bus.servo_map import ServoMap
 from robot.config.robot import RobotConfig
 from robot.config.world import World
 from robot.errors import BusError
-from sim.mujoco.geoms import foot_geoms
-from sim.mujoco.mjcf import build_mjcf, standing_qpos
+from sim.mujoco.mjcf import build_mjcf, foot_geoms, standing_qpos
 from sim.mujoco.observation import BodyObservation
 from sim.mujoco.run_watch import SimRunWatch
 from sim.mujoco.servo_law import ChainLaw, robot_servos

@@ -1,5 +1,5 @@
-"""An import (robot/body/importer.py) as robot file text: the usual tables (bus, IMU,
-geometry, joints, rest) and the model's body (``[model]``, robot/body/toml_body.py).
+"""An import (robot/config/model_import.py) as robot file text: the usual tables (bus, IMU,
+geometry, joints, rest) and the model's body (``[model]``, robot/config/model_file.py).
 
 The geometry is measured from the model and only scales the gait; the simulation, the
 IK and ``biped mjcf`` use the model's own body.
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import math
 
-from robot.body.importer import Imported
-from robot.body.toml_body import _q, model_toml, num
+from robot.config.model_file import _q, model_toml, num
+from robot.config.model_import import Imported
 from robot.servo.models import ServoModel
 
 GEOMETRY_ORDER = ("hip_width", "thigh", "shin", "ankle_height", "foot_length", "foot_width",

@@ -87,7 +87,8 @@ class _Pose:
     """The model at the offsets found so far, seen in the robot frame."""
 
     def __init__(self, tree: BodyTree, axes: Array) -> None:
-        self.tree, self.axes, self.angles = tree, axes, {}
+        self.tree, self.axes = tree, axes
+        self.angles: dict[str, float] = {}
         self.update()
 
     def update(self) -> None:

@@ -94,12 +94,14 @@ def _sole_frames(tree: BodyTree, roles: Roles, m: Measured) -> BodyTree:
                            link.shapes, (*link.frames, Frame(f"{side}_sole", tuple(map(float, local)),  # type: ignore[arg-type]
                                                                quat)))
     torso = sorted(torso_links(tree))
-    mass = sum(tree.links[i].inertial.mass for i in torso if tree.links[i].inertial)  # type: ignore[union-attr]
-    com = sum(tree.links[i].inertial.mass * (pos[i] + rot[i] @ np.asarray(tree.links[i].inertial.com))  # type: ignore[union-attr]
-              for i in torso if tree.links[i].inertial) / max(mass, 1e-12)
+    weighed = [(link.inertial.mass, pos[i] + rot[i] @ np.asarray(link.inertial.com))
+               for i in torso if (link := tree.links[i]).inertial is not None]
+    mass = sum(w for w, _ in weighed)
+    com = sum((w * c for w, c in weighed), np.zeros(3)) / max(mass, 1e-12)
     root = links[0]
     links[0] = Link(root.name, -1, root.pos, root.quat, root.inertial, None, root.shapes,
-                    (*root.frames, Frame("imu", tuple(map(float, com)), matrix_to_quat(axes.T))))  # type: ignore[arg-type]
+                    (*root.frames, Frame("imu", (float(com[0]), float(com[1]), float(com[2])),
+                                         matrix_to_quat(axes.T))))
     del by
     return BodyTree(tuple(links), source=tree.source, excludes=tree.excludes)
 

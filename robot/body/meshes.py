@@ -189,7 +189,9 @@ def _walk(anchor: Path, parts: list[str]) -> tuple[Path | None, bool]:
 def mesh_candidates(ref: str, *, base_dir: Path, mesh_dir: Path | None) -> list[Path]:
     """Where a URDF's mesh ``ref`` may be, in order: ``package://PKG/rest`` under
     ``mesh_dir`` as DIR/PKG/rest, DIR/rest, DIR/<file name>, then in a folder named PKG above
-    the URDF, beside it and under it; ``file://`` and plain paths relative to the URDF."""
+    the URDF, PKG/rest beside the URDF (onshape-to-robot's package://assets/...), rest in
+    the URDF's parent folder (a ROS package's urdf/ and meshes/), beside it, and the file
+    name beside it; ``file://`` and plain paths relative to the URDF, then under DIR."""
     name = ref.replace("\\", "/")
     if name.startswith("package://"):
         pkg, _, rest = name.removeprefix("package://").partition("/")
@@ -197,7 +199,8 @@ def mesh_candidates(ref: str, *, base_dir: Path, mesh_dir: Path | None) -> list[
         if mesh_dir is not None:
             out += [mesh_dir / pkg / rest, mesh_dir / rest, mesh_dir / Path(rest).name]
         out += [up / rest for up in (base_dir, *base_dir.parents) if up.name == pkg]
-        out += [base_dir.parent / rest, base_dir / rest, base_dir / Path(rest).name]
+        out += [base_dir / pkg / rest, base_dir.parent / rest, base_dir / rest,
+                base_dir / Path(rest).name]
         return out
     name = name.removeprefix("file://")
     out = [base_dir / name]

@@ -54,6 +54,7 @@ class _Builder:
         self.bodies: list[_Body] = []
         self.hulls: dict[tuple[Path, tuple[float, float, float]], meshes.Hull] = {}
         self.boxed: set[str] = set()
+        self.folded: set[Path] = set()
 
     def fail(self, what: str) -> ConfigError:
         return ConfigError(f"{self.path}: {what}")
@@ -74,7 +75,7 @@ class _Builder:
             children[j.child] = j.name
         roots = [n for n in self.raw.links if n not in children]
         if len(roots) != 1:
-            what = ", ".join(repr(r) for r in roots) if roots else "none (every link has a parent)"
+            what = ", ".join(repr(r) for r in roots) if roots else "none (every link has a parent: a loop)"
             raise self.fail(f"a URDF needs exactly one root link, found {what}")
         return roots[0]
 
@@ -151,11 +152,15 @@ class _Builder:
         where = f"link {link.name!r}: collision mesh {col.filename!r}"
         if found is None:
             return self.stand_in(link, where, tried, pos, rot)
-        if folded:
+        if folded and found not in self.folded:
+            self.folded.add(found)
             self.warnings.append(f"{where}: taken as {found} (its name differs in case)")
         key = (found, col.scale)
         if key not in self.hulls:
-            self.hulls[key] = meshes.hull(found, scale=col.scale, max_vertices=self.max_vertices)
+            try:
+                self.hulls[key] = meshes.hull(found, scale=col.scale, max_vertices=self.max_vertices)
+            except ConfigError as err:
+                raise self.fail(f"{where}: {err}") from err
         hull = self.hulls[key]
         return Shape(kind="hull", pos=_vec(spos), quat=matrix_to_quat(srot),
                      vertices=hull.vertices, name=name, note=hull.note(found.name))

@@ -85,8 +85,8 @@ class _Checker:
         return True
 
     def from_shapes(self, i: int, found: str) -> None:
-        self.refuse_or_fix(i, found, need="; give it a mass and inertia, or fix them with "
-                           "the importer's fix option (from its collision shapes)")
+        self.refuse_or_fix(i, found, need="; give it a mass and inertia, or import with "
+                           "--fix-inertia (made from its collision shapes)")
         new = shapes_inertial(self.tree.links[i])
         if new is None or not new.mass > 0:
             raise ConfigError(f"{self.where(i)}: {found}, and it has no collision shape to "
@@ -124,7 +124,7 @@ class _Checker:
             return
         if not all(math.isfinite(v) for v in inert.inertia):
             found = f"inertia {_fmt(inert.inertia)} kg m^2 is not finite"
-            self.refuse_or_fix(i, found)
+            self.refuse_or_fix(i, found, need="; --fix-inertia puts a sphere's")
             self.replace_moments(i, inert, np.full(3, math.nan), np.eye(3), found)
             return
         moments, axes = inertia.principal(inert)
@@ -136,7 +136,7 @@ class _Checker:
                      f"({a:.4g} + {b:.4g} < {c:.4g}: no rigid body has them)")
         else:
             return
-        self.refuse_or_fix(i, found)
+        self.refuse_or_fix(i, found, need="; --fix-inertia sets the moments to their mean")
         self.replace_moments(i, inert, moments, axes, found)
 
     def replace_moments(self, i: int, inert: Inertial, moments: np.ndarray, axes: np.ndarray,
@@ -164,7 +164,7 @@ class _Checker:
         found = (f"mass {inert.mass:.4g} kg with inertia {_fmt(inert.inertia)} kg m^2: its "
                  f"equivalent-inertia box has a density of {rho:.3g} kg/m^3, outside the "
                  f"plausible {low:g}-{high:g} (an inertia or mass in the wrong unit?)")
-        self.refuse_or_fix(i, found)
+        self.refuse_or_fix(i, found, need="; --fix-inertia scales the inertia into the range")
         if not math.isfinite(rho):
             raise ConfigError(f"{self.where(i)}: {found}; a flat box cannot be scaled")
         scale = (rho / target) ** (2.0 / 3.0)

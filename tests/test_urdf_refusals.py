@@ -78,7 +78,7 @@ def test_a_missing_collision_mesh_is_refused_or_boxed(tmp_path: Path) -> None:
         '<collision><geometry><mesh filename="package://pkg/meshes/leg.stl"/></geometry></collision>')
     path = _urdf(tmp_path, ROOT + _leg(link=leg))
     _refused(path, "link 'leg'", "collision mesh 'package://pkg/meshes/leg.stl' not found",
-             "--mesh-dir", "--missing-mesh box")
+             "--mesh-dir", "--missing-meshes box")
     tree, warnings = read_urdf(path, missing_mesh="box")
     assert len(warnings) == 1 and "link 'leg'" in warnings[0] and "equivalent-inertia box" in warnings[0]
     (box,) = tree.links[1].shapes

@@ -1,7 +1,7 @@
 """Rigid-body inertia arithmetic on ``Inertial`` (robot/body/tree.py): principal moments and
 axes, an inertial seen from another frame, two inertials combined (the parallel axis
-theorem), and the equivalent-inertia box (MuJoCo's own stand-in for a body: the solid box
-with the body's mass and principal moments, at its centre of mass, in its principal axes).
+theorem), the sides and density of the equivalent-inertia box (the box itself as a shape:
+robot.body.tree.equivalent_box), a solid sphere's inertial.
 
 Units: kg, m, kg m^2; the density of the equivalent box in kg/m^3.
 """
@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from robot.body.tree import ORIGIN, Array, Inertial, Shape, matrix_to_quat
+from robot.body.tree import ORIGIN, Array, Inertial
 
 ZERO_INERTIA = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
@@ -78,17 +78,6 @@ def box_density(inertial: Inertial) -> float:
     sides, _ = box_sides(inertial)
     volume = float(np.prod(sides))
     return inertial.mass / volume if volume > 0.0 else math.inf
-
-
-def equivalent_box(inertial: Inertial, *, name: str = "", note: str = "") -> Shape:
-    """The equivalent-inertia box of ``inertial`` (mass > 0) as a collision shape in the
-    inertial's frame: half sizes [m], at the centre of mass, in the principal axes."""
-    if not inertial.mass > 0.0:
-        raise ValueError(f"an equivalent-inertia box needs a mass > 0 kg, not {inertial.mass}")
-    sides, axes = box_sides(inertial)
-    half = tuple(float(s) / 2.0 for s in sides)
-    return Shape(kind="box", pos=inertial.com, quat=matrix_to_quat(axes), size=half,
-                 name=name, note=note)
 
 
 def sphere_inertial(mass: float, com: tuple[float, float, float] = ORIGIN, *,

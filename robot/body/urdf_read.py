@@ -20,7 +20,17 @@ import numpy as np
 
 from robot.body import inertia, meshes
 from robot.body.checks import check_tree
-from robot.body.tree import Array, BodyTree, Frame, Hinge, Inertial, Link, Shape, matrix_to_quat
+from robot.body.tree import (
+    Array,
+    BodyTree,
+    Frame,
+    Hinge,
+    Inertial,
+    Link,
+    Shape,
+    equivalent_box,
+    matrix_to_quat,
+)
 from robot.body.urdf_xml import TAKEN_TYPES, Collision, RawJoint, RawLink, RawUrdf, read_raw
 from robot.errors import ConfigError
 
@@ -170,7 +180,7 @@ class _Builder:
         looked = ", ".join(str(p) for p in tried[:4]) + (" ..." if len(tried) > 4 else "")
         if self.missing_mesh != "box":
             raise self.fail(f"{where} not found (looked at {looked}); give the folder that holds "
-                            "it (--mesh-dir), or --missing-mesh box for the link's "
+                            "it (--mesh-dir), or --missing-meshes box for the link's "
                             "equivalent-inertia box")
         if link.name in self.boxed:
             return None
@@ -178,7 +188,7 @@ class _Builder:
         if link.inertial is None or not link.inertial.mass > 0:
             raise self.fail(f"{where} not found, and the link has no mass to size an "
                             "equivalent-inertia box for it")
-        box = inertia.equivalent_box(inertia.transformed(link.inertial, pos, rot),
+        box = equivalent_box(inertia.transformed(link.inertial, pos, rot),
                                      name=f"{link.name}_inertia_box",
                                      note=f"stand-in: {where} not found; the link's "
                                           "equivalent-inertia box")

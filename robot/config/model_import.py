@@ -32,8 +32,12 @@ from robot.servo.models import MODELS, ServoModel
 
 #: The rest pose of a straight-legged robot [rad]: knees bent as the bundled robots rest.
 REST = {"hip_pitch": -0.55, "knee": 1.1, "ankle_pitch": -0.55}
-MAP_KEYS = {"name", "servo_id", "min_rad", "max_rad", "max_speed_rad_s", "limits_source",
-            "fixed_rad"}
+#: What ``--map`` may say of a model joint: its name (an extra joint's), its servo's id,
+#: limits in the project's convention (min_rad, max_rad) or the model's (model_range,
+#: [rad]: where a vendor documents them so) and where they come from, a slew limit, the
+#: angle an extra joint is held at.
+MAP_KEYS = {"name", "servo_id", "min_rad", "max_rad", "model_range", "max_speed_rad_s",
+            "limits_source", "fixed_rad"}
 
 
 @dataclass(frozen=True)
@@ -126,6 +130,7 @@ def build(tree: BodyTree, *, servo: ServoModel, joint_map: dict[str, dict[str, o
                       tuple(map(float, m.origin @ roles.axes)), m.legs, file, source, licence)  # type: ignore[arg-type]
     ordered = sorted(roles.joints, key=lambda j: _order(j.name))
     ids_used: set[int] = set()
+    unlimited: list[str] = []
     joints = []
     for k, role in enumerate(ordered):
         entry = joint_map.get(role.model_joint, {})
@@ -141,10 +146,20 @@ def build(tree: BodyTree, *, servo: ServoModel, joint_map: dict[str, dict[str, o
         assert hinge is not None
         per_rad = servo.ticks_per_rad
         centre = servo.resolution // 2
-        if hinge.range is not None:
-            ends = sorted(((hinge.range[0] - role.offset) * role.sign,
-                           (hinge.range[1] - role.offset) * role.sign))
-            lo, hi, src = ends[0], ends[1], "the model's range"
+        model_range = hinge.range
+        src = "the model's range"
+        if model_range is None and "model_range" in entry:
+            raw = entry["model_range"]
+            if not (isinstance(raw, list) and len(raw) == 2 and all(
+                    isinstance(v, int | float) and math.isfinite(v) for v in raw) and raw[0] < raw[1]):
+                raise ConfigError(f"--map: joints.{role.model_joint}.model_range: expected [lo, hi] "
+                                  f"[rad] with lo < hi, got {raw!r}")
+            model_range = (float(raw[0]), float(raw[1]))
+            src = str(entry.get("limits_source", "--map"))
+        if model_range is not None:
+            ends = sorted(((model_range[0] - role.offset) * role.sign,
+                           (model_range[1] - role.offset) * role.sign))
+            lo, hi = ends[0], ends[1]
         elif "min_rad" in entry and "max_rad" in entry:
             lo, hi = float(entry["min_rad"]), float(entry["max_rad"])  # type: ignore[arg-type]
             src = str(entry.get("limits_source", "--map"))
@@ -153,9 +168,7 @@ def build(tree: BodyTree, *, servo: ServoModel, joint_map: dict[str, dict[str, o
             lo, hi = -half - role.offset * role.sign, half - role.offset * role.sign
             lo, hi = sorted((lo, hi))
             src = f"the {servo.name}'s whole range (the model gives none)"
-            warnings.append(f"{role.model_joint} ({name}): no joint limits in the model: "
-                            f"the servo's whole range [{lo:.3f}, {hi:.3f}] rad; give real "
-                            "limits with --map (min_rad, max_rad)")
+            unlimited.append(role.model_joint)
         lo, hi = max(lo, -math.pi), min(hi, math.pi)
         speed = servo.no_load_speed if hinge.velocity is None else min(hinge.velocity, servo.no_load_speed)
         speed = min(speed, float(entry.get("max_speed_rad_s", speed)))  # type: ignore[arg-type]
@@ -165,6 +178,10 @@ def build(tree: BodyTree, *, servo: ServoModel, joint_map: dict[str, dict[str, o
             fixed = min(max(float(entry.get("fixed_rad", 0.0)), lo), hi)  # type: ignore[arg-type]
         joints.append(JointEntry(name, role.model_joint, role.sign, role.offset, servo_id,
                                  role.sign, zero, lo, hi, round(min(speed, 20.0), 3), src, fixed))
+    if unlimited:
+        warnings.append(f"no joint limits in the model for {', '.join(unlimited)}: each gets "
+                        f"the {servo.name}'s whole range; give real limits with --map "
+                        "(min_rad, max_rad, limits_source)")
     return Imported(model, joints, m, roles, warnings)
 
 
@@ -205,3 +222,60 @@ def _yaw_off(leg: object) -> float:
     if leg.yaw_axis is None:
         return 0.0
     return math.hypot(leg.yaw_axis[0] - leg.hip[0], leg.yaw_axis[1] - leg.hip[1])
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """An import's ``--map`` file: per model joint what MAP_KEYS allow; the bus (kind,
+    model, baud), the gain registers and balance gains the robot file gets; where the
+    model comes from, its licence, and notes for the file's opening comment."""
+
+    joints: dict[str, dict[str, object]] = field(default_factory=dict)
+    bus: dict[str, object] = field(default_factory=dict)
+    gains: dict[str, int] = field(default_factory=dict)
+    balance: dict[str, float] = field(default_factory=dict)
+    source: str = ""
+    licence: str = ""
+    notes: tuple[str, ...] = ()
+
+
+RECIPE_KEYS = ("joints", "bus", "balance", "source", "licence", "notes")
+
+
+def read_map(path: str | None) -> Recipe:
+    """The ``--map`` file at ``path`` (None: an empty one); one-line ConfigError."""
+    if path is None:
+        return Recipe()
+    from robot.config.toml_io import read_toml
+
+    data = read_toml(Path(path))
+    where = f"--map {path}"
+    bad = sorted(set(data) - set(RECIPE_KEYS))
+    if bad:
+        raise ConfigError(f"{where}: {bad[0]}: unknown key; valid: {', '.join(RECIPE_KEYS)}")
+    joints = data.get("joints", {})
+    if not isinstance(joints, dict):
+        raise ConfigError(f"{where}: joints: expected [joints.MODEL_JOINT] tables")
+    out: dict[str, dict[str, object]] = {}
+    for name, tab in joints.items():
+        if not isinstance(tab, dict):
+            raise ConfigError(f"{where}: joints.{name}: expected a table")
+        unknown = sorted(set(tab) - MAP_KEYS)
+        if unknown:
+            raise ConfigError(f"{where}: joints.{name}.{unknown[0]}: unknown key; valid: "
+                              f"{', '.join(sorted(MAP_KEYS))}")
+        out[name] = dict(tab)
+    bus = data.get("bus", {})
+    balance = data.get("balance", {})
+    notes = data.get("notes", [])
+    if not isinstance(bus, dict) or not isinstance(balance, dict) or not isinstance(notes, list):
+        raise ConfigError(f"{where}: bus and balance must be tables, notes a list of strings")
+    gains = bus.pop("gains", {}) if isinstance(bus.get("gains", {}), dict) else None
+    if gains is None:
+        raise ConfigError(f"{where}: bus.gains: expected a table of register values")
+    unknown = sorted(set(bus) - {"kind", "model", "baud"})
+    if unknown:
+        raise ConfigError(f"{where}: bus.{unknown[0]}: unknown key; valid: kind, model, baud, gains")
+    return Recipe(out, dict(bus), dict(gains), dict(balance),  # type: ignore[arg-type]
+                  str(data.get("source", "")), str(data.get("licence", "")),
+                  tuple(str(n) for n in notes))

@@ -157,7 +157,8 @@ def _read(f: BinaryIO, p: Path, size: int, *, progress: bool) -> Rig:
     seconds = n * frame_s
     if seconds > MAX_SECONDS or n * len(names) > MAX_BONE_FRAMES:
         raise ConfigError(
-            f"{p}: {n} frames of {len(names)} joints at {1 / frame_s:g} fps ({seconds:.0f} s): "
+            f"{p}: {n} frames of {len(names)} joints at {1 / nominal_frame_s(frame_s):g} fps "
+            f"({seconds:.0f} s): "
             f"more than can be imported at once (at most {MAX_SECONDS:.0f} s and "
             f"{MAX_BONE_FRAMES:,} joint-frames); cut the animation into parts")
     width = sum(len(c) for c in channels)

@@ -17,15 +17,10 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from anim_files import KNEE_HIERARCHY
 
 REPO = Path(__file__).resolve().parent.parent
-HEAD = ["HIERARCHY", "ROOT pelvis", "{", "OFFSET 0 0 0",
-        "CHANNELS 6 Xposition Yposition Zposition Yrotation Zrotation Xrotation",
-        "JOINT r_hip", "{", "OFFSET -5 0 0", "CHANNELS 3 Yrotation Zrotation Xrotation",
-        "JOINT r_knee", "{", "OFFSET 0 -10 0", "CHANNELS 3 Zrotation Yrotation Xrotation",
-        "End Site", "{", "OFFSET 0 -10 0", "}", "}", "}",
-        "JOINT l_hip", "{", "OFFSET 5 0 0", "CHANNELS 3 Yrotation Zrotation Xrotation",
-        "End Site", "{", "OFFSET 0 -20 0", "}", "}", "}", "MOTION"]
+HEAD = KNEE_HIERARCHY
 FPS = 120.0
 FRAMES = 30_000          # 250 s: a 60,000-tick take at 240 Hz
 PAD = 96                 # zeros after each number's one decimal: 100 characters a number

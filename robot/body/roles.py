@@ -23,6 +23,7 @@ against; its angle in the model's terms is ``sign * angle + offset``.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from collections.abc import Mapping
@@ -31,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robot.body.limbs import SNAP_TOL, Limb, find_limbs, link_points, robot_axes, side_of
-from robot.body.tree import Array, BodyTree
+from robot.body.tree import Array, BodyTree, Shape, quat_to_matrix
 from robot.errors import ConfigError
 
 X, Y, Z = np.eye(3)
@@ -132,21 +133,50 @@ def _angle_to(v: Array, about: Array, target: Array) -> float:
 
 
 def sole_normal(pose: _Pose, foot_links: list[int]) -> Array:
-    """The downward normal of the lowest face of the foot's shapes (robot frame)."""
-    pts = pose.points(foot_links)
-    down = -Z
-    for _ in range(4):
-        h = pts @ down
-        low = pts[h >= h.max() - SOLE_BAND]
-        if len(low) < 3:
-            return down
-        centred = low - low.mean(axis=0)
-        normal = np.linalg.svd(centred)[2][-1]
-        normal = normal if normal @ down > 0 else -normal
-        if np.linalg.norm(np.cross(normal, down)) < 1e-12:
-            break
-        down = normal
-    return down
+    """The downward normal of the lowest face of the foot's shapes (robot frame): a box's
+    face (the face of the lowest box that faces down most), else the plane through a
+    hull's lowest points (refit until it settles: a tilted sole's lowest band widens)."""
+    tree = pose.tree
+    boxes = [(i, s) for i in foot_links for s in tree.links[i].shapes if s.kind == "box"]
+    if boxes:
+        def lowest(item: tuple[int, Shape]) -> float:
+            return float(link_points_one(pose, item[0], item[1])[:, 2].min())
+        i, box = min(boxes, key=lowest)
+        rot = pose.axes @ pose.rot[i] @ quat_to_matrix(box.quat)
+        normals = np.concatenate([rot.T, -rot.T])
+        return normals[int(np.argmax(normals @ -Z))]
+    return hull_sole(pose.points(foot_links))
+
+
+def hull_sole(pts: Array, *, lowest: int = 40) -> Array:
+    """The downward normal of the convex hull face that faces down within 60 deg and has
+    the most of the points on it (a flat sole), found among the planes through three of
+    the ``lowest`` points that every point lies above."""
+    low = pts[np.argsort(pts[:, 2])[:lowest]]
+    n = len(low)
+    i, j, k = np.array([(a, b, c) for a in range(n) for b in range(a + 1, n)
+                        for c in range(b + 1, n)]).T
+    normal = np.cross(low[j] - low[i], low[k] - low[i])
+    size = np.linalg.norm(normal, axis=1)
+    ok = size > 1e-9
+    normal = normal[ok] / size[ok, None]
+    normal *= np.where(normal[:, 2] < 0, 1.0, -1.0)[:, None]   # pointing down
+    base = low[i[ok]]
+    height = np.einsum("pnk,pk->pn", pts[None, :, :] - base[:, None, :], normal)
+    support = (height.max(axis=1) <= 1e-6) & (normal[:, 2] < -0.5)
+    if not support.any():
+        return -Z
+    on = (np.abs(height) < 1e-4).sum(axis=1)
+    score = np.where(support, on + 1e-3 * -normal[:, 2], -1.0)
+    return normal[int(np.argmax(score))]
+
+
+def link_points_one(pose: _Pose, i: int, shape: Shape) -> Array:
+    """One shape's points in the robot frame (root origin) [m]."""
+    link = pose.tree.links[i]
+    one = BodyTree((dataclasses.replace(link, parent=-1, shapes=(shape,)),))
+    pts = link_points(one, 0, pose.pos[i:i + 1], pose.rot[i:i + 1])
+    return pts @ pose.axes.T
 
 
 def _leg_roles(pose: _Pose, limb: Limb, side: str, feet: list[int]) -> tuple[list[JointRole], str]:
@@ -170,6 +200,9 @@ def _leg_roles(pose: _Pose, limb: Limb, side: str, feet: list[int]) -> tuple[lis
             below = hinges[k + 1]
             v = pose.anchor(below) - pose.anchor(link)
             pose.turn(link, Y, _angle_to(v, Y, -Z))
+        elif letter == "y" and nxt is not None:          # ankle pitch: the roll axis along x
+            nax = pose.axis(nxt)
+            pose.turn(link, Y, _angle_to(nax, Y, X * (1.0 if nax @ X >= 0 else -1.0)))
         elif letter == "y":                              # ankle pitch: sole level in pitch
             pose.turn(link, Y, _angle_to(sole_normal(pose, feet), Y, -Z))
         elif letter == "x":                              # ankle roll: sole level in roll

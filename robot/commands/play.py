@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -36,6 +37,7 @@ from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
+from robot.loop.mcap_recorder import McapRecorder, is_mcap
 from robot.loop.recorder import Recorder
 from robot.loop.soundtrack import Soundtrack
 from robot.loop.take_writer import TakeWriter
@@ -69,7 +71,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--realtime", action="store_true", help="pace the simulation to the wall clock")
     p.add_argument("--view", action="store_true", help="open the MuJoCo viewer (needs a display)")
     p.add_argument("--record", default=None, metavar="PATH",
-                   help=f"record the replay (.csv, .jsonl or NAME{SUFFIX})")
+                   help=f"record the replay (.csv, .jsonl, .mcap or NAME{SUFFIX})")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--audio", default=None, type=input_file, metavar="SOUND",
                    help="play this soundtrack in sync (default: the file's own show.audio); "
@@ -161,10 +163,14 @@ def run(args: argparse.Namespace) -> int:
         {"realtime": args.realtime, "view": args.view} if kind == "sim" else {})
     bus = bus_from(args, robot, kind=kind, **options)
     imu = imu_for(args, robot, bus)
-    writer: TakeWriter | Recorder | None = None
+    writer: TakeWriter | Recorder | McapRecorder | None = None
     if args.record:
         writer = (TakeWriter(args.record, header) if is_take(args.record)
+                  else McapRecorder(args.record, robot, header, params=lambda: engine.params,
+                                    body=bus) if is_mcap(args.record)
                   else Recorder(args.record, robot.joint_names, robot.ids))
+    if soundtrack is not None and isinstance(writer, McapRecorder):
+        soundtrack.on_cue = _logged(soundtrack.on_cue, writer)
     watch = physics_watch(bus)
     observers = [o for o in (watch, soundtrack) if o is not None]
 
@@ -228,6 +234,15 @@ def run(args: argparse.Namespace) -> int:
             if args.check_plot:
                 print(f"wrote {args.check_plot}")
     return code
+
+
+def _logged(on_cue: Callable[[Cue], None] | None, log: McapRecorder) -> Callable[[Cue], None]:
+    """``on_cue``, and each cue on the record's /events too."""
+    def cue(c: Cue) -> None:
+        log.log(f"cue {c.t:.3f} s: {c.name}")
+        if on_cue is not None:
+            on_cue(c)
+    return cue
 
 
 def _soundtrack(args: argparse.Namespace, show: Show) -> Soundtrack | None:

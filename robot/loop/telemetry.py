@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from robot.bus.base import ServoState
+from robot.imu.base import ImuSample
 from robot.loop.latency import SampleStats
 
 
@@ -18,7 +19,8 @@ class Telemetry:
     "estop"; period_error_ms: lateness of the last tick start [ms]; clamped: the joints
     (names, joint order) held at a limit in this tick's command: by the source (the gait
     engine clamps what its IK asks beyond a limit) or by the loop (a feedback correction
-    beyond one); empty when none was.
+    beyond one); empty when none was; imu: the balance stage's last IMU sample (None: no
+    IMU in the run).
     """
 
     t: float = 0.0
@@ -33,6 +35,7 @@ class Telemetry:
     stop_reason: str | None = None
     fresh: bool = False  # True on ticks that read the servos back
     clamped: tuple[str, ...] = ()
+    imu: ImuSample | None = None
 
 
 TickObserver = Callable[[Telemetry], None]

@@ -68,7 +68,9 @@ def chased(args: argparse.Namespace, engine: GaitEngine, clock: Clock) -> Chased
     label = start_label(args.chase_start)
     source = source_of(args.chase)
     freewheel = int(round(args.freewheel)) if args.freewheel is not None else FREEWHEEL_FRAMES
-    return ChasedShow(engine, ChaseClock(label, freewheel=freewheel), source, clock)
+    show = ChasedShow(engine, ChaseClock(label, freewheel=freewheel), source, clock)
+    show.prepare()
+    return show
 
 
 def live(spec: str | None) -> bool:

@@ -100,6 +100,10 @@ class ChasedShow:
     def amplitude(self) -> float:
         return self.show.amplitude
 
+    def prepare(self) -> None:
+        """What can fail before anything moves (robot.timecode.sources)."""
+        self.source.prepare()
+
     def close(self) -> None:
         self.source.close()
 

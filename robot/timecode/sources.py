@@ -40,11 +40,13 @@ CAPTURE_HZ, CAPTURE_CHUNK = 48_000, 480
 
 
 class TimecodeSource(Protocol):
-    """``open(now)`` starts hearing it (``now``: the loop's clock [s]); ``poll(now)``: the
-    readings that arrived up to ``now``; ``close()``; ``name``: for messages."""
+    """``prepare()`` does what can fail (a file read, a port opened: ConfigError, before
+    anything moves); ``open(now)`` starts hearing it (``now``: the loop's clock [s]);
+    ``poll(now)``: the readings that arrived up to ``now``; ``close()``; ``name``."""
 
     name: str
 
+    def prepare(self) -> None: ...
     def open(self, now: float) -> None: ...
     def poll(self, now: float) -> list[Reading]: ...
     def close(self) -> None: ...
@@ -94,19 +96,22 @@ class LtcFile:
     def __init__(self, path: Path) -> None:
         self.path = path
         self.name = f"ltc:{path}"
+        self._words: list[LtcFrame] = []
+        self._rate = 0.0
         self._frames: list[Reading] = []
         self._next = 0
-        self._t0 = 0.0
 
-    def open(self, now: float) -> None:
-        x, rate = read_wav(self.path)
-        frames = LtcDecoder(rate).feed(x)
-        if not frames:
+    def prepare(self) -> None:
+        x, self._rate = read_wav(self.path)
+        self._words = LtcDecoder(self._rate).feed(x)
+        if not self._words:
             raise ConfigError(f"--chase ltc:{self.path}: no LTC found in it (expected "
                               "SMPTE linear timecode audio)")
-        self._t0 = now
-        self._frames = [r for f in frames
-                        if (r := ltc_reading(f, rate, now + f.end / rate)) is not None]
+
+    def open(self, now: float) -> None:
+        self._frames = [r for f in self._words
+                        if (r := ltc_reading(f, self._rate, now + f.end / self._rate))
+                        is not None]
 
     def poll(self, now: float) -> list[Reading]:
         out = []
@@ -159,10 +164,12 @@ class LtcDevice(_Live):
         self.name = f"ltc:{device}"
         self._proc: subprocess.Popen[bytes] | None = None
 
-    def open(self, now: float) -> None:
+    def prepare(self) -> None:
         if shutil.which("arecord") is None:
             raise ConfigError(f"--chase ltc:{self.device}: arecord not found (ALSA's "
                               "alsa-utils); or give a WAV file")
+
+    def open(self, now: float) -> None:
         self._proc = subprocess.Popen(
             ["arecord", "-q", "-D", self.device, "-f", "S16_LE", "-c", "1", "-r",
              str(CAPTURE_HZ), "-t", "raw"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
@@ -201,7 +208,7 @@ class MtcPort(_Live):
         self._port: Any = None
         self._decoder = MtcDecoder()
 
-    def open(self, now: float) -> None:
+    def prepare(self) -> None:
         try:
             import mido
             import mido.sockets
@@ -218,6 +225,8 @@ class MtcPort(_Live):
             names = ", ".join(mido.get_input_names()) if not host else ""
             raise ConfigError(f"--chase {self.name}: cannot open it: {e}"
                               + (f"; inputs: {names or '(none)'}" if not host else "")) from None
+
+    def open(self, now: float) -> None:
         self._start(now, self._listen)
 
     def _listen(self) -> None:

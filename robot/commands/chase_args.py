@@ -1,5 +1,5 @@
 """`biped play SHOW --chase ...`: the options that make a show follow an external timecode
-and what it reports (robot/motion/chased.py, robot/timecode/).
+and what it reports (robot/timecode/chased.py, robot/timecode/).
 
 ``--freewheel`` defaults to 15 frames (0.5-0.6 s): an audio cable's crackle, a DAW's loop
 point or a MIDI interface's hiccup is shorter and the show rides through it; when the
@@ -18,9 +18,9 @@ from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.loop.clock import Clock
 from robot.loop.telemetry import Telemetry
-from robot.motion.chased import ChasedShow
 from robot.motion.layered import LayeredEngine
-from robot.timecode.chase import ChaseClock
+from robot.timecode.chase import JUMP_FRAMES, LIVE_JUMP_FRAMES, ChaseClock
+from robot.timecode.chased import ChasedShow
 from robot.timecode.sources import LtcFile, source_of
 
 FREEWHEEL_FRAMES = 15
@@ -68,7 +68,9 @@ def chased(args: argparse.Namespace, engine: GaitEngine, clock: Clock) -> Chased
     label = start_label(args.chase_start)
     source = source_of(args.chase)
     freewheel = int(round(args.freewheel)) if args.freewheel is not None else FREEWHEEL_FRAMES
-    show = ChasedShow(engine, ChaseClock(label, freewheel=freewheel), source, clock)
+    jump = JUMP_FRAMES if isinstance(source, LtcFile) else LIVE_JUMP_FRAMES
+    show = ChasedShow(engine, ChaseClock(label, freewheel=freewheel, jump_frames=jump), source,
+                      clock)
     show.prepare()
     return show
 
@@ -93,11 +95,30 @@ def stop_when_lost(show: ChasedShow, stop: Any) -> Any:
     return watch
 
 
+def chase_events(show: ChasedShow, log: Any) -> Any:
+    """A tick observer: ``log(text)`` (an MCAP record's /events) at each timecode jump and
+    dropout, and when the show ends by itself."""
+    counts = [0, 0]
+    said: list[str | None] = [None]
+
+    def watch(tel: Telemetry) -> None:
+        st = show.chase.stats
+        for a, b in st.jumped[counts[0]:]:
+            log(f"timecode jump: show time {a:.3f} s -> {b:.3f} s")
+        if st.dropouts > counts[1]:
+            log(f"timecode dropout (freewheel {show.chase.freewheel} frames)", level="warning")
+        if show.ended and show.ended != said[0]:
+            log(f"show: {show.ended}")
+        counts[:], said[0] = [len(st.jumped), st.dropouts], show.ended
+    return watch
+
+
 def summary(show: ChasedShow) -> dict[str, Any]:
     """The ``"chase"`` object of `biped play --json`."""
     st = show.chase.stats
     rate = st.rate
     return {"source": show.source.name, "fps": rate.name if rate else None,
-            "max_error_frames": round(st.max_error_frames, 4), "dropouts": st.dropouts,
+            "max_error_frames": round(st.max_error_frames, 4),
+            "p95_error_frames": round(st.error_frames(95), 4), "dropouts": st.dropouts,
             "jumps": st.jumps, "jumped_s": [[round(a, 4), round(b, 4)] for a, b in st.jumped],
             "readings": st.readings, "stopped": show.ended}

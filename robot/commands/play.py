@@ -20,7 +20,14 @@ from pathlib import Path
 from typing import Any
 
 from robot.commands.balance_args import add_balance_args, imu_for
-from robot.commands.chase_args import add_chase_args, chased, live, stop_when_lost, summary
+from robot.commands.chase_args import (
+    add_chase_args,
+    chase_events,
+    chased,
+    live,
+    stop_when_lost,
+    summary,
+)
 from robot.commands.common import (
     add_bus_args,
     bus_from,
@@ -182,7 +189,9 @@ def run(args: argparse.Namespace) -> int:
     watch = physics_watch(bus)
     runs: list[Run[Any]] = []              # the run, once built: what the timecode stops
     lost = None if chase is None else stop_when_lost(chase, lambda why: runs[0].request_stop(why))
-    observers = [o for o in (watch, soundtrack, lost) if o is not None]
+    events = (chase_events(chase, writer.log)
+              if chase is not None and isinstance(writer, McapRecorder) else None)
+    observers = [o for o in (watch, soundtrack, lost, events) if o is not None]
     if chase is not None and soundtrack is not None:
         soundtrack.clock = lambda: chase.show_time
 

@@ -25,9 +25,9 @@ from robot.commands.common import checked, input_file, output_file
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
-from robot.loop.mcap_read import mcap_take
 from robot.loop.mcap_recorder import is_mcap
 from robot.motion.takes import Take, read_take
+from robot.previs.mcap_read import mcap_take
 from robot.servo.bench_load import BenchLoad, parse_load
 
 Floats = npt.NDArray[np.float64]

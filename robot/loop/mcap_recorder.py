@@ -24,7 +24,7 @@ monotonic clock from the same anchor: a take's ``present_t``; the log time is th
 Effort is the servo's load (% of its maximum torque) times its stall torque. A channel
 appears at its first message; the run's take header (robot, joints, rate) is the metadata
 record ``biped`` (``take_header``: its JSON), so
-``biped sim-gap`` and ``biped plot`` read the file (robot/loop/mcap_read.py).
+``biped sim-gap`` and ``biped plot`` read the file (robot/previs/mcap_read.py).
 """
 
 from __future__ import annotations

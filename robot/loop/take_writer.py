@@ -19,7 +19,7 @@ class TakeWriter:
     line (from the loop thread, via ``robot.motion.scripted.RecordingEngine``), and calling it with
     the loop's telemetry writes the tick. A failed write (disk full) is kept and raised at
     the next tick, so the streamer ends the run as an observer fault (ramp out, torque off).
-    ``show_time``: a chased show's time (robot/motion/chased.py): each tick's ``t``, from
+    ``show_time``: a chased show's time (robot/timecode/chased.py): each tick's ``t``, from
     the first tick it is known."""
 
     def __init__(self, path: str | Path, header: TakeHeader, *,

@@ -16,8 +16,8 @@ from robot.config.joint_names import limb_groups
 from robot.config.toml_io import parse_json
 from robot.errors import ConfigError
 from robot.gait.expressions import CHANNELS
-from robot.loop.mcap_read import mcap_rows
 from robot.previs.curves import outside_legend, palette, plot_curves
+from robot.previs.mcap_read import mcap_rows
 
 Array = npt.NDArray[np.float64]
 

@@ -4,9 +4,9 @@
 Show time 0 is the start timecode (``--chase-start``). Between readings the show time runs
 on the loop's clock; each reading pulls it halfway to where the reading says (a phase
 lock: arrival jitter is halved, a steady error shrinks to nothing within a few frames).
-A reading more than ``JUMP_FRAMES`` away is a jump (the operator relocated the cue): the
-show time is set to it at once, and the motion source ramps there (robot/motion/
-chased.py). No reading for longer than ``gap_frames`` (the source's usual spacing and a
+A reading more than ``jump_frames`` away (2 for a file, 8 for a live source) is a jump
+(the operator relocated the cue): the show time is set to it at once, and the show ramps
+there (robot/timecode/chased.py). No reading for longer than ``gap_frames`` (the source's usual spacing and a
 half) is a dropout: the clock freewheels on; one for longer than ``freewheel`` frames is
 lost: the show stops the way Stop does.
 
@@ -18,10 +18,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from robot.timecode.frames import Rate, frame_number
 
-#: A reading this many frames from the show time is a jump, not jitter.
-JUMP_FRAMES = 2.0
+#: A reading this many frames from the show time is a jump, not jitter: a file's timecode
+#: (exact), a live source's (a loaded host hears a MIDI message or an audio buffer tens of
+#: ms late; a relocation by an operator is seconds).
+JUMP_FRAMES, LIVE_JUMP_FRAMES = 2.0, 8.0
 #: Share of a reading's error taken at once.
 GAIN = 0.5
 
@@ -33,10 +37,15 @@ class ChaseStats:
 
     rate: Rate | None = None
     max_error_frames: float = 0.0
+    errors: list[float] = field(default_factory=list)
     dropouts: int = 0
     jumps: int = 0
     jumped: list[tuple[float, float]] = field(default_factory=list)
     readings: int = 0
+
+    def error_frames(self, percent: float) -> float:
+        """A percentile of the readings' lock errors [frames] (0 before any)."""
+        return float(np.percentile(self.errors, percent)) if self.errors else 0.0
 
 
 class ChaseClock:
@@ -45,8 +54,9 @@ class ChaseClock:
     the source's reading spacing before a silence counts as a dropout [frames]."""
 
     def __init__(self, start_label: tuple[int, int, int, int], *, freewheel: int,
-                 gap_frames: float = 1.5) -> None:
+                 gap_frames: float = 1.5, jump_frames: float = JUMP_FRAMES) -> None:
         self.start_label = start_label
+        self.jump_frames = jump_frames
         self.freewheel = freewheel
         self.gap_frames = gap_frames
         self.stats = ChaseStats()
@@ -73,12 +83,13 @@ class ChaseClock:
             return
         predicted = self._ref_show + (at - self._ref_t)
         error = value - predicted
-        if abs(error) * rate.fps > JUMP_FRAMES:
+        if abs(error) * rate.fps > self.jump_frames:
             st.jumps += 1
             st.jumped.append((predicted, value))
             self._ref_t, self._ref_show = at, value
             return
         st.max_error_frames = max(st.max_error_frames, abs(error) * rate.fps)
+        st.errors.append(abs(error) * rate.fps)
         self._ref_t, self._ref_show = at, predicted + GAIN * error
 
     def show_time(self, now: float) -> float | None:

@@ -10,8 +10,8 @@
   MIDI-over-TCP bridge, mido's ``PortServer``).
 
 Each source stamps a reading with the loop's clock: live sources on the host's monotonic
-clock, mapped onto the loop's at ``open`` (the loop then runs on the wall clock: a
-simulation chasing a live source runs in real time).
+clock as it arrives, placed on the loop's clock by its age when the loop polls (the loop
+then runs on the wall clock: a simulation chasing a live source runs in real time).
 """
 
 from __future__ import annotations
@@ -132,23 +132,25 @@ class _Live:
 
     def __init__(self) -> None:
         self._queue: queue.Queue[Reading] = queue.Queue()
-        self._offset = 0.0
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
     def _start(self, now: float, target: Any) -> None:
-        self._offset = now - time.monotonic()
         self._thread = threading.Thread(target=target, daemon=True, name=self.name)
         self._thread.start()
 
     def poll(self, now: float) -> list[Reading]:
+        """Readings since the last poll, each placed on the loop's clock by its age now
+        (the two clocks compared afresh each poll: a simulation that fell behind the wall
+        clock does not shift the timecode)."""
         out: list[Reading] = []
+        heard = time.monotonic()
         while True:
             try:
                 r = self._queue.get_nowait()
             except queue.Empty:
                 return out
-            out.append(Reading(r.at + self._offset, r.frame, r.rate, r.locate))
+            out.append(Reading(now - (heard - r.at), r.frame, r.rate, r.locate))
 
     def _put(self, reading: Reading | None) -> None:
         if reading is not None:
@@ -233,7 +235,7 @@ class MtcPort(_Live):
         while not self._stop.is_set():
             try:
                 msg = self._port.receive(block=True)
-            except (OSError, EOFError):
+            except (OSError, EOFError, ValueError):     # closed (ValueError: by us)
                 return
             if msg is None:
                 return

@@ -133,3 +133,35 @@ def test_a_file_that_is_no_record_is_one_line(tmp_path: Path,
         err = capsys.readouterr().err.strip()
         assert str(bad) in err and len(err.splitlines()) == 1
     assert not (tmp_path / "x.png").exists()
+
+
+def test_a_panel_take_with_mcap_writes_both(tmp_path: Path) -> None:
+    """`biped panel --mcap`: a take recorded from the panel (a live change in it) is also
+    NAME.mcap beside it, its joint stream the take's, its parameters as they changed."""
+    from waiting import wait_for
+
+    from robot.config.bundled import DEFAULT_ROBOT
+    from robot.config.gait_file import load_gait
+    from robot.config.robot_file import load_robot
+    from robot.panel.controller import BusSpec, LoopOptions, make_controller
+    from robot.panel.studio import Studio
+    controller = make_controller(load_robot(DEFAULT_ROBOT), BusSpec("sim"),
+                                 load_gait("walk").params, preset="walk",
+                                 options=LoopOptions(rate_hz=100.0, read_every=5, mcap=True))
+    studio = Studio(controller, takes_dir=tmp_path / "takes", keys_dir=tmp_path / "keys")
+    try:
+        name = studio.record("live")
+        assert wait_for(lambda: int(controller.state()["tick"]) >= 60)
+        controller.set_params({"speed": 0.7})
+        at = int(controller.state()["tick"])
+        assert wait_for(lambda: int(controller.state()["tick"]) >= at + 60)
+        controller.stop()
+        assert controller.wait(30) and studio.recording is None
+    finally:
+        controller.shutdown(timeout=5)
+    take = read_take(tmp_path / "takes" / f"{name}.take.jsonl")
+    got = _messages(tmp_path / "takes" / f"{name}.mcap")
+    q = np.array([m.position for _, m in got["/joint_commands"]])   # type: ignore[attr-defined]
+    assert q.shape == take.q.shape and np.abs(q - take.q).max() <= 1e-9
+    speeds = [p["speed"] for _, p in got["/gait/params"]]           # type: ignore[index]
+    assert speeds[0] == take.header.params.speed and speeds[-1] == 0.7

@@ -98,9 +98,8 @@ class McapRecorder:
         self._tmp = self.path.with_name(self.path.name + ".part")
         self._schemas: dict[str, int] = {}
         self._channels: dict[str, int] = {}
-        self._last_tick = -1
+        self._last_tick, self._epoch_ns = -1, 0
         self._t0: float | None = None
-        self._epoch_ns = 0
         self._state = ""
         self._reason: str | None = None
         self._last_params: GaitParams | None = None
@@ -274,3 +273,27 @@ class McapRecorder:
                   angular_velocity_covariance=unknown,
                   linear_acceleration=vec(x=s.accel[0], y=s.accel[1], z=s.accel[2]),
                   linear_acceleration_covariance=unknown)
+
+
+class Alongside:
+    """A take and its MCAP side by side (panel takes, ``--mcap``); the take's error first."""
+
+    def __init__(self, take: Any, mcap: McapRecorder) -> None:
+        self.take, self.mcap = take, mcap
+
+    def open(self) -> Alongside:
+        self.take.open()
+        try:
+            self.mcap.open()
+        except BaseException:
+            self.take.close_quietly()
+            raise
+        return self
+
+    def __call__(self, tel: Telemetry) -> None:
+        self.take(tel)
+        self.mcap(tel)
+
+    def close_quietly(self) -> str | None:
+        first, second = self.take.close_quietly(), self.mcap.close_quietly()
+        return first or second

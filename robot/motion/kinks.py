@@ -53,16 +53,14 @@ SNAP = 0.02
 
 def _candidates(values: Array) -> list[int]:
     d4 = np.abs(np.diff(values, 4))
+    pad = np.concatenate([np.zeros(5), d4, np.zeros(5)])    # pad[j + 5] = d4[j]
+    i = np.arange(1, len(values) - 2)
 
-    def window(j: int) -> float:
-        return float(d4[j]) if 0 <= j < len(d4) else 0.0
-    out = []
-    for i in range(1, len(values) - 2):     # two frames each side at least
-        spoiled = max(window(j) for j in range(i - 3, i + 1))
-        clean = max(window(i - 5), window(i - 4), window(i + 1), window(i + 2))
-        if spoiled > RATIO * clean + FLOOR:
-            out.append(i)
-    return out
+    def window(offset: int) -> Array:
+        return np.asarray(pad[i + offset + 5], dtype=np.float64)
+    spoiled = np.max([window(o) for o in range(-3, 1)], axis=0)
+    clean = np.max([window(o) for o in (-5, -4, 1, 2)], axis=0)
+    return [int(k) for k in i[spoiled > RATIO * clean + FLOOR]]
 
 
 def _fit(x: Array, y: Array, s: float | None) -> tuple[float, Array]:

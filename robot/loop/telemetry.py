@@ -17,10 +17,10 @@ class Telemetry:
 
     state: "idle" | "ramp_in" | "waiting" (a chased show before its start timecode) |
     "walking" | "ramp_out" | "rest" | "pose" | "stopped" | "estop"; period_error_ms:
-    lateness of the last tick start [ms]; clamped: the joints (names, joint order) held at a limit in this tick's command: by the source (the gait
-    engine clamps what its IK asks beyond a limit) or by the loop (a feedback correction
-    beyond one); empty when none was; imu: the balance stage's last IMU sample (None: no
-    IMU in the run).
+    lateness of the last tick start [ms]; clamped: the joints (names, joint order) held at
+    a limit in this tick's command: by the source (the gait engine clamps what its IK asks
+    beyond a limit) or by the loop (a feedback correction beyond one); empty when none
+    was; imu: the balance stage's last IMU sample (None: no IMU in the run).
     """
 
     t: float = 0.0

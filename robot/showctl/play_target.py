@@ -31,10 +31,11 @@ STOPS = ("stop", "take stop", "estop")
 
 class PlayTarget:
     """The feed's target on one play: ``run`` (open), its ``joints`` and ``show_time``
-    (the engine's time [s]); ``take``: what plays (the file's name)."""
+    (the show's time [s]: the engine's, or the chased timecode's; None before it starts);
+    ``take``: what plays (the file's name)."""
 
     def __init__(self, run: Run[Any], *, joints: tuple[str, ...], take: str,
-                 show_time: Callable[[], float], cues: CueList | None = None,
+                 show_time: Callable[[], float | None], cues: CueList | None = None,
                  once: OnceLog | None = None) -> None:
         self.run = run
         self.joints = joints
@@ -80,13 +81,14 @@ class PlayTarget:
     def status(self) -> Status:
         tel: Telemetry = self.run.streamer.telemetry
         q = tel.q_cmd or []
-        return Status(state=str(tel.state), fault=None, show_t=float(self.show_time()),
+        t = self.show_time()                # None: a chased show waiting for its start
+        return Status(state=str(tel.state), fault=None, show_t=None if t is None else float(t),
                       take=self.take, joints=tuple(zip(self.joints, q, strict=False)))
 
 
 @contextmanager
 def play_show_control(options: ShowOptions, run: Run[Any], *, joints: tuple[str, ...],
-                      take: str, show_time: Callable[[], float], rate_hz: float,
+                      take: str, show_time: Callable[[], float | None], rate_hz: float,
                       announce: Callable[[str], None]) -> Iterator[None]:
     """OSC in (and status out) for an open ``run`` while the block streams it; nothing
     without ``--osc``. The port opens before the play moves (ConfigError, one line);

@@ -11,6 +11,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 
+from robot.body.legs import LegChain
 from robot.config.imu_file import ImuConfig
 from robot.config.joint_names import ARM_NAMES, JOINT_NAMES, LEG_NAMES
 from robot.config.servo_file import physics_for
@@ -165,6 +166,9 @@ class RobotConfig:
     #: Servo physics read from the model files the robot file names, per joint name
     #: (joints without one use their model's bundled physics: ``servo_physics``).
     physics: Mapping[str, ServoPhysics] = field(default_factory=dict)
+    #: The legs' axes and offsets (right, left; robot.body.legs), measured from the model
+    #: by the importer; None: the box model's, from ``geometry`` (see ``legs``).
+    leg_chains: tuple[LegChain, LegChain] | None = None
 
     def joint(self, name: str) -> JointConfig:
         for j in self.joints:
@@ -185,6 +189,27 @@ class RobotConfig:
     def has_hip_yaw(self) -> bool:
         """False for 5-DoF legs (no hip yaw: the gait cannot turn by yawing the feet)."""
         return "r_hip_yaw" in self.joint_names
+
+    @cached_property
+    def has_ankle_roll(self) -> bool:
+        """False for 5-DoF legs without ankle roll (the foot's roll goes with the leg's)."""
+        return "r_ankle_roll" in self.joint_names
+
+    @cached_property
+    def legs(self) -> tuple[LegChain, LegChain]:
+        """The right and left leg as the IK sees them: ``leg_chains``, else the box
+        model's from ``geometry`` (hip centre (0, -/+ hip_width / 2, 0), the yaw axis
+        through it when the robot has hip yaw, sole ``ankle_height`` below the ankle)."""
+        if self.leg_chains is not None:
+            return self.leg_chains
+        g = self.geometry
+
+        def box(side: str, sign: float) -> LegChain:
+            y = sign * g.hip_width / 2
+            return LegChain(side, (0.0, y, 0.0), g.thigh, g.shin, (0.0, 0.0, -g.ankle_height),
+                            yaw_axis=(0.0, y) if self.has_hip_yaw else None,
+                            has_ankle_roll=self.has_ankle_roll)
+        return box("r", -1.0), box("l", 1.0)
 
     def servo(self, joint: JointConfig) -> ServoModel:
         """The servo model of ``joint`` (its own ``model``, else the bus's)."""

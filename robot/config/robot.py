@@ -170,6 +170,18 @@ class RobotConfig:
     #: by the importer; None: the box model's, from ``geometry`` (see ``legs``).
     leg_chains: tuple[LegChain, LegChain] | None = None
 
+    def __post_init__(self) -> None:
+        if self.leg_chains is None:
+            return
+        for leg, side in zip(self.leg_chains, ("r", "l"), strict=True):
+            if leg.side != side or (leg.has_yaw, leg.has_ankle_roll) != (
+                    self.has_hip_yaw, self.has_ankle_roll):
+                raise ConfigError(
+                    f"{self.source}: leg_chains: the {side} leg's chain (side {leg.side!r}, "
+                    f"hip yaw {leg.has_yaw}, ankle roll {leg.has_ankle_roll}) does not match "
+                    f"the joints (hip yaw {self.has_hip_yaw}, ankle roll "
+                    f"{self.has_ankle_roll}); expected (right, left) chains of these joints")
+
     def joint(self, name: str) -> JointConfig:
         for j in self.joints:
             if j.name == name:

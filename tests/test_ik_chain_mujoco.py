@@ -121,12 +121,15 @@ def rot_angle(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def random_angles(rng: np.random.Generator, leg: LegChain) -> tuple[float, ...]:
-    """A pose of the walking range: the knee 0.1-1.6 rad, the foot within 0.6 rad of flat."""
-    knee = rng.uniform(0.1, 1.6)
+    """A pose of the walking range and beyond: the knee 0.1-1.8 rad, the hip within 0.9
+    rad of the ankle's up axis (not near the ankle roll's singularity, the hip in the
+    sole's plane, where the roll's two roots meet and no closed form is well-conditioned)."""
+    knee = rng.uniform(0.1, 1.8)
+    lean = math.atan2(leg.thigh * math.sin(knee), leg.shin + leg.thigh * math.cos(knee))
     yaw = rng.uniform(-0.4, 0.4) if leg.has_yaw else 0.0
-    roll, pitch = rng.uniform(-0.3, 0.3), rng.uniform(-0.8, 0.4)
-    ankle = -(pitch + knee) + rng.uniform(-0.6, 0.6)
-    return yaw, roll, pitch, knee, ankle, rng.uniform(-0.3, 0.3) if leg.has_ankle_roll else 0.0
+    ankle_roll = rng.uniform(-0.3, 0.3) if leg.has_ankle_roll else 0.0
+    return (yaw, rng.uniform(-0.3, 0.3), rng.uniform(-0.8, 0.6), knee,
+            rng.uniform(-0.9, 0.9) - lean, ankle_roll)
 
 
 @pytest.mark.parametrize("name", LEGS)

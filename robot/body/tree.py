@@ -205,3 +205,17 @@ def axis_angle(axis: Vec3 | Array, angle: float) -> Array:
     a = a / np.linalg.norm(a)
     k = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
     return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
+
+
+def equivalent_box(inertial: Inertial, *, name: str = "", note: str = "") -> Shape:
+    """The solid box of ``inertial``'s mass and principal moments, at its centre of mass
+    in its principal axes (MuJoCo's equivalent-inertia box): half sizes
+    sqrt(3 (I_j + I_k - I_i) / (2 m)) [m]."""
+    moments, axes = np.linalg.eigh(inertial.matrix())
+    if np.linalg.det(axes) < 0:
+        axes[:, 0] = -axes[:, 0]
+    m = inertial.mass
+    total = float(moments.sum())
+    half = tuple(float(np.sqrt(max(3.0 * (total - 2.0 * moments[i]) / (2.0 * m), 1e-12)))
+                 for i in range(3))
+    return Shape("box", inertial.com, matrix_to_quat(axes), half, name=name, note=note)

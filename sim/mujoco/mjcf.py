@@ -17,7 +17,6 @@ rotor's armature, as with the torque on.
 
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -30,6 +29,7 @@ import numpy.typing as npt
 
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
+from sim.mujoco.geoms import foot_geoms, geom_points
 from sim.mujoco.mjcf_robot import add_actuators_and_sensors, add_assets, add_defaults, add_worldbody, fmt
 
 if TYPE_CHECKING:
@@ -38,7 +38,6 @@ if TYPE_CHECKING:
 ROBOT_FILE = "robot.xml"
 SCENE_FILE = "scene.xml"
 DEFAULT_TIMESTEP = 0.002  # [s]
-FOOT_GEOMS = ("r_foot", "l_foot")
 
 
 @dataclass(frozen=True)
@@ -147,7 +146,7 @@ def _joint_qpos(model: mujoco.MjModel, name: str) -> int:
 
 def standing_qpos(model: mujoco.MjModel, pose: Mapping[str, float]) -> npt.NDArray[np.float64]:
     """qpos with the joints at ``pose`` [rad] (missing joints 0), torso upright at x = y = 0
-    and its height [m] chosen so the lowest foot-box point touches z = 0."""
+    and its height [m] chosen so the lowest sole point touches z = 0."""
     data = mujoco.MjData(model)
     qpos = np.zeros(model.nq)
     qpos[3] = 1.0
@@ -155,13 +154,8 @@ def standing_qpos(model: mujoco.MjModel, pose: Mapping[str, float]) -> npt.NDArr
         qpos[_joint_qpos(model, name)] = q
     data.qpos[:] = qpos
     mujoco.mj_kinematics(model, data)
-    lowest = math.inf
-    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
-    for name in FOOT_GEOMS:
-        gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
-        rot = data.geom_xmat[gid].reshape(3, 3)
-        pts = data.geom_xpos[gid] + (corners * model.geom_size[gid]) @ rot.T
-        lowest = min(lowest, float(pts[:, 2].min()))
+    lowest = min(float(geom_points(model, data, g)[:, 2].min())
+                 for foot in foot_geoms(model) for g in foot)
     qpos[2] = -lowest
     return qpos
 

@@ -15,15 +15,12 @@ r = F^T (A - P) this reads
     cos(a) r_y - sin(a) r_z = k0 + k1 sqrt(1 - (g_c cos(a) - g_s sin(a))^2)
 
 (g: row z of F for yaw_roll, row x for roll_yaw). With k1 = u_y = 0 it is linear in
-(cos a, sin a): a = atan2(r_y, r_z) - asin(k0 / |r|), the box model's atan2 when k0 = 0
-(cos a and sin a are formed from r by algebra, no trigonometry). Otherwise ``NEWTON``
-Newton steps from that with the root term at 1, each a rotation of (cos a, sin a) by the
-step (by its half angle's tangent to fifth order: no trigonometry); the error falls from
-~k1 (1 - cos) / |r| to ~1e-14 rad in three (tests/test_ik_chain.py). The root picked is
-the one nearer a = 0 (the box model's branch). n then gives the hip yaw and roll, these
-the hip pitch point, and the knee, ankle pitch and hip pitch follow as
-robot.gait.ik.leg_ik's: the law of cosines in the pitch plane, clamped along the ankle →
-hip line within the knee limits' span.
+(cos a, sin a): a = atan2(r_y, r_z) - asin(k0 / |r|), the box model's atan2 when k0 = 0.
+Otherwise ``NEWTON`` Newton steps from that with the root term at 1 (the error falls from
+~k1 (1 - cos) / |r| to ~1e-15 rad in three: tests/test_ik_chain.py). n then gives the hip
+yaw and roll, these the hip pitch point, and the knee, ankle pitch and hip pitch follow
+as robot.gait.ik.leg_ik's: the law of cosines in the pitch plane, clamped along the ankle
+→ hip line within the knee limits' span.
 
 A leg without ankle roll keeps the sole point and the foot's x axis (its heading and
 pitch) exactly and gives up the roll about that axis: the same equation with A the sole
@@ -157,40 +154,31 @@ def chain_leg_ik(leg: LegChain, sole: Vec, foot_rot: Rot = xm.IDENTITY, *,
     rz = f2 * wx + f5 * wy + f8 * wz
     sg = xm.sign(rz)
     rho = xm.sqrt(ry * ry + rz * rz)
-    inv = 1.0 / xm.maximum(rho, 1e-300)
-    x = sg * (k.k0 + k.k1) * inv           # sin(gamma - roll), gamma = atan2(ry sg, rz sg)
+    x = sg * (k.k0 + k.k1) / xm.maximum(rho, 1e-300)
     side_ok = abs(x) <= 1.0
-    x = xm.clip(x, -1.0, 1.0)
-    cg, sn = sg * rz * inv + (rho == 0.0), sg * ry * inv    # cos, sin gamma (gamma 0 at rho 0)
-    cb = xm.sqrt(1.0 - x * x)
-    c6, s6 = cg * cb + sn * x, sn * cb - cg * x             # cos, sin roll
+    roll = xm.atan2(ry * sg, rz * sg) - xm.asin(x)
     if k.k1 != 0.0:
         gc, gs = (f7, f8) if k.yaw_roll else (f1, f2)
-        for _ in range(NEWTON):   # on the angle, each step a rotation of (c6, s6)
-            nc = gc * c6 - gs * s6
+        for _ in range(NEWTON):
+            c, s = xm.cos(roll), xm.sin(roll)
+            nc = gc * c - gs * s
             root = xm.sqrt(xm.maximum(1.0 - nc * nc, 1e-24))
-            g = c6 * ry - s6 * rz - k.k0 - k.k1 * root
-            dg = -s6 * ry - c6 * rz - k.k1 * nc * (gc * s6 + gs * c6) / root
-            d = xm.clip(g / (dg + xm.sign(dg) * 1e-300), -MAX_STEP, MAX_STEP)
-            t = 0.5 * d * (1.0 + d * d / 12.0)    # tan(d / 2) to O(d^5)
-            w = 1.0 / (1.0 + t * t)
-            cd, sd = (1.0 - t * t) * w, 2.0 * t * w
-            c6, s6 = c6 * cd + s6 * sd, s6 * cd - c6 * sd
+            g = c * ry - s * rz - k.k0 - k.k1 * root
+            dg = -s * ry - c * rz - k.k1 * nc * (gc * s + gs * c) / root
+            roll = roll - xm.clip(g / (dg + xm.sign(dg) * 1e-300), -MAX_STEP, MAX_STEP)
         side_ok = abs(k.k0 + k.k1 * root) <= rho
-    roll = xm.atan2(s6, c6)
+    c6, s6 = xm.cos(roll), xm.sin(roll)
     # The foot before its ankle roll, F Rx(-roll): columns (f0, f3, f6), n, e.
     n0, n1, n2 = c6 * f1 - s6 * f2, c6 * f4 - s6 * f5, c6 * f7 - s6 * f8
     e0, e1, e2 = c6 * f2 + s6 * f1, c6 * f5 + s6 * f4, c6 * f8 + s6 * f7
-    if k.yaw_roll:   # n = Rz(yaw) Rx(hip_roll) y = (-sy cr, cy cr, sr)
-        cr = xm.sqrt(n0 * n0 + n1 * n1)
-        yaw, hip_roll = xm.atan2(-n0, n1), xm.atan2(n2, cr)
-        h = 1.0 / xm.maximum(cr, 1e-300)
-        cy, sy_, sr = n1 * h + (cr == 0.0), -n0 * h, n2
-    else:            # n = Rx(hip_roll) Rz(yaw) y = (-sy, cy cr, cy sr)
-        cy = xm.sqrt(n1 * n1 + n2 * n2)
-        yaw, hip_roll = xm.atan2(-n0, cy), xm.atan2(n2, n1)
-        h = 1.0 / xm.maximum(cy, 1e-300)
-        sy_, cr, sr = -n0, n1 * h + (cy == 0.0), n2 * h
+    if k.yaw_roll:
+        yaw = xm.atan2(-n0, n1)
+        hip_roll = xm.atan2(n2, xm.sqrt(n0 * n0 + n1 * n1))
+    else:
+        yaw = xm.atan2(-n0, xm.sqrt(n1 * n1 + n2 * n2))
+        hip_roll = xm.atan2(n2, n1)
+    cy, sy_ = xm.cos(yaw), xm.sin(yaw)
+    cr, sr = xm.cos(hip_roll), xm.sin(hip_roll)
     ux, uy, drop = k.ux, k.uy, k.drop
     if k.yaw_roll:  # the hip pitch point: fk's yaw_point + Rz (hip - yaw_point) + R1 drop
         hpx = k.px + (cy * ux - sy_ * uy) - drop * (sy_ * sr)

@@ -9,7 +9,7 @@ constants ``chain_constants`` derives once per robot, with no per-call type test
 from __future__ import annotations
 
 from collections.abc import Callable
-from math import atan2, cos, sin, sqrt
+from math import asin, atan2, cos, sin, sqrt
 from typing import Any
 
 from robot.body.legs import LegChain
@@ -47,41 +47,33 @@ def chain_ik(k: Chain, sole: Sole, f: Rot) -> tuple[list[float], bool]:
     rz = f2 * wx + f5 * wy + f8 * wz
     sg = 1.0 if rz >= 0 else -1.0
     rho = sqrt(ry * ry + rz * rz)
-    inv = 1.0 / (rho if rho > 1e-300 else 1e-300)
-    x = sg * (k0 + k1) * inv
+    x = sg * (k0 + k1) / (rho if rho > 1e-300 else 1e-300)
     side_ok = abs(x) <= 1.0
-    x = -1.0 if x < -1.0 else 1.0 if x > 1.0 else x
-    cg, sn = sg * rz * inv + (rho == 0.0), sg * ry * inv
-    cb = sqrt(1.0 - x * x)
-    c6, s6 = cg * cb + sn * x, sn * cb - cg * x
+    roll = atan2(ry * sg, rz * sg) - asin(-1.0 if x < -1.0 else 1.0 if x > 1.0 else x)
     if k1 != 0.0:
         gc, gs = (f7, f8) if yaw_roll else (f1, f2)
         for _ in range(NEWTON):
-            nc = gc * c6 - gs * s6
+            c, s = cos(roll), sin(roll)
+            nc = gc * c - gs * s
             root = 1.0 - nc * nc
             root = sqrt(root if root > 1e-24 else 1e-24)
-            g = c6 * ry - s6 * rz - k0 - k1 * root
-            dg = -s6 * ry - c6 * rz - k1 * nc * (gc * s6 + gs * c6) / root
-            d = g / (dg + (1.0 if dg >= 0 else -1.0) * 1e-300)
-            d = -MAX_STEP if d < -MAX_STEP else MAX_STEP if d > MAX_STEP else d
-            t = 0.5 * d * (1.0 + d * d / 12.0)
-            w = 1.0 / (1.0 + t * t)
-            cd, sd = (1.0 - t * t) * w, 2.0 * t * w
-            c6, s6 = c6 * cd + s6 * sd, s6 * cd - c6 * sd
+            g = c * ry - s * rz - k0 - k1 * root
+            dg = -s * ry - c * rz - k1 * nc * (gc * s + gs * c) / root
+            step = g / (dg + (1.0 if dg >= 0 else -1.0) * 1e-300)
+            roll = roll - (-MAX_STEP if step < -MAX_STEP else MAX_STEP if step > MAX_STEP
+                           else step)
         side_ok = abs(k0 + k1 * root) <= rho
-    roll = atan2(s6, c6)
+    c6, s6 = cos(roll), sin(roll)
     n0, n1, n2 = c6 * f1 - s6 * f2, c6 * f4 - s6 * f5, c6 * f7 - s6 * f8
     e0, e1, e2 = c6 * f2 + s6 * f1, c6 * f5 + s6 * f4, c6 * f8 + s6 * f7
     if yaw_roll:
-        cr = sqrt(n0 * n0 + n1 * n1)
-        yaw, hip_roll = atan2(-n0, n1), atan2(n2, cr)
-        h = 1.0 / (cr if cr > 1e-300 else 1e-300)
-        cy, sy_, sr = n1 * h + (cr == 0.0), -n0 * h, n2
+        yaw = atan2(-n0, n1)
+        hip_roll = atan2(n2, sqrt(n0 * n0 + n1 * n1))
     else:
-        cy = sqrt(n1 * n1 + n2 * n2)
-        yaw, hip_roll = atan2(-n0, cy), atan2(n2, n1)
-        h = 1.0 / (cy if cy > 1e-300 else 1e-300)
-        sy_, cr, sr = -n0, n1 * h + (cy == 0.0), n2 * h
+        yaw = atan2(-n0, sqrt(n1 * n1 + n2 * n2))
+        hip_roll = atan2(n2, n1)
+    cy, sy_ = cos(yaw), sin(yaw)
+    cr, sr = cos(hip_roll), sin(hip_roll)
     if yaw_roll:
         hpx = px + (cy * ux - sy_ * uy) - drop * (sy_ * sr)
         hpy = py + (sy_ * ux + cy * uy) + drop * (cy * sr)

@@ -17,10 +17,11 @@ r = F^T (A - P) this reads
 (g: row z of F for yaw_roll, row x for roll_yaw). With k1 = u_y = 0 it is linear in
 (cos a, sin a): a = atan2(r_y, r_z) - asin(k0 / |r|), the box model's atan2 when k0 = 0.
 Otherwise ``NEWTON`` Newton steps from that with the root term at 1 (the error falls from
-~k1 (1 - cos) / |r| to ~1e-15 rad in three: tests/test_ik_chain.py). n then gives the hip
-yaw and roll, these the hip pitch point, and the knee, ankle pitch and hip pitch follow
-as robot.gait.ik.leg_ik's: the law of cosines in the pitch plane, clamped along the ankle
-→ hip line within the knee limits' span.
+~k1 (1 - cos) / |r| to ~1e-14 rad in two while |u_y| < 0.1 (thigh + shin), else in three:
+tests/test_ik_chain.py). n then gives the hip yaw and roll, these the hip pitch point,
+and the knee, ankle pitch and hip pitch follow as robot.gait.ik.leg_ik's: the law of
+cosines in the pitch plane, clamped along the ankle → hip line within the knee limits'
+span.
 
 A leg without ankle roll keeps the sole point and the foot's x axis (its heading and
 pitch) exactly and gives up the roll about that axis: the same equation with A the sole
@@ -41,8 +42,10 @@ from robot.gait import xmath as xm
 from robot.gait.ik import REACH_TOL, LegIK, Reach, leg_ik_at
 from robot.gait.xmath import Rot, Vec
 
-#: Newton steps on the lateral constraint when the yaw axis is off the hip sideways.
-NEWTON = 3
+#: Newton steps on the lateral constraint when the yaw axis is off the hip sideways: 2
+#: while that offset is under ``NEWTON_NEAR`` of the leg's length (thigh + shin), else 3.
+NEWTON = (2, 3)
+NEWTON_NEAR = 0.1
 #: The largest Newton step [rad]: a guard for targets far out of reach.
 MAX_STEP = 0.5
 
@@ -77,6 +80,7 @@ class Chain(NamedTuple):
     hi: float
     lo_tol: float    # lo - REACH_TOL
     hi_tol: float    # hi + REACH_TOL
+    steps: int       # Newton steps (NEWTON)
 
 
 def layout_name(leg: LegChain) -> str:
@@ -127,7 +131,8 @@ def chain_constants(leg: LegChain, span: Reach | None = None) -> Chain:
     lo, hi = span if span is not None else (abs(a - b), a + b)
     return Chain(six, yaw_roll, px, py, hz, ux, uy, hx, hy, hz, leg.roll_drop,
                  leg.ankle_drop, sx, sy, oz, k0, k1, a, b, a + b, abs(a - b), 4.0 * a * b,
-                 lo, hi, lo - REACH_TOL, hi + REACH_TOL)
+                 lo, hi, lo - REACH_TOL, hi + REACH_TOL,
+                 NEWTON[0] if abs(uy) < NEWTON_NEAR * (a + b) else NEWTON[1])
 
 
 def chain_leg_ik(leg: LegChain, sole: Vec, foot_rot: Rot = xm.IDENTITY, *,
@@ -159,7 +164,7 @@ def chain_leg_ik(leg: LegChain, sole: Vec, foot_rot: Rot = xm.IDENTITY, *,
     roll = xm.atan2(ry * sg, rz * sg) - xm.asin(x)
     if k.k1 != 0.0:
         gc, gs = (f7, f8) if k.yaw_roll else (f1, f2)
-        for _ in range(NEWTON):
+        for _ in range(k.steps):
             c, s = xm.cos(roll), xm.sin(roll)
             nc = gc * c - gs * s
             root = xm.sqrt(xm.maximum(1.0 - nc * nc, 1e-24))

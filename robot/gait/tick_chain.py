@@ -14,7 +14,7 @@ from typing import Any
 
 from robot.body.legs import LegChain
 from robot.gait.ik import Reach
-from robot.gait.ik_chain import MAX_STEP, NEWTON, Chain, chain_constants
+from robot.gait.ik_chain import MAX_STEP, Chain, chain_constants
 from robot.gait.tick_limbs import leg_constants, leg_ik
 from robot.gait.xmath import Rot
 
@@ -33,7 +33,7 @@ def leg_solver(leg: LegChain, span: Reach) -> Solver:
 def chain_ik(k: Chain, sole: Sole, f: Rot) -> tuple[list[float], bool]:
     """chain_leg_ik on floats: the six leg angles [rad] and the reachable flag."""
     (six, yaw_roll, px, py, pz, ux, uy, hx, hy, hz, drop, ad, ox, oy, oz, k0, k1, a, b,
-     far, near, span, lo, hi, lo_tol, hi_tol) = k
+     far, near, span, lo, hi, lo_tol, hi_tol, steps) = k
     f0, f1, f2, f3, f4, f5, f6, f7, f8 = f
     sx, sy, sz = sole
     if six:
@@ -52,7 +52,7 @@ def chain_ik(k: Chain, sole: Sole, f: Rot) -> tuple[list[float], bool]:
     roll = atan2(ry * sg, rz * sg) - asin(-1.0 if x < -1.0 else 1.0 if x > 1.0 else x)
     if k1 != 0.0:
         gc, gs = (f7, f8) if yaw_roll else (f1, f2)
-        for _ in range(NEWTON):
+        for _ in range(steps):
             c, s = cos(roll), sin(roll)
             nc = gc * c - gs * s
             root = 1.0 - nc * nc

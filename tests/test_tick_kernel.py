@@ -2,8 +2,10 @@
 
 ``TickKernel.pose`` must give exactly what ``expressions.channels`` → ``targets.body_targets``
 → ``engine.solve`` give on Python floats, for any parameters, phase, envelope and trim
-(including unreachable targets, turning and the 5-DoF legs). Compared as the bits of each
-float (``struct``), so -0.0 and 0.0 differ.
+(including unreachable targets, turning and the 5-DoF legs), and for legs with real
+offsets (robot.gait.ik_chain: 6-DoF, without hip yaw, without ankle roll in both hip
+orders, with and without Newton steps). Compared as the bits of each float (``struct``),
+so -0.0 and 0.0 differ.
 """
 
 from __future__ import annotations

@@ -22,119 +22,25 @@ child body); other world geoms (a floor in a scene file) are not part of it.
 
 from __future__ import annotations
 
-import struct
-import xml.etree.ElementTree as ET
+import dataclasses
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
+from robot.body.checks import check_tree
+from robot.body.mjcf_files import prepare
 from robot.body.tree import BodyTree, Frame, Hinge, Inertial, Link, Shape, equivalent_box, quat_to_matrix
 from robot.errors import ConfigError
 
-#: Hull vertices kept per mesh (MuJoCo's ``maxhullvert``): a foot sole's hull keeps its
-#: outline (an STL sole of 1025 vertices: 32 hull vertices within 0.1 mm of its extent).
-MAX_HULL = 32
+#: Hull vertices kept per mesh (MuJoCo's ``maxhullvert``), as robot/body/meshes.py keeps
+#: for a URDF's meshes: on the Open Duck Mini's 17 STLs the dropped hull vertices lie at
+#: most 1.1 mm outside the kept hull (median 0.2 mm).
+MAX_HULL = 64
 GEOM_KINDS = {int(mujoco.mjtGeom.mjGEOM_BOX): "box", int(mujoco.mjtGeom.mjGEOM_SPHERE): "sphere",
               int(mujoco.mjtGeom.mjGEOM_CAPSULE): "capsule",
               int(mujoco.mjtGeom.mjGEOM_CYLINDER): "cylinder"}
 _MESH = int(mujoco.mjtGeom.mjGEOM_MESH)
-_DROPPED = ("texture", "hfield", "skin")
-
-
-def _stand_in() -> bytes:
-    """A binary STL tetrahedron one unit across (a missing mesh's placeholder)."""
-    tris = (((0, 0, 0), (1, 0, 0), (0, 1, 0)), ((0, 0, 0), (0, 1, 0), (0, 0, 1)),
-            ((0, 0, 0), (0, 0, 1), (1, 0, 0)), ((1, 0, 0), (0, 1, 0), (0, 0, 1)))
-    out = bytearray(b"\0" * 80 + struct.pack("<I", len(tris)))
-    for tri in tris:
-        out += struct.pack("<3f", 0.0, 0.0, 0.0)
-        for v in tri:
-            out += struct.pack("<3f", *(float(c) for c in v))
-        out += b"\0\0"
-    return bytes(out)
-
-
-def find_file(folder: Path, name: str, warnings: list[str], *, where: str) -> Path | None:
-    """``folder / name``, or the one file there whose path differs only in case (with a
-    warning); None if there is none."""
-    path = folder / name
-    if path.is_file():
-        return path
-    parent = path.parent
-    if not parent.is_dir():
-        return None
-    matches = [p for p in parent.iterdir() if p.name.lower() == path.name.lower() and p.is_file()]
-    if len(matches) == 1:
-        warnings.append(f"{where}: mesh file {name!r} found as {matches[0].name!r} "
-                        "(differs in case)")
-        return matches[0]
-    return None
-
-
-def _expand(path: Path, seen: tuple[Path, ...] = ()) -> ET.Element:
-    """The file's root element with every ``<include file=...>`` replaced by the included
-    file's children (relative to the including file)."""
-    try:
-        root = ET.parse(path).getroot()
-    except OSError as e:
-        raise ConfigError(f"{path}: cannot read the model: {e.strerror or e}") from e
-    except ET.ParseError as e:
-        raise ConfigError(f"{path}: not well-formed XML: {e}") from e
-    for parent in list(root.iter()):
-        for i, child in enumerate(list(parent)):
-            if child.tag != "include":
-                continue
-            inc = (path.parent / child.get("file", "")).resolve()
-            if inc in seen or len(seen) > 16:
-                raise ConfigError(f"{path}: include {child.get('file')!r} includes itself")
-            parent.remove(child)
-            for k, sub in enumerate(list(_expand(inc, (*seen, inc)))):
-                parent.insert(i + k, sub)
-    return root
-
-
-def _prepare(path: Path, max_hull: int, warnings: list[str]
-             ) -> tuple[str, dict[str, bytes], dict[str, tuple[str, str]]]:
-    """The XML to compile, its mesh assets, and per stand-in mesh name (the referenced
-    file, the mesh's name in the model)."""
-    root = _expand(path)
-    if root.tag != "mujoco":
-        raise ConfigError(f"{path}: not an MJCF file (its root element is <{root.tag}>, "
-                          "expected <mujoco>; a URDF? it is read by its .urdf suffix)")
-    compiler = root.find("compiler")
-    meshdir = assetdir = ""
-    if compiler is not None:
-        assetdir = compiler.get("assetdir", "")
-        meshdir = compiler.get("meshdir", assetdir)
-        for key in ("meshdir", "assetdir", "texturedir"):
-            compiler.attrib.pop(key, None)
-    folder = path.parent / meshdir
-    assets: dict[str, bytes] = {}
-    missing: dict[str, tuple[str, str]] = {}
-    stand_in = _stand_in()
-    for parent in list(root.iter()):
-        for el in list(parent):
-            if el.tag in _DROPPED:
-                parent.remove(el)
-            elif el.tag == "material":
-                el.attrib.pop("texture", None)
-    for i, mesh in enumerate(root.iter("mesh")):
-        ref = mesh.get("file")
-        if ref is None:
-            continue   # a mesh given by its vertices in the file
-        name = mesh.get("name") or Path(ref).stem
-        mesh.set("name", name)
-        key = f"biped_mesh_{i}{Path(ref).suffix.lower() or '.stl'}"
-        mesh.set("file", key)
-        mesh.set("maxhullvert", str(max_hull))
-        found = find_file(folder, ref, warnings, where=str(path))
-        if found is None:
-            assets[key] = stand_in
-            missing[name] = (ref, name)
-        else:
-            assets[key] = found.read_bytes()
-    return ET.tostring(root, encoding="unicode"), assets, missing
 
 
 def _robot_root(model: mujoco.MjModel, path: Path) -> int:
@@ -206,12 +112,14 @@ def hull_of(model: mujoco.MjModel, mesh: int) -> tuple[tuple[float, float, float
     return tuple((float(x), float(y), float(z)) for x, y, z in pts)
 
 
-def read_mjcf(path: str | Path, *, missing_mesh: str = "error", max_hull: int = MAX_HULL
-              ) -> tuple[BodyTree, list[str]]:
-    """The robot in MJCF file ``path`` and the warnings (see the module docstring)."""
+def read_mjcf(path: str | Path, *, missing_mesh: str = "error", max_hull: int = MAX_HULL,
+              fix_inertia: bool = False) -> tuple[BodyTree, list[str]]:
+    """The robot in MJCF file ``path`` and the warnings (see the module docstring); the
+    tree passes robot/body/checks.py (``fix_inertia``: fixed where it can be, with a
+    warning)."""
     p = Path(path)
     warnings: list[str] = []
-    xml, assets, missing = _prepare(p, max_hull, warnings)
+    xml, assets, missing = prepare(p, max_hull, warnings)
     try:
         model = mujoco.MjModel.from_xml_string(xml, assets)
     except ValueError as e:
@@ -236,6 +144,9 @@ def read_mjcf(path: str | Path, *, missing_mesh: str = "error", max_hull: int = 
                 raise ConfigError(f"{p}: body {model.body(b).name!r}: a collision mesh is "
                                   "missing and the body has no mass to size a stand-in box")
             shapes.append(equivalent_box(inertial, note=notes))
+            warnings.append(f"{p}: body {name!r}: collision mesh{'es' if notes.count(';') else ''} "
+                            f"missing ({notes.replace('stand-in for missing mesh ', '')}): the "
+                            "body's equivalent-inertia box instead")
         frames = tuple(Frame(model.site(s).name, tuple(map(float, model.site_pos[s])),  # type: ignore[arg-type]
                              tuple(map(float, model.site_quat[s])))  # type: ignore[arg-type]
                        for s in range(model.nsite) if model.site_bodyid[s] == b and model.site(s).name)
@@ -249,7 +160,41 @@ def read_mjcf(path: str | Path, *, missing_mesh: str = "error", max_hull: int = 
         b1, b2 = int(sig) >> 16, int(sig) & 0xFFFF
         if b1 in index and b2 in index:
             excludes.append((links[index[b1]].name, links[index[b2]].name))
-    return BodyTree(tuple(links), source=str(p), excludes=tuple(excludes)), warnings
+    tree, fixed = check_tree(_frames_kept(BodyTree(tuple(links), source=str(p),
+                                                   excludes=tuple(excludes))), fix=fix_inertia)
+    return tree, warnings + fixed
+
+
+#: A welded body lighter than this, with no shapes and no children, is a marker: an
+#: exporter's frame (onshape-to-robot writes its frames as 1e-9 kg bodies) [kg].
+MARKER_MASS = 1e-6
+
+
+def _frames_kept(tree: BodyTree) -> BodyTree:
+    """``tree`` with every marker body (MARKER_MASS) turned into a Frame of its name on its
+    parent."""
+    parents = {link.parent for link in tree.links}
+    marker = {i for i, link in enumerate(tree.links)
+              if i > 0 and link.joint is None and not link.shapes and i not in parents
+              and (link.inertial is None or link.inertial.mass < MARKER_MASS)}
+    if not marker:
+        return tree
+    extra: dict[int, list[Frame]] = {}
+    for i in marker:
+        link = tree.links[i]
+        extra.setdefault(link.parent, []).append(Frame(link.name, link.pos, link.quat))
+    new_index: dict[int, int] = {}
+    links: list[Link] = []
+    for i, link in enumerate(tree.links):
+        if i in marker:
+            continue
+        new_index[i] = len(links)
+        links.append(dataclasses.replace(
+            link, parent=new_index[link.parent] if link.parent >= 0 else -1,
+            frames=(*link.frames, *extra.get(i, ()))))
+    names = {link.name for link in links}
+    excludes = tuple(pair for pair in tree.excludes if set(pair) <= names)
+    return BodyTree(tuple(links), source=tree.source, excludes=excludes)
 
 
 def _under(model: mujoco.MjModel, b: int, root: int) -> bool:
@@ -286,8 +231,6 @@ def _shape(model: mujoco.MjModel, g: int, b: int, missing: dict[str, tuple[str, 
             raise ConfigError(f"{path}: body {bname!r}: collision mesh {mname!r} (file {ref!r}) "
                               "is missing; put the file where the model says, or import with "
                               "--missing-meshes box to use the body's equivalent-inertia box")
-        warnings.append(f"{path}: body {bname!r}: collision mesh {mname!r} (file {ref!r}) is "
-                        "missing: replaced by the body's equivalent-inertia box")
         return Shape("inertia_box", name=gname, note=f"stand-in for missing mesh {ref}")
     verts = hull_of(model, mesh)
     return Shape("hull", pos, quat, vertices=verts, name=gname,  # type: ignore[arg-type]

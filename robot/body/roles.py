@@ -30,7 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robot.body.limbs import SNAP_TOL, Limb, find_limbs, link_points, robot_axes, side_of
+from robot.body.limbs import SNAP_TOL, Limb, find_limbs, robot_axes, side_of
+from robot.body.pose import Pose, sole_normal
 from robot.body.tree import Array, BodyTree
 from robot.errors import ConfigError
 
@@ -83,38 +84,6 @@ def extra_name(model_joint: str) -> str:
     return (name if name[0].isalpha() else f"j_{name}")[:32]
 
 
-class _Pose:
-    """The model at the offsets found so far, seen in the robot frame."""
-
-    def __init__(self, tree: BodyTree, axes: Array) -> None:
-        self.tree, self.axes, self.angles = tree, axes, {}
-        self.update()
-
-    def update(self) -> None:
-        self.pos, self.rot = self.tree.poses(self.angles)
-
-    def axis(self, link: int) -> Array:
-        hinge = self.tree.links[link].joint
-        assert hinge is not None
-        return self.axes @ self.rot[link] @ np.asarray(hinge.axis, float)
-
-    def anchor(self, link: int) -> Array:
-        hinge = self.tree.links[link].joint
-        assert hinge is not None
-        return self.axes @ (self.pos[link] + self.rot[link] @ np.asarray(hinge.pos, float))
-
-    def turn(self, link: int, about: Array, angle: float) -> None:
-        """Turn ``link``'s hinge by ``angle`` [rad] about the robot axis ``about``."""
-        hinge = self.tree.links[link].joint
-        assert hinge is not None
-        sign = 1.0 if float(self.axis(link) @ about) > 0 else -1.0
-        self.angles[hinge.name] = self.angles.get(hinge.name, 0.0) + sign * angle
-        self.update()
-
-    def points(self, links: list[int]) -> Array:
-        return np.concatenate([link_points(self.tree, i, self.pos, self.rot) for i in links]) @ self.axes.T
-
-
 def _letter(v: Array) -> str:
     k = int(np.argmax(np.abs(v)))
     return "xyz"[k] if math.acos(min(abs(float(v[k])) / float(np.linalg.norm(v)), 1.0)) <= SNAP_TOL else "?"
@@ -130,25 +99,7 @@ def _angle_to(v: Array, about: Array, target: Array) -> float:
     return math.atan2(float(np.cross(a, b) @ about), float(a @ b))
 
 
-def sole_normal(pose: _Pose, foot_links: list[int]) -> Array:
-    """The downward normal of the lowest face of the foot's shapes (robot frame)."""
-    pts = pose.points(foot_links)
-    down = -Z
-    for _ in range(4):
-        h = pts @ down
-        low = pts[h >= h.max() - SOLE_BAND]
-        if len(low) < 3:
-            return down
-        centred = low - low.mean(axis=0)
-        normal = np.linalg.svd(centred)[2][-1]
-        normal = normal if normal @ down > 0 else -normal
-        if np.linalg.norm(np.cross(normal, down)) < 1e-12:
-            break
-        down = normal
-    return down
-
-
-def _leg_roles(pose: _Pose, limb: Limb, side: str, feet: list[int]) -> tuple[list[JointRole], str]:
+def _leg_roles(pose: Pose, limb: Limb, side: str, feet: list[int]) -> tuple[list[JointRole], str]:
     tree = pose.tree
     hinges = list(limb.hinges)
     names = [tree.links[i].joint.name for i in hinges]  # type: ignore[union-attr]
@@ -169,6 +120,9 @@ def _leg_roles(pose: _Pose, limb: Limb, side: str, feet: list[int]) -> tuple[lis
             below = hinges[k + 1]
             v = pose.anchor(below) - pose.anchor(link)
             pose.turn(link, Y, _angle_to(v, Y, -Z))
+        elif letter == "y" and nxt is not None:          # ankle pitch: the roll axis along x
+            nax = pose.axis(nxt)
+            pose.turn(link, Y, _angle_to(nax, Y, X * (1.0 if nax @ X >= 0 else -1.0)))
         elif letter == "y":                              # ankle pitch: sole level in pitch
             pose.turn(link, Y, _angle_to(sole_normal(pose, feet), Y, -Z))
         elif letter == "x":                              # ankle roll: sole level in roll
@@ -194,7 +148,7 @@ def _wrap(a: float) -> float:
     return math.atan2(math.sin(a), math.cos(a))
 
 
-def _arm_roles(pose: _Pose, limb: Limb, side: str) -> list[JointRole]:
+def _arm_roles(pose: Pose, limb: Limb, side: str) -> list[JointRole]:
     tree = pose.tree
     hinges = list(limb.hinges)
     upper_end = pose.anchor(hinges[2])
@@ -260,7 +214,7 @@ def find_roles(tree: BodyTree) -> Roles:
                           "joints where two legs were expected; name the joints with --map")
     leg_pair = legs[0]
     axes = robot_axes(tree, leg_pair)
-    pose = _Pose(tree, axes)
+    pose = Pose(tree, axes)
     joints: list[JointRole] = []
     order = "yaw_roll"
     for limb, side in zip(leg_pair, "rl", strict=True):

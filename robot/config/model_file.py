@@ -235,7 +235,10 @@ def parse_model(src: str, value: TomlValue) -> BodyModel:
         index[link.name] = k
         links.append(link)
     excludes = []
-    for k, pair in enumerate(tab.get("excludes", [])):  # type: ignore[union-attr]
+    pairs = tab.get("excludes", [])
+    if not isinstance(pairs, list):
+        raise ConfigError(f"{src}: model.excludes: expected a list of [link, link] pairs")
+    for k, pair in enumerate(pairs):
         if not (isinstance(pair, list) and len(pair) == 2 and all(p in index for p in pair)):
             raise ConfigError(f"{src}: model.excludes[{k}]: expected two link names, got {show(pair)}")
         excludes.append((str(pair[0]), str(pair[1])))

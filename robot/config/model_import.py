@@ -15,6 +15,7 @@ What each joint gets (robot/body/roles.py finds the roles, signs and offsets):
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,8 +33,12 @@ from robot.servo.models import MODELS, ServoModel
 
 #: The rest pose of a straight-legged robot [rad]: knees bent as the bundled robots rest.
 REST = {"hip_pitch": -0.55, "knee": 1.1, "ankle_pitch": -0.55}
-MAP_KEYS = {"name", "servo_id", "min_rad", "max_rad", "max_speed_rad_s", "limits_source",
-            "fixed_rad"}
+#: What ``--map`` may say of a model joint: its name (an extra joint's), its servo's id,
+#: limits in the project's convention (min_rad, max_rad) or the model's (model_range,
+#: [rad]: where a vendor documents them so) and where they come from, a slew limit, the
+#: angle an extra joint is held at, weld (true: no servo drives it; welded at the model's zero).
+MAP_KEYS = {"name", "servo_id", "min_rad", "max_rad", "model_range", "max_speed_rad_s",
+            "limits_source", "fixed_rad", "weld"}
 
 
 @dataclass(frozen=True)
@@ -94,12 +99,14 @@ def _sole_frames(tree: BodyTree, roles: Roles, m: Measured) -> BodyTree:
                            link.shapes, (*link.frames, Frame(f"{side}_sole", tuple(map(float, local)),  # type: ignore[arg-type]
                                                                quat)))
     torso = sorted(torso_links(tree))
-    mass = sum(tree.links[i].inertial.mass for i in torso if tree.links[i].inertial)  # type: ignore[union-attr]
-    com = sum(tree.links[i].inertial.mass * (pos[i] + rot[i] @ np.asarray(tree.links[i].inertial.com))  # type: ignore[union-attr]
-              for i in torso if tree.links[i].inertial) / max(mass, 1e-12)
+    weighed = [(link.inertial.mass, pos[i] + rot[i] @ np.asarray(link.inertial.com))
+               for i in torso if (link := tree.links[i]).inertial is not None]
+    mass = sum(w for w, _ in weighed)
+    com = sum((w * c for w, c in weighed), np.zeros(3)) / max(mass, 1e-12)
     root = links[0]
     links[0] = Link(root.name, -1, root.pos, root.quat, root.inertial, None, root.shapes,
-                    (*root.frames, Frame("imu", tuple(map(float, com)), matrix_to_quat(axes.T))))  # type: ignore[arg-type]
+                    (*root.frames, Frame("imu", (float(com[0]), float(com[1]), float(com[2])),
+                                         matrix_to_quat(axes.T))))
     del by
     return BodyTree(tuple(links), source=tree.source, excludes=tree.excludes)
 
@@ -111,7 +118,19 @@ def _order(name: str) -> tuple[int, int]:
 
 def build(tree: BodyTree, *, servo: ServoModel, joint_map: dict[str, dict[str, object]],
           file: str, source: str = "", licence: str = "") -> Imported:
-    """Roles, measurements and joint tables of ``tree`` (see the module docstring)."""
+    """Roles, measurements and joint tables of ``tree`` (see the module docstring). A
+    model joint the map marks ``weld = true`` (one no servo drives: a PWM servo off the
+    bus, a passive part) is welded at the model's zero."""
+    welded = [n for n, e in joint_map.items() if e.get("weld") is True]
+    missing = [n for n in welded if n not in tree.joint_link]
+    if missing:
+        raise ConfigError(f"--map: joints.{missing[0]}: the model has no joint of that name; "
+                          f"valid: {', '.join(tree.joint_link)}")
+    if welded:
+        tree = dataclasses.replace(tree, links=tuple(
+            dataclasses.replace(link, joint=None) if link.joint and link.joint.name in welded
+            else link for link in tree.links))
+        joint_map = {n: e for n, e in joint_map.items() if n not in welded}
     roles = find_roles(tree)
     m = measure(tree, roles)
     warnings: list[str] = []
@@ -124,6 +143,7 @@ def build(tree: BodyTree, *, servo: ServoModel, joint_map: dict[str, dict[str, o
                       tuple(map(float, m.origin @ roles.axes)), m.legs, file, source, licence)  # type: ignore[arg-type]
     ordered = sorted(roles.joints, key=lambda j: _order(j.name))
     ids_used: set[int] = set()
+    unlimited: list[str] = []
     joints = []
     for k, role in enumerate(ordered):
         entry = joint_map.get(role.model_joint, {})
@@ -139,10 +159,20 @@ def build(tree: BodyTree, *, servo: ServoModel, joint_map: dict[str, dict[str, o
         assert hinge is not None
         per_rad = servo.ticks_per_rad
         centre = servo.resolution // 2
-        if hinge.range is not None:
-            ends = sorted(((hinge.range[0] - role.offset) * role.sign,
-                           (hinge.range[1] - role.offset) * role.sign))
-            lo, hi, src = ends[0], ends[1], "the model's range"
+        model_range = hinge.range
+        src = "the model's range"
+        if model_range is None and "model_range" in entry:
+            raw = entry["model_range"]
+            if not (isinstance(raw, list) and len(raw) == 2 and all(
+                    isinstance(v, int | float) and math.isfinite(v) for v in raw) and raw[0] < raw[1]):
+                raise ConfigError(f"--map: joints.{role.model_joint}.model_range: expected [lo, hi] "
+                                  f"[rad] with lo < hi, got {raw!r}")
+            model_range = (float(raw[0]), float(raw[1]))
+            src = str(entry.get("limits_source", "--map"))
+        if model_range is not None:
+            ends = sorted(((model_range[0] - role.offset) * role.sign,
+                           (model_range[1] - role.offset) * role.sign))
+            lo, hi = ends[0], ends[1]
         elif "min_rad" in entry and "max_rad" in entry:
             lo, hi = float(entry["min_rad"]), float(entry["max_rad"])  # type: ignore[arg-type]
             src = str(entry.get("limits_source", "--map"))
@@ -151,9 +181,7 @@ def build(tree: BodyTree, *, servo: ServoModel, joint_map: dict[str, dict[str, o
             lo, hi = -half - role.offset * role.sign, half - role.offset * role.sign
             lo, hi = sorted((lo, hi))
             src = f"the {servo.name}'s whole range (the model gives none)"
-            warnings.append(f"{role.model_joint} ({name}): no joint limits in the model: "
-                            f"the servo's whole range [{lo:.3f}, {hi:.3f}] rad; give real "
-                            "limits with --map (min_rad, max_rad)")
+            unlimited.append(role.model_joint)
         lo, hi = max(lo, -math.pi), min(hi, math.pi)
         speed = servo.no_load_speed if hinge.velocity is None else min(hinge.velocity, servo.no_load_speed)
         speed = min(speed, float(entry.get("max_speed_rad_s", speed)))  # type: ignore[arg-type]
@@ -163,6 +191,10 @@ def build(tree: BodyTree, *, servo: ServoModel, joint_map: dict[str, dict[str, o
             fixed = min(max(float(entry.get("fixed_rad", 0.0)), lo), hi)  # type: ignore[arg-type]
         joints.append(JointEntry(name, role.model_joint, role.sign, role.offset, servo_id,
                                  role.sign, zero, lo, hi, round(min(speed, 20.0), 3), src, fixed))
+    if unlimited:
+        warnings.append(f"no joint limits in the model for {', '.join(unlimited)}: each gets "
+                        f"the {servo.name}'s whole range; give real limits with --map "
+                        "(min_rad, max_rad, limits_source)")
     return Imported(model, joints, m, roles, warnings)
 
 
@@ -203,3 +235,60 @@ def _yaw_off(leg: object) -> float:
     if leg.yaw_axis is None:
         return 0.0
     return math.hypot(leg.yaw_axis[0] - leg.hip[0], leg.yaw_axis[1] - leg.hip[1])
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """An import's ``--map`` file: per model joint what MAP_KEYS allow; the bus (kind,
+    model, baud), the gain registers and balance gains the robot file gets; where the
+    model comes from, its licence, and notes for the file's opening comment."""
+
+    joints: dict[str, dict[str, object]] = field(default_factory=dict)
+    bus: dict[str, object] = field(default_factory=dict)
+    gains: dict[str, int] = field(default_factory=dict)
+    balance: dict[str, float] = field(default_factory=dict)
+    source: str = ""
+    licence: str = ""
+    notes: tuple[str, ...] = ()
+
+
+RECIPE_KEYS = ("joints", "bus", "balance", "source", "licence", "notes")
+
+
+def read_map(path: str | None) -> Recipe:
+    """The ``--map`` file at ``path`` (None: an empty one); one-line ConfigError."""
+    if path is None:
+        return Recipe()
+    from robot.config.toml_io import read_toml
+
+    data = read_toml(Path(path))
+    where = f"--map {path}"
+    bad = sorted(set(data) - set(RECIPE_KEYS))
+    if bad:
+        raise ConfigError(f"{where}: {bad[0]}: unknown key; valid: {', '.join(RECIPE_KEYS)}")
+    joints = data.get("joints", {})
+    if not isinstance(joints, dict):
+        raise ConfigError(f"{where}: joints: expected [joints.MODEL_JOINT] tables")
+    out: dict[str, dict[str, object]] = {}
+    for name, tab in joints.items():
+        if not isinstance(tab, dict):
+            raise ConfigError(f"{where}: joints.{name}: expected a table")
+        unknown = sorted(set(tab) - MAP_KEYS)
+        if unknown:
+            raise ConfigError(f"{where}: joints.{name}.{unknown[0]}: unknown key; valid: "
+                              f"{', '.join(sorted(MAP_KEYS))}")
+        out[name] = dict(tab)
+    bus = data.get("bus", {})
+    balance = data.get("balance", {})
+    notes = data.get("notes", [])
+    if not isinstance(bus, dict) or not isinstance(balance, dict) or not isinstance(notes, list):
+        raise ConfigError(f"{where}: bus and balance must be tables, notes a list of strings")
+    gains = bus.pop("gains", {}) if isinstance(bus.get("gains", {}), dict) else None
+    if gains is None:
+        raise ConfigError(f"{where}: bus.gains: expected a table of register values")
+    unknown = sorted(set(bus) - {"kind", "model", "baud"})
+    if unknown:
+        raise ConfigError(f"{where}: bus.{unknown[0]}: unknown key; valid: kind, model, baud, gains")
+    return Recipe(out, dict(bus), dict(gains), dict(balance),  # type: ignore[arg-type]
+                  str(data.get("source", "")), str(data.get("licence", "")),
+                  tuple(str(n) for n in notes))

@@ -8,6 +8,7 @@ IK and ``biped mjcf`` use the model's own body.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 from robot.config.model_file import _q, model_toml, num
 from robot.config.model_import import Imported
@@ -19,11 +20,17 @@ GEOMETRY_ORDER = ("hip_width", "thigh", "shin", "ankle_height", "foot_length", "
 
 
 def robot_file_text(imp: Imported, *, name: str, kind: str, servo: ServoModel, baud: int,
-                    header: list[str]) -> str:
-    """The robot file for ``imp`` (``header``: comment lines to open it with)."""
+                    header: list[str], gains: Mapping[str, int] | None = None,
+                    balance: Mapping[str, float] | None = None) -> str:
+    """The robot file for ``imp`` (``header``: comment lines to open it with; ``gains``:
+    ``[bus.gains]``; ``balance``: ``[balance]``)."""
     out = [f"# {line}" if line else "#" for line in header]
     out += ["", f"name = {_q(name)}", "", "[bus]", f"kind = {_q(kind)}", f"model = {_q(servo.name)}",
             'port = "/dev/ttyUSB0"', f"baud = {baud}", "",
+            *(["[bus.gains]  # written by the driver before torque on (docs/servos.md)",
+               *(f"{k} = {v}" for k, v in gains.items()), ""] if gains else []),
+            *(["[balance]  # this robot's balance gains (docs/gait.md)",
+               *(f"{k} = {num(float(v))}" for k, v in balance.items()), ""] if balance else []),
             "[imu]  # simulated at the torso's centre of mass (the model's \"imu\" frame); docs/imu.md",
             'kind = "sim"', "", "[geometry]  # measured from the model at the zero pose [m]; "
             "scales the gait (the sim and the IK use [model])"]

@@ -30,6 +30,7 @@ import numpy.typing as npt
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from sim.mujoco.geoms import foot_geoms, geom_points
+from sim.mujoco.mjcf_body import add_body_actuators, add_body_defaults, add_body_worldbody
 from sim.mujoco.mjcf_robot import add_actuators_and_sensors, add_assets, add_defaults, add_worldbody, fmt
 
 if TYPE_CHECKING:
@@ -77,18 +78,31 @@ def _to_string(root: ET.Element) -> str:
 
 
 def robot_xml(robot: RobotConfig, *, timestep: float = DEFAULT_TIMESTEP,
-              home: npt.NDArray[np.float64] | None = None) -> str:
-    """The robot MJCF; ``home`` (qpos) adds the ``home`` keyframe (ctrl = its joints)."""
+              home: npt.NDArray[np.float64] | None = None,
+              ctrl: npt.NDArray[np.float64] | None = None) -> str:
+    """The robot MJCF; ``home`` (qpos) adds the ``home`` keyframe with ``ctrl`` (default:
+    its joints, in actuator order)."""
     root = ET.Element("mujoco", model=robot.name)
-    ET.SubElement(root, "compiler", angle="radian", autolimits="true")
+    if robot.body is None:
+        ET.SubElement(root, "compiler", angle="radian", autolimits="true")
+    else:   # every link's mass is its own inertial (none from the shapes)
+        ET.SubElement(root, "compiler", angle="radian", autolimits="true",
+                      inertiafromgeom="false")
     ET.SubElement(root, "option", timestep=fmt(timestep), integrator="implicitfast")
-    add_defaults(root, robot)
-    add_assets(root)
-    add_worldbody(root, robot)
-    add_actuators_and_sensors(root, robot)
+    if robot.body is None:
+        add_defaults(root, robot)
+        add_assets(root)
+        add_worldbody(root, robot)
+        add_actuators_and_sensors(root, robot)
+    else:
+        add_body_defaults(root, robot)
+        add_assets(root)
+        add_body_worldbody(root, robot, -min(leg.zero_sole()[2] for leg in robot.body.legs))
+        add_body_actuators(root, robot)
     if home is not None:
         keyframe = ET.SubElement(root, "keyframe")
-        ET.SubElement(keyframe, "key", name="home", qpos=fmt(*home), ctrl=fmt(*home[7:]))
+        ET.SubElement(keyframe, "key", name="home", qpos=fmt(*home),
+                      ctrl=fmt(*(home[7:] if ctrl is None else ctrl)))
     return _to_string(root)
 
 
@@ -170,5 +184,6 @@ def build_mjcf(robot: RobotConfig, *, timestep: float | None = None,
     bare = _compile(robot_xml(robot, timestep=dt))
     fixed = {j.name: j.fixed_rad for j in robot.joints if j.fixed_rad is not None}
     home = standing_qpos(bare, {**robot.rest, **fixed})
-    return Mjcf(robot=robot_xml(robot, timestep=dt, home=home),
+    ctrl = home[bare.jnt_qposadr[bare.actuator_trnid[:, 0]]]
+    return Mjcf(robot=robot_xml(robot, timestep=dt, home=home, ctrl=ctrl),
                 scene=scene_xml(robot, world=world))

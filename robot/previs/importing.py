@@ -21,6 +21,7 @@ import numpy as np
 from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
 from robot.motion.interp import smooth
 from robot.motion.show import Show
 from robot.motion.takes import TakeHeader
@@ -43,7 +44,12 @@ def read_rig(path: str | Path) -> Rig:
     suffix = Path(path).suffix.lower()
     if suffix not in SUFFIXES:
         raise ConfigError(f"{path}: expected a {', '.join(SUFFIXES)} animation")
-    return read_bvh(path) if suffix == ".bvh" else read_gltf(path)
+    rig = read_bvh(path) if suffix == ".bvh" else read_gltf(path)
+    if rig.frames < 2:
+        raise ConfigError(f"{path}: {rig.frames} frame: a pose, not an animation; a take "
+                          "needs at least 2 frames (a pose: biped capture, or a keyframe "
+                          "file for biped play)")
+    return rig
 
 
 @dataclass(frozen=True)
@@ -80,7 +86,7 @@ def import_animation(path: str | Path, robot: RobotConfig, bone_map: BoneMap, ho
     rate = stream_rate(rig.frame_s, min_rate)
     n = int(round(frames.t[-1] * rate)) + 1
     t = np.arange(n) / rate
-    raw = smooth(frames.t, frames.q, t) if len(frames.t) > 1 else frames.q[:1].copy()
+    raw = smooth(frames.t, frames.q, t)
     found = check(robot, t, raw, max_accel=max_accel, joints=frames.animated)
     q = clamp(robot, t, raw, max_accel=max_accel) if found else raw
     plans: tuple[WalkPlan, ...] = ()
@@ -106,6 +112,6 @@ def write_stream_take(path: str | Path, robot: RobotConfig, params: GaitParams,
         lines.append(json.dumps({"tick": k, "t": round(t, 9), "state": "show",
                                  "q": [round(v, 8) for v in row]}))
     try:
-        Path(path).write_text("\n".join(lines) + "\n")
+        write_text(path, "\n".join(lines) + "\n")
     except OSError as e:
         raise ConfigError(f"--out {path}: cannot write it: {e.strerror or e}") from None

@@ -20,6 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.errors import ConfigError
+from robot.files.atomic import write_bytes
 
 Floats = npt.NDArray[np.float64]
 #: The resampling period of ``identify check`` and ``fit`` [s].
@@ -141,7 +142,7 @@ def write_log(log: PendulumLog, path: str | Path) -> Path:
     """Write ``log`` as JSON (gzip-compressed when ``path`` ends in .gz)."""
     p = Path(path)
     text = json.dumps(log.to_json(), separators=(",", ":")).encode()
-    p.write_bytes(gzip.compress(text, mtime=0) if p.suffix == ".gz" else text)
+    write_bytes(p, gzip.compress(text, mtime=0) if p.suffix == ".gz" else text)
     return p
 
 

@@ -21,6 +21,7 @@ from robot.bus.servo_map import ServoMap
 from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
+from robot.files.atomic import replacing
 from robot.gait.engine import GaitEngine
 from robot.loop.streamer import Streamer, Telemetry
 from sim.mujoco.bus import MujocoBus
@@ -82,17 +83,30 @@ def _writer(path: Path, fps: float) -> Any:
 
 def render_walk(robot: RobotConfig, params: GaitParams, out: str | Path, *,
                 spec: ClipSpec = ClipSpec(), progress: bool = True) -> ClipResult:
-    """Walk ``params`` on a fresh MujocoBus and write ``spec.frames`` frames to ``out``."""
+    """Walk ``params`` on a fresh MujocoBus and write ``spec.frames`` frames to ``out``
+    (whole, robot.files.atomic; OSError if it cannot be written)."""
+    path = check_output(out, spec)
+    with replacing(path) as temp:    # whole or not at all (a device: copied at the end)
+        count, fell = _render(robot, params, temp, spec=spec, progress=progress,
+                              label=path.name)
+    log.info("wrote %s: %d frames at %g fps", path, count, spec.fps)
+    return ClipResult(path=path, frames=count, seconds=count / spec.fps, fell=fell)
+
+
+def _render(robot: RobotConfig, params: GaitParams, path: Path, *, spec: ClipSpec,
+            progress: bool, label: str) -> tuple[int, bool]:
+    """Walk and write the clip to ``path``; (frames written, whether the robot fell).
+    OSError if the clip cannot be written."""
     from tqdm import tqdm
 
     from sim.mujoco.metrics import WalkMonitor
 
-    path = check_output(out, spec)
     n = spec.frames
     frames: list[Frame] = []
     writer = _writer(path, spec.fps)
     bus = MujocoBus(robot)
-    bar = tqdm(total=n, unit="frame", desc=f"render {path.name}", disable=not progress)
+    bar = tqdm(total=n, unit="frame", desc=f"render {label}", disable=not progress)
+    failed: list[OSError] = []
     try:
         with bus:
             monitor = WalkMonitor(standing_height=bus.standing_height)
@@ -105,7 +119,12 @@ def render_walk(robot: RobotConfig, params: GaitParams, out: str | Path, *,
                     return
                 frame = bus.render(spec.width, spec.height, camera=spec.camera)
                 if writer is not None:
-                    writer.append_data(frame)
+                    try:
+                        writer.append_data(frame)
+                    except OSError as e:       # ffmpeg could not write: end the clip
+                        failed.append(e)
+                        streamer.request_stop("clip cannot be written")
+                        return
                 else:
                     frames.append(frame.copy())
                 box["count"] += 1
@@ -121,11 +140,11 @@ def render_walk(robot: RobotConfig, params: GaitParams, out: str | Path, *,
         bar.close()
         if writer is not None:
             writer.close()
+    if failed:
+        raise failed[0]
     if writer is None:
         _write_gif(path, frames, spec.fps)
-    count = int(box["count"])
-    log.info("wrote %s: %d frames at %g fps", path, count, spec.fps)
-    return ClipResult(path=path, frames=count, seconds=count / spec.fps, fell=monitor.fell)
+    return int(box["count"]), monitor.fell
 
 
 def _write_gif(path: Path, frames: list[Frame], fps: float) -> None:

@@ -150,14 +150,14 @@ def plot(robot: RobotConfig, take: Take, sim: Floats, path: str) -> None:
 def run(args: argparse.Namespace) -> int:
     from sim.mujoco.take_replay import replay
 
-    take = read_take(checked("TAKE", input_file, args.take))
     plot_path = None if args.plot is None else checked("--plot", plot_output, args.plot)
+    take = read_take(checked("TAKE", input_file, args.take))
     robot = robot_for(take, args.robot)
     recorded_on = take.header.robot
     if recorded_on and recorded_on != robot.name:
-        log.warning("%s was recorded on robot %r, not %r: the gap is to another robot's "
-                    "simulation (default: the robot the take names)", take.source,
-                    recorded_on, robot.name)
+        log.warning("%s was recorded on robot %r; simulating %r (--robot): the gap "
+                    "includes how the two robots differ (without --robot: the one the "
+                    "take names)", take.source, recorded_on, robot.name)
     loads = loads_from(args.load)
     if loads and args.world != "bench":
         raise ConfigError("--load: only with --world bench (the robot world has its body)")

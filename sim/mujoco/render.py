@@ -8,8 +8,10 @@ Frames are written with imageio: .mp4 through imageio-ffmpeg's bundled ffmpeg (H
 
 from __future__ import annotations
 
+import errno
 import logging
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -77,8 +79,26 @@ def _writer(path: Path, fps: float) -> Any:
 
     if path.suffix.lower() == ".mp4":
         return imageio.get_writer(path, format="FFMPEG", mode="I", fps=fps, codec="libx264",
-                                  quality=7, macro_block_size=2, pixelformat="yuv420p")
+                                  quality=7, macro_block_size=2, pixelformat="yuv420p",
+                                  ffmpeg_log_level="quiet")   # its failures: _check_clip
     return None
+
+
+def _check_clip(path: Path, frames: int) -> None:
+    """OSError unless ffmpeg reads ``frames`` frames back from the clip it wrote: imageio
+    does not look at how ffmpeg exited (a full disk as it wrote the trailer: a clip that
+    does not play, and no error)."""
+    import imageio_ffmpeg
+
+    try:
+        got = imageio_ffmpeg.count_frames_and_secs(str(path))[0]
+    except RuntimeError:                     # ffmpeg cannot read it at all
+        got = 0
+    if got != frames:
+        full = os.statvfs(path.parent).f_bavail == 0
+        raise OSError(errno.ENOSPC if full else errno.EIO,
+                      os.strerror(errno.ENOSPC) if full
+                      else f"ffmpeg wrote a clip of {got} frames, not {frames}", str(path))
 
 
 def render_walk(robot: RobotConfig, params: GaitParams, out: str | Path, *,
@@ -144,6 +164,8 @@ def _render(robot: RobotConfig, params: GaitParams, path: Path, *, spec: ClipSpe
         raise failed[0]
     if writer is None:
         _write_gif(path, frames, spec.fps)
+    else:
+        _check_clip(path, int(box["count"]))
     return int(box["count"]), monitor.fell
 
 

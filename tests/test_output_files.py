@@ -23,7 +23,7 @@ import pytest
 from anim_files import write_blender_bvh
 from bus_harness import PATIENT_TIMEOUT_MS
 from full_disk import LEFT
-from test_bad_input import assert_refused
+from test_bad_input import assert_refused, run_cli
 from test_command_ends import Biped
 from test_end_paths import ticks_of
 from test_keyframes import WAVE
@@ -41,16 +41,6 @@ OLD = "the old file, whole\n"
 
 def names(d: Path) -> list[str]:
     return sorted(p.name for p in d.iterdir())
-
-
-def run_cli(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    """(exit code, stdout, stderr) of ``biped <argv>`` in this process."""
-    try:
-        code = cli.main(argv)
-    except SystemExit as e:
-        code = int(e.code or 0)
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.fixture(scope="module")
@@ -179,7 +169,7 @@ WRITERS: dict[str, tuple[str, Callable[[Path, Path], list[str]]]] = {
 @pytest.mark.parametrize("command", sorted(WRITERS))
 def test_a_write_that_does_not_fit_keeps_the_old_file(
         command: str, nearly_full_dir: Path, tmp_path: Path,
-        capsys: pytest.CaptureFixture[str]) -> None:
+        capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
     name, argv = WRITERS[command]
     out = nearly_full_dir / name
     out.write_text(OLD)
@@ -187,7 +177,7 @@ def test_a_write_that_does_not_fit_keeps_the_old_file(
     inputs.mkdir()
     args = argv(out, inputs)
     capsys.readouterr()
-    code, _, err = run_cli(args, capsys)
+    code, _, err = run_cli(args, capsys, monkeypatch)
     line = assert_refused(code, err, str(out))
     assert "no space left on device" in line.lower(), line
     assert out.read_text() == OLD
@@ -195,34 +185,38 @@ def test_a_write_that_does_not_fit_keeps_the_old_file(
 
 
 def test_mjcf_that_does_not_fit_keeps_the_old_files(
-        nearly_full_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+        nearly_full_dir: Path,
+        capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
     out = nearly_full_dir / "m"
     out.mkdir()
     (out / "robot.xml").write_text(OLD)
-    code, _, err = run_cli(["mjcf", "--out", str(out)], capsys)
+    code, _, err = run_cli(["mjcf", "--out", str(out)], capsys, monkeypatch)
     assert_refused(code, err, str(out), "No space left on device")
     assert (out / "robot.xml").read_text() == OLD and names(out) == ["robot.xml"]
 
 
 def test_a_robot_copy_that_does_not_fit_leaves_nothing(
-        nearly_full_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+        nearly_full_dir: Path,
+        capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
     """The copy (5.4 kB) in the one page (4 kB) left beside another file."""
     (nearly_full_dir / "other.toml").write_text(OLD)
     dest = nearly_full_dir / "mine.toml"
-    code, _, err = run_cli(["robots", "copy", "biped18-dynamixel", str(dest)], capsys)
+    code, _, err = run_cli(["robots", "copy", "biped18-dynamixel", str(dest)], capsys,
+                           monkeypatch)
     assert_refused(code, err, str(dest), "No space left on device")
     assert names(nearly_full_dir) == [".fill", "other.toml"]
 
 
 @pytest.mark.parametrize("command", ["render", "export"])
 def test_a_clip_onto_dev_full_is_refused(command: str, tmp_path: Path,
-                                         capsys: pytest.CaptureFixture[str]) -> None:
+                                         capsys: pytest.CaptureFixture[str],
+                                         monkeypatch: pytest.MonkeyPatch) -> None:
     """render said `wrote full.mp4`, exit 0 (ffmpeg's error never reached it)."""
     out = tmp_path / ("full.mp4" if command == "render" else "full.glb")
     out.symlink_to("/dev/full")
     args = ([command, "--seconds", "0.2", "--quiet", "--out", str(out)] if command == "render"
             else [command, "--seconds", "0.2", "--out", str(out)])
-    code, outs, err = run_cli(args, capsys)
+    code, outs, err = run_cli(args, capsys, monkeypatch)
     assert_refused(code, err, f"--out {out}", "No space left on device")
     assert "wrote" not in outs
     assert os.path.islink(out) and names(tmp_path) == [out.name]

@@ -11,21 +11,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from test_bad_input import assert_refused
+from test_bad_input import assert_refused, run_cli
 
 import robot.cli as cli
 from robot.previs.figure_file import FORMATS
 
 MAGIC = {"png": b"\x89PNG\r\n\x1a\n", "pdf": b"%PDF-", "jpg": b"\xff\xd8\xff"}
-
-
-def run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    try:
-        code = cli.main(argv)
-    except SystemExit as e:
-        code = int(e.code or 0)
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 #: command → argv writing a plot named ``name`` (inputs in ``tmp``), the option named.
@@ -48,11 +39,12 @@ PLOTTERS = {
 
 @pytest.mark.parametrize("command", sorted(PLOTTERS))
 def test_a_plot_name_that_is_no_picture_is_refused_before_the_work(
-        command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+        command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str],
+        monkeypatch: pytest.MonkeyPatch) -> None:
     """A matplotlib ValueError traceback after the work (curves had written c.csv)."""
     (tmp_path / "in.csv").write_text("t\n0\n")
     argv, option = PLOTTERS[command]
-    code, out, err = run(argv(tmp_path, "y.txt"), capsys)
+    code, out, err = run_cli(argv(tmp_path, "y.txt"), capsys, monkeypatch)
     line = assert_refused(code, err, option, "'.txt' is not a picture format")
     assert all(f".{f}" in line for f in FORMATS), line
     assert out == "" and sorted(p.name for p in tmp_path.iterdir()) == ["in.csv"]
@@ -69,9 +61,10 @@ def test_the_formats_are_matplotlib_s() -> None:
 @pytest.mark.parametrize(("name", "kind"), [("noext", "png"), ("c.pdf", "pdf"),
                                             ("c.JPG", "jpg")])
 def test_the_name_said_is_the_name_written(name: str, kind: str, tmp_path: Path,
-                                           capsys: pytest.CaptureFixture[str]) -> None:
+                                           capsys: pytest.CaptureFixture[str],
+                                           monkeypatch: pytest.MonkeyPatch) -> None:
     """`--plot noext` said `wrote noext` and wrote noext.png."""
-    code, out, err = run(PLOTTERS["curves --plot"][0](tmp_path, name), capsys)
+    code, out, err = run_cli(PLOTTERS["curves --plot"][0](tmp_path, name), capsys, monkeypatch)
     assert code == 0, err
     assert f"wrote {tmp_path / name}\n" in out
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["c.csv", name])
@@ -79,10 +72,11 @@ def test_the_name_said_is_the_name_written(name: str, kind: str, tmp_path: Path,
 
 
 def test_plot_out_without_a_suffix_is_that_name(tmp_path: Path,
-                                                capsys: pytest.CaptureFixture[str]) -> None:
+                                                capsys: pytest.CaptureFixture[str],
+                                                monkeypatch: pytest.MonkeyPatch) -> None:
     record = tmp_path / "run.csv"
     assert cli.main(["walk", "--seconds", "0.3", "--record", str(record)]) == 0
-    code, out, err = run(["plot", str(record), "--out", str(tmp_path / "zz")], capsys)
+    code, out, err = run_cli(["plot", str(record), "--out", str(tmp_path / "zz")], capsys, monkeypatch)
     assert code == 0, err
     assert f"wrote {tmp_path / 'zz'} " in out
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv", "zz"]

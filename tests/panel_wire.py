@@ -70,13 +70,14 @@ class Panel:
 
 
 @contextmanager
-def launched(emu: Emulator, robot_toml: Path, tmp: Path, *extra: str,
+def launched(emu: Emulator | None, robot_toml: Path, tmp: Path, *extra: str,
              rate: float = 200.0, start: bool = False) -> Iterator[Panel]:
-    """`biped panel` on ``emu`` (``--no-start`` unless ``start``; stderr collected in
-    ``Panel.err``); SIGTERM and a wait for its exit at the end (killed if it will not
-    end)."""
-    cmd = [sys.executable, "-m", "robot.cli", "panel", "--bus", emu.protocol, "--port",
-           emu.port, "--robot", str(robot_toml), "--http-port", "0", "--rate", f"{rate:g}",
+    """`biped panel` on ``emu`` (None: the sim bus; ``--no-start`` unless ``start``;
+    stderr collected in ``Panel.err``); SIGTERM and a wait for its exit at the end
+    (killed if it will not end)."""
+    bus = ["--bus", "sim"] if emu is None else ["--bus", emu.protocol, "--port", emu.port]
+    cmd = [sys.executable, "-m", "robot.cli", "panel", *bus,
+           "--robot", str(robot_toml), "--http-port", "0", "--rate", f"{rate:g}",
            "--presets-dir", str(tmp / "presets"), "--studio-dir", str(tmp / "studio"),
            *extra, *([] if start else ["--no-start"])]
     proc = subprocess.Popen(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE,

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from anim_files import ANGLES, map_toml, write_blender_bvh, write_blender_gltf
+from anim_files import ANGLES, KNEE_HIERARCHY, map_toml, write_blender_bvh, write_blender_gltf
 
 import robot.cli as cli
 from robot.config.gait_file import load_gait
@@ -86,14 +86,7 @@ def test_export_then_import_round_trips(tmp_path: Path, suffix: str) -> None:
 
 def _knee_bvh(path: Path, knee_deg: list[float], fps: float = 30.0) -> None:
     """Our skeleton's names, only the right knee moving (Xrotation: the robot's pitch)."""
-    lines = ["HIERARCHY", "ROOT pelvis", "{", "OFFSET 0 0 0",
-             "CHANNELS 6 Xposition Yposition Zposition Yrotation Zrotation Xrotation",
-             "JOINT r_hip", "{", "OFFSET -5 0 0", "CHANNELS 3 Yrotation Zrotation Xrotation",
-             "JOINT r_knee", "{", "OFFSET 0 -10 0", "CHANNELS 3 Zrotation Yrotation Xrotation",
-             "End Site", "{", "OFFSET 0 -10 0", "}", "}", "}",
-             "JOINT l_hip", "{", "OFFSET 5 0 0", "CHANNELS 3 Yrotation Zrotation Xrotation",
-             "End Site", "{", "OFFSET 0 -20 0", "}", "}", "}",
-             "MOTION", f"Frames: {len(knee_deg)}", f"Frame Time: {1 / fps:.6f}"]
+    lines = [*KNEE_HIERARCHY, f"Frames: {len(knee_deg)}", f"Frame Time: {1 / fps:.6f}"]
     lines += [f"0 25 0 0 0 0 0 0 0 0 0 {d} 0 0 0" for d in knee_deg]
     path.write_text("\n".join(lines) + "\n")
 

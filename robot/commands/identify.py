@@ -76,8 +76,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     return one_line_errors(p)
 
 
-def _logs(paths: list[str]) -> list[PendulumLog]:
-    return [read_log(checked("LOG", input_file, p)) for p in paths]
+def _logs(paths: list[str], law: str) -> list[PendulumLog]:
+    """The logs, each checked (robot.servo.log_rules) for a servo of firmware ``law``."""
+    return [read_log(checked("LOG", input_file, p), law=law) for p in paths]
 
 
 def _model(text: str) -> ServoPhysics:
@@ -106,7 +107,7 @@ def _check(args: argparse.Namespace) -> int:
     if args.plot is not None:
         checked("--plot", plot_output, args.plot)
     physics = _model(args.model)
-    logs = _logs(args.logs)
+    logs = _logs(args.logs, physics.law)
     errors = _errors(logs, physics, args.offset, args.plot)
     mean = sum(errors) / len(errors)
     if args.json:
@@ -135,8 +136,11 @@ def _fit(args: argparse.Namespace) -> int:
     if args.trials < 10:
         raise ConfigError(f"--trials: expected at least 10, got {args.trials}")
     train_paths, held_paths = split_logs([Path(p) for p in args.logs], args.holdout)
-    train, held = _logs([str(p) for p in train_paths]), _logs([str(p) for p in held_paths])
+    if not train_paths:   # one log, all of it held out
+        raise ConfigError("need at least 2 logs with --holdout > 0 (or --holdout 0)")
     start = physics_for(args.motor)
+    train = _logs([str(p) for p in train_paths], start.law)
+    held = _logs([str(p) for p in held_paths], start.law)
     source = f"fitted by biped identify fit on {len(train)} logs ({', '.join(p.name for p in train_paths)})"
     print(f"fitting {', '.join(params)} of {args.motor} on {len(train)} logs "
           f"({len(held)} held out), {args.trials} trials ...")

@@ -103,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
         efficiency = replace(efficiency, forward=args.travel_efficiency, forward_by_speed=())
     got = import_animation(args.file, robot, bone_map, hold, up=args.up,
                            min_rate=args.rate, max_accel=args.max_accel, params=params,
-                           efficiency=efficiency)
+                           efficiency=efficiency, progress=True)
     frames = got.frames
     for w in got.walks:
         print(w.line())
@@ -125,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
                 cues=tuple(sorted(cues, key=lambda c: c.t)), up=frames.up,
                 travel_m=tuple(float(v) for v in frames.travel[-1]))  # type: ignore[arg-type]
     write_stream_take(args.out, robot, params, got, show,
-                      note=f"imported from {Path(args.file).name}")
+                      note=f"imported from {Path(args.file).name}", progress=True)
     held = [n for n in robot.joint_names if n not in frames.animated]
     fwd, left, _ = frames.travel[-1]
     fps = 1.0 / (frames.t[1] - frames.t[0]) if len(frames.t) > 1 else 0.0

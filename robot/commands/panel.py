@@ -6,7 +6,9 @@ SIGINT/SIGTERM starts a safe stop (ramp out, rest, then torque off, or hold with
 ``--hold``); a second one stops at once with torque off; any later one is ignored. Either
 way the bus is closed before the process exits: 130 after SIGINT, 143 after SIGTERM
 (never killed by the signal), 2 for bad options, 1 when torque could not be confirmed
-off at the end (the last line says which servos).
+off at the end (the last line says which servos) or when the control loop's process died
+(SIGKILL, the OOM killer): then this process opens the port and turns torque off itself
+(robot.panel.loop_lost).
 """
 
 from __future__ import annotations
@@ -98,6 +100,8 @@ def _farewell(report: dict[str, Any], *, aborted: bool) -> tuple[str, bool]:
     on = sorted(i for i, v in torque.items() if v)
     if not report:
         return "torque untouched (the bus was never opened)", True
+    if report.get("sim"):
+        return "the simulation ended with the control loop process; nothing to turn off", False
     if report.get("holding") and not aborted and not failed:
         return "torque left ON (holding)", True
     if failed or on:
@@ -155,14 +159,19 @@ def run(args: argparse.Namespace) -> int:
                 time.sleep(0.1)
             if controller.loop.gone is not None:
                 log.error("%s", controller.loop.gone)
-            end = "hold" if args.hold else "torque off"
-            print(f"biped panel: stopping (ramp out, rest, {end}; again: torque off now)",
-                  flush=True)
+                print("biped panel: stopping (the control loop is gone: torque off from "
+                      "this process)" if kind != "sim" else "biped panel: stopping", flush=True)
+            else:
+                end = "hold" if args.hold else "torque off"
+                print(f"biped panel: stopping (ramp out, rest, {end}; again: torque off now)",
+                      flush=True)
         finally:
             report = controller.shutdown(abort=lambda: signals.abort)  # first: a second
             if server is not None:                                    # signal acts at once
                 server.shutdown()
                 server.server_close()
         line, safe = _farewell(report, aborted=signals.abort)
+        if report.get("lost") and safe:
+            line += " (by this process: the control loop process had ended)"
         print(f"biped panel: stopped; {line}", flush=True)
-    return latch.exit_code(None) if safe else 1
+    return latch.exit_code(None) if safe and not report.get("lost") else 1

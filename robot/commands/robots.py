@@ -15,6 +15,7 @@ from collections import Counter
 from pathlib import Path
 
 from robot.commands.common import one_line_errors
+from robot.commands.robots_import import add_import_parser, run_import
 from robot.config.bundled import ROBOTS_DIR, robot_names
 from robot.config.joint_names import ARM_NAMES, LEG_NAMES
 from robot.config.robot import RobotConfig
@@ -36,6 +37,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     c.add_argument("dest", metavar="DEST",
                    help="the new file (ending in .toml), or an existing directory")
     one_line_errors(c)
+    one_line_errors(add_import_parser(actions))
     return one_line_errors(p)
 
 
@@ -117,6 +119,8 @@ def copy(name: str, dest: Path) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.action == "import":
+        return run_import(args)
     if args.action != "copy":
         _list(args.json)
         return 0

@@ -21,6 +21,7 @@ from robot.servo import ticks as tick_math
 from robot.servo.models import BUS_FAMILIES, MODELS, bauds
 
 if TYPE_CHECKING:
+    from robot.body.model import BodyModel
     from robot.config.robot import BusConfig, JointConfig, RobotConfig
 
 #: Decimal places of the radian ranges printed in messages (rounded inward, so a value
@@ -177,3 +178,28 @@ def check_joint_extras(src: str, jp: str, j: JointConfig, bus: BusConfig, *,
     if j.fixed_rad is not None and not j.min_rad <= j.fixed_rad <= j.max_rad:
         raise ConfigError(f"{src}: {jp}.fixed_rad: {j.fixed_rad:g} is outside the joint "
                           f"limits [{j.min_rad:g}, {j.max_rad:g}]")
+
+
+def check_model_joints(src: str, body: BodyModel, joints: list[JointConfig]) -> None:
+    """Every joint of an imported robot names one hinge of its model (``model_joint``,
+    ``model_sign`` +-1), and every hinge of the model is a joint of the file."""
+    hinges = body.tree.joint_link
+    seen: dict[str, str] = {}
+    for j in joints:
+        where = f"{src}: joints.{j.name}"
+        if j.model_joint is None:
+            raise ConfigError(f"{where}.model_joint: missing (an imported robot names each "
+                              "joint's hinge in [model.links])")
+        if j.model_joint not in hinges:
+            raise ConfigError(f"{where}.model_joint: the model has no joint {j.model_joint!r}; "
+                              f"valid: {', '.join(hinges)}")
+        if j.model_joint in seen:
+            raise ConfigError(f"{where}.model_joint: {j.model_joint!r} is also "
+                              f"joints.{seen[j.model_joint]}'s")
+        seen[j.model_joint] = j.name
+        if j.model_sign not in (1, -1):
+            raise ConfigError(f"{where}.model_sign: expected +1 or -1, got {show(j.model_sign)}")
+    missing = [h for h in hinges if h not in seen]
+    if missing:
+        raise ConfigError(f"{src}: model joint {missing[0]!r} is no joint of the file; add a "
+                          "[joints.NAME] with model_joint = ... (an extra joint: fixed_rad)")

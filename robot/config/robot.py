@@ -11,6 +11,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 
+from robot.body.model import BodyModel
 from robot.config.imu_file import ImuConfig
 from robot.config.joint_names import ARM_NAMES, JOINT_NAMES, LEG_NAMES
 from robot.config.servo_file import physics_for
@@ -26,6 +27,8 @@ RETRIES = Range(0, 10)
 TIMEOUT_MS = Range(1.0, 1000.0, "ms")
 #: Geometry: 1 mm (no servo link is smaller; 0 divides by zero in IK) to 2 m.
 LENGTH = Range(0.001, 2.0, "m")
+#: An offset that may be 0 or negative (a sole centred on or behind the ankle) [m].
+OFFSET = Range(-0.5, 0.5, "m")
 #: Link masses: 1 g to 100 kg.
 MASS = Range(0.001, 100.0, "kg")
 #: Joint limits: one turn, centred on zero.
@@ -81,7 +84,7 @@ class Geometry:
     ankle_height: float = field(metadata=spec(LENGTH))
     foot_length: float = field(metadata=spec(LENGTH))
     foot_width: float = field(metadata=spec(LENGTH))
-    foot_forward: float = field(metadata=spec(LENGTH))
+    foot_forward: float = field(metadata=spec(OFFSET))
     torso_height: float = field(metadata=spec(LENGTH))
     torso_depth: float = field(metadata=spec(LENGTH))
     shoulder_width: float = field(default=0.0, metadata=spec(LENGTH))  # arms only
@@ -145,6 +148,11 @@ class JointConfig:
     #: dual-axis servos (2XL430-W250, 2XC430-W250): the case this joint's axis sits in; the
     #: two joints naming one case share it (two ids, one baud rate; setup-motors sets both)
     case: str | None = None
+    #: an imported robot's joint in its model's terms (robot/body/model.py): the model's
+    #: name for it, and model angle = model_sign * angle + model_offset [rad]
+    model_joint: str | None = None
+    model_sign: int = 1
+    model_offset: float = field(default=0.0, metadata=spec(ANGLE))
 
 
 @dataclass(frozen=True)
@@ -152,7 +160,7 @@ class RobotConfig:
     name: str
     bus: BusConfig
     geometry: Geometry
-    mass: Masses
+    mass: Masses | None
     joints: tuple[JointConfig, ...]
     rest: Mapping[str, float] = field(default_factory=dict)
     source: str = "<memory>"
@@ -165,6 +173,9 @@ class RobotConfig:
     #: Servo physics read from the model files the robot file names, per joint name
     #: (joints without one use their model's bundled physics: ``servo_physics``).
     physics: Mapping[str, ServoPhysics] = field(default_factory=dict)
+    #: An imported robot's own body (the ``[model]`` section, robot/body/model.py); None:
+    #: the box model built from ``geometry`` and ``mass``.
+    body: BodyModel | None = None
 
     def joint(self, name: str) -> JointConfig:
         for j in self.joints:

@@ -186,10 +186,10 @@ class OutputFile:
             raise
         self._whole += done
 
-    def commit(self) -> None:
+    def commit(self, *, partial: bool = True) -> None:
         """Flush and rename onto the path (a device: close); OSError if a write failed
-        (the file then holds the whole records before it; the old file stays if none
-        was written)."""
+        (the file then holds the whole records before it; ``partial`` False, or none
+        written: the old file stays)."""
         if self._fd is None:
             return
         if self.failure is None and self._pending:
@@ -198,7 +198,7 @@ class OutputFile:
         fd, self._fd = self._fd, None
         if self._temp is None:
             os.close(fd)
-        elif self._whole == 0 and self.failure is not None:
+        elif self.failure is not None and (self._whole == 0 or not partial):
             os.close(fd)
             self._temp.unlink(missing_ok=True)
         else:

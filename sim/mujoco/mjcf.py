@@ -17,7 +17,6 @@ rotor's armature, as with the torque on.
 
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -31,6 +30,8 @@ import numpy.typing as npt
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.files.atomic import write_text
+from sim.mujoco.geoms import foot_geoms, geom_points
+from sim.mujoco.mjcf_body import add_body_actuators, add_body_defaults, add_body_worldbody
 from sim.mujoco.mjcf_robot import add_actuators_and_sensors, add_assets, add_defaults, add_worldbody, fmt
 
 if TYPE_CHECKING:
@@ -39,7 +40,6 @@ if TYPE_CHECKING:
 ROBOT_FILE = "robot.xml"
 SCENE_FILE = "scene.xml"
 DEFAULT_TIMESTEP = 0.002  # [s]
-FOOT_GEOMS = ("r_foot", "l_foot")
 
 
 @dataclass(frozen=True)
@@ -79,18 +79,31 @@ def _to_string(root: ET.Element) -> str:
 
 
 def robot_xml(robot: RobotConfig, *, timestep: float = DEFAULT_TIMESTEP,
-              home: npt.NDArray[np.float64] | None = None) -> str:
-    """The robot MJCF; ``home`` (qpos) adds the ``home`` keyframe (ctrl = its joints)."""
+              home: npt.NDArray[np.float64] | None = None,
+              ctrl: npt.NDArray[np.float64] | None = None) -> str:
+    """The robot MJCF; ``home`` (qpos) adds the ``home`` keyframe with ``ctrl`` (default:
+    its joints, in actuator order)."""
     root = ET.Element("mujoco", model=robot.name)
-    ET.SubElement(root, "compiler", angle="radian", autolimits="true")
+    if robot.body is None:
+        ET.SubElement(root, "compiler", angle="radian", autolimits="true")
+    else:   # every link's mass is its own inertial (none from the shapes)
+        ET.SubElement(root, "compiler", angle="radian", autolimits="true",
+                      inertiafromgeom="false")
     ET.SubElement(root, "option", timestep=fmt(timestep), integrator="implicitfast")
-    add_defaults(root, robot)
-    add_assets(root)
-    add_worldbody(root, robot)
-    add_actuators_and_sensors(root, robot)
+    if robot.body is None:
+        add_defaults(root, robot)
+        add_assets(root)
+        add_worldbody(root, robot)
+        add_actuators_and_sensors(root, robot)
+    else:
+        add_body_defaults(root, robot)
+        add_assets(root)
+        add_body_worldbody(root, robot, -min(leg.zero_sole()[2] for leg in robot.body.legs))
+        add_body_actuators(root, robot)
     if home is not None:
         keyframe = ET.SubElement(root, "keyframe")
-        ET.SubElement(keyframe, "key", name="home", qpos=fmt(*home), ctrl=fmt(*home[7:]))
+        ET.SubElement(keyframe, "key", name="home", qpos=fmt(*home),
+                      ctrl=fmt(*(home[7:] if ctrl is None else ctrl)))
     return _to_string(root)
 
 
@@ -148,7 +161,7 @@ def _joint_qpos(model: mujoco.MjModel, name: str) -> int:
 
 def standing_qpos(model: mujoco.MjModel, pose: Mapping[str, float]) -> npt.NDArray[np.float64]:
     """qpos with the joints at ``pose`` [rad] (missing joints 0), torso upright at x = y = 0
-    and its height [m] chosen so the lowest foot-box point touches z = 0."""
+    and its height [m] chosen so the lowest sole point touches z = 0."""
     data = mujoco.MjData(model)
     qpos = np.zeros(model.nq)
     qpos[3] = 1.0
@@ -156,13 +169,8 @@ def standing_qpos(model: mujoco.MjModel, pose: Mapping[str, float]) -> npt.NDArr
         qpos[_joint_qpos(model, name)] = q
     data.qpos[:] = qpos
     mujoco.mj_kinematics(model, data)
-    lowest = math.inf
-    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
-    for name in FOOT_GEOMS:
-        gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
-        rot = data.geom_xmat[gid].reshape(3, 3)
-        pts = data.geom_xpos[gid] + (corners * model.geom_size[gid]) @ rot.T
-        lowest = min(lowest, float(pts[:, 2].min()))
+    lowest = min(float(geom_points(model, data, g)[:, 2].min())
+                 for foot in foot_geoms(model) for g in foot)
     qpos[2] = -lowest
     return qpos
 
@@ -177,5 +185,6 @@ def build_mjcf(robot: RobotConfig, *, timestep: float | None = None,
     bare = _compile(robot_xml(robot, timestep=dt))
     fixed = {j.name: j.fixed_rad for j in robot.joints if j.fixed_rad is not None}
     home = standing_qpos(bare, {**robot.rest, **fixed})
-    return Mjcf(robot=robot_xml(robot, timestep=dt, home=home),
+    ctrl = home[bare.jnt_qposadr[bare.actuator_trnid[:, 0]]]
+    return Mjcf(robot=robot_xml(robot, timestep=dt, home=home, ctrl=ctrl),
                 scene=scene_xml(robot, world=world))

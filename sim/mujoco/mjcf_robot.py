@@ -119,6 +119,7 @@ def _body(parent: ET.Element, name: str, pos: tuple[float, float, float],
 
 def add_worldbody(root: ET.Element, robot: RobotConfig) -> None:
     g, m = robot.geometry, robot.mass
+    assert m is not None, "the box model needs [mass]"
     s = (robot.bus.servo.mass / SERVO_DENSITY) ** (1 / 3)  # servo edge [m]
     r = 0.45 * s  # link capsule radius [m]
     world = _sub(root, "worldbody")

@@ -62,6 +62,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                    help=f"where takes and keyframe sequences are kept (default: "
                         f"{user_data_dir()}: takes/, keyframes/)")
     p.add_argument("--no-start", action="store_true", help="serve without starting the gait")
+    p.add_argument("--mcap", action="store_true", help="each recorded take also as NAME.mcap "
+                   "beside it (opens in Foxglove; docs/show-control.md)")
     return p
 
 
@@ -127,7 +129,8 @@ def run(args: argparse.Namespace) -> int:
     controller = PanelController(
         robot, BusSpec(kind, port=args.port, baud=args.baud, options=options), params,
         options=LoopOptions(rate_hz=args.rate, read_every=args.read_every, hold=args.hold,
-                            balance=not args.no_balance, imu_noise=args.imu_noise),
+                            balance=not args.no_balance, imu_noise=args.imu_noise,
+                            mcap=args.mcap),
         presets=presets, preset=gait.name)
     studio_dir = Path(args.studio_dir) if args.studio_dir else user_data_dir()
     studio = Studio(controller, takes_dir=studio_dir / "takes",

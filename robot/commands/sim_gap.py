@@ -26,8 +26,10 @@ from robot.commands.common import checked, input_file, plot_output
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
+from robot.loop.mcap_recorder import is_mcap
 from robot.motion.takes import Take, read_take
 from robot.previs.figure_file import save_figure
+from robot.previs.mcap_read import mcap_take
 from robot.servo.bench_load import BenchLoad, parse_load
 
 log = logging.getLogger(__name__)
@@ -54,7 +56,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p = subparsers.add_parser("sim-gap", help="compare a take recorded on servos with the "
                               "simulation of the same commands", description=__doc__,
                               formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("take", metavar="TAKE", help="a take recorded on a servo bus (.take.jsonl)")
+    p.add_argument("take", metavar="TAKE", help="a take recorded on a servo bus (.take.jsonl; or a .mcap)")
     p.add_argument("--robot", default=None, metavar="NAME|PATH",
                    help="the robot file to simulate (default: the one the take names)")
     p.add_argument("--world", choices=("robot", "bench"), default="robot",
@@ -151,7 +153,8 @@ def run(args: argparse.Namespace) -> int:
     from sim.mujoco.take_replay import replay
 
     plot_path = None if args.plot is None else checked("--plot", plot_output, args.plot)
-    take = read_take(checked("TAKE", input_file, args.take))
+    path = checked("TAKE", input_file, args.take)
+    take = mcap_take(path) if is_mcap(path) else read_take(path)
     robot = robot_for(take, args.robot)
     recorded_on = take.header.robot
     if recorded_on and recorded_on != robot.name:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
@@ -41,6 +42,7 @@ from robot.commands.common import (
     seconds,
 )
 from robot.commands.physics_check import physics_check, physics_watch
+from robot.commands.show_args import add_show_args, show_options
 from robot.commands.walk import servo_words
 from robot.config.bundled import DEFAULT_GAIT
 from robot.config.robot import RobotConfig
@@ -62,6 +64,7 @@ from robot.motion.takes import SUFFIX, Take, TakeHeader, is_take, read_take
 from robot.previs.show_check import plot_check
 from robot.run.run import Run
 from robot.run.spec import RunOptions, RunSpec
+from robot.showctl.play_target import play_show_control
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
@@ -103,6 +106,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--balance", action="store_true", help="an imported take (biped import): "
                    "the balance stage corrects the legs while the arms and head perform as "
                    "authored (needs the robot's [imu])")
+    add_show_args(p, midi=False)
     p.set_defaults(set=[])
     return p
 
@@ -122,6 +126,7 @@ def run(args: argparse.Namespace) -> int:
     checked("FILE", input_file, args.file)
     if args.record:
         checked("--record", output_file, args.record)
+    shows = show_options(args)            # OSC, cue list: checked before anything moves
     kind = args.bus or "sim"
     if kind != "sim" and (args.view or args.realtime):
         raise ConfigError("--view and --realtime apply to --bus sim only")
@@ -215,7 +220,12 @@ def run(args: argparse.Namespace) -> int:
                 for k, kind_, step in sorted(timeline, key=lambda e: (e[0], e[1])):
                     writer.event(k, **{kind_: dict(step)})
                 writer.event(stop, stop=True)
-            playing.stream()
+            clock = (lambda: chase.show_time) if chase is not None else lambda: engine.time
+            with play_show_control(shows, playing, joints=tuple(robot.joint_names),
+                                   take=Path(args.file).name, show_time=clock, rate_hz=rate,
+                                   announce=lambda line: print(f"biped play: {line}",
+                                                               file=sys.stderr, flush=True)):
+                playing.stream()
     finally:
         if soundtrack is not None:
             soundtrack.close()

@@ -31,11 +31,13 @@ from robot.commands.chase_args import (
 )
 from robot.commands.common import (
     add_bus_args,
+    audio_offset,
     bus_from,
     checked,
     input_file,
     output_file,
     params_from,
+    plot_output,
     rate_hz,
     seconds,
 )
@@ -88,12 +90,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--audio", default=None, type=input_file, metavar="SOUND",
                    help="play this soundtrack in sync (default: the file's own show.audio); "
                         "the sim then runs in real time")
-    p.add_argument("--audio-offset", type=float, default=None, metavar="SECONDS",
+    p.add_argument("--audio-offset", type=audio_offset, default=None, metavar="SECONDS",
                    help="show time [s] at which the audio starts (default: the file's, or 0)")
     p.add_argument("--player", default=None, metavar="CMD",
                    help="audio player reading a WAV on stdin (default: aplay, paplay, else "
                         "ffplay)")
-    p.add_argument("--check-plot", default=None, type=output_file, metavar="FILE.png",
+    p.add_argument("--check-plot", default=None, type=plot_output, metavar="FILE.png",
                    help="sim bus: plot the physics check (support margin, torque by limb, "
                         "headroom per joint)")
     p.add_argument("--no-root-travel", action="store_true",

@@ -29,6 +29,7 @@ import numpy.typing as npt
 
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
 from sim.mujoco.geoms import foot_geoms, geom_points
 from sim.mujoco.mjcf_body import add_body_actuators, add_body_defaults, add_body_worldbody
 from sim.mujoco.mjcf_robot import add_actuators_and_sensors, add_assets, add_defaults, add_worldbody, fmt
@@ -54,8 +55,8 @@ class Mjcf:
         try:
             out.mkdir(parents=True, exist_ok=True)
             robot_path, scene_path = out / ROBOT_FILE, out / SCENE_FILE
-            robot_path.write_text(self.robot)
-            scene_path.write_text(self.scene)
+            write_text(robot_path, self.robot)
+            write_text(scene_path, self.scene)
         except OSError as e:
             raise ConfigError(f"--out {out}: cannot write MJCF files: {e.strerror}") from e
         return robot_path, scene_path

@@ -231,3 +231,24 @@ def gone(pid: int) -> bool:
         return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "Z"
     except OSError:
         return True
+
+
+def patient_robot_file(tmp: Path) -> Path:
+    """The bundled 18-Dynamixel robot with bus_harness.PATIENT_TIMEOUT_MS (a starved
+    emulator on a loaded machine), written under ``tmp``."""
+    from bus_harness import PATIENT_TIMEOUT_MS
+
+    from robot.config.bundled import ROBOTS_DIR
+    text = (ROBOTS_DIR / "biped18-dynamixel.toml").read_text()
+    path = tmp / "robot.toml"
+    path.write_text(text.replace("timeout_ms = 20.0", f"timeout_ms = {PATIENT_TIMEOUT_MS}"))
+    return path
+
+
+def osc_datagram(address: str, *args: float | str) -> bytes:
+    """One OSC message, built by python-osc's builder (not by the code under test)."""
+    from pythonosc.osc_message_builder import OscMessageBuilder
+    b = OscMessageBuilder(address)
+    for a in args:
+        b.add_arg(a)
+    return bytes(b.build().dgram)

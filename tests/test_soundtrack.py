@@ -95,3 +95,43 @@ def test_no_player_runs_the_show_silent_with_one_warning(
     assert result["stop_reason"] == "completed"
     assert "runs silent" in result["audio"]["warning"]
     assert [r.levelname for r in caplog.records if "runs silent" in r.message] == ["WARNING"]
+
+
+def test_a_chased_jump_restarts_the_player_there_and_the_cues_from_there(
+        tmp_path: Path) -> None:
+    """A chased show (``clock``: its show time): a jump from 0.5 s to 2.0 s restarts the
+    player with the WAV cut at 2.0 s; the cue the jump passed over is not fired, the one
+    after it is; a jump back fires the passed cue again."""
+    from waiting import wait_for
+    _wav(tmp_path / "song.wav", 3.0)
+    log = tmp_path / "heard.jsonl"
+    script = tmp_path / "player.py"
+    script.write_text("import sys, io, wave, json\n"
+                      "w = wave.open(io.BytesIO(sys.stdin.buffer.read()), 'rb')\n"
+                      f"open({str(log)!r}, 'a').write(json.dumps(w.getnframes()) + '\\n')\n")
+    track = Soundtrack(Show(audio="song.wav", base=str(tmp_path),
+                            cues=(Cue(0.2, "a"), Cue(1.0, "skipped"), Cue(2.2, "b"))),
+                       player=f"{sys.executable} {script}")
+    seen: list[str] = []
+    track.on_cue = lambda c: seen.append(c.name)
+    show_t = [0.0]
+    track.clock = lambda: show_t[0]
+
+    def lines() -> list[int]:
+        return [int(v) for v in log.read_text().split()] if log.exists() else []
+    for k in range(60):                                  # 0 .. 0.59 s at 100 Hz
+        show_t[0] = k / 100
+        track(Telemetry(t=k / 100, state="walking", tick=k))
+    assert wait_for(lambda: len(lines()) == 1)
+    for k in range(60, 100):                             # jumped: 2.0 .. 2.39 s
+        show_t[0] = 2.0 + (k - 60) / 100
+        track(Telemetry(t=k / 100, state="walking", tick=k))
+    assert wait_for(lambda: len(lines()) == 2)
+    assert lines() == [3 * RATE, 1 * RATE]               # the whole song, then from 2.0 s
+    assert seen == ["a", "b"]
+    show_t[0] = 0.1                                      # and back
+    track(Telemetry(t=1.0, state="walking", tick=100))
+    show_t[0] = 0.3
+    track(Telemetry(t=1.2, state="walking", tick=101))
+    track.close()
+    assert seen == ["a", "b", "a"]

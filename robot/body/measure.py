@@ -16,7 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from robot.body.legs import LegChain
-from robot.body.roles import SOLE_BAND, Roles, _Pose
+from robot.body.pose import Pose
+from robot.body.roles import SOLE_BAND, Roles
 from robot.body.tree import Array, BodyTree
 from robot.errors import ConfigError
 
@@ -55,14 +56,14 @@ def _foot_links(tree: BodyTree, last: int) -> list[int]:
     return [i for i in range(len(tree.links)) if last in tree.chain(i)]
 
 
-def _sole(pose: _Pose, links: list[int]) -> Sole:
+def _sole(pose: Pose, links: list[int]) -> Sole:
     pts = pose.points(links)
     low = pts[pts[:, 2] <= pts[:, 2].min() + SOLE_BAND]
     return Sole(float(pts[:, 2].min()), float(low[:, 0].min()), float(low[:, 0].max()),
                 float(low[:, 1].min()), float(low[:, 1].max()))
 
 
-def _leg(pose: _Pose, roles: Roles, side: str, where: str) -> tuple[dict[str, Array], Sole]:
+def _leg(pose: Pose, roles: Roles, side: str, where: str) -> tuple[dict[str, Array], Sole]:
     """Per role, the axis anchor (robot frame, root origin); the sole."""
     by = roles.by_name()
     anchors = {r: pose.anchor(by[f"{side}_{r}"].link) for r in
@@ -81,7 +82,7 @@ def _leg(pose: _Pose, roles: Roles, side: str, where: str) -> tuple[dict[str, Ar
 
 def measure(tree: BodyTree, roles: Roles) -> Measured:
     """The legs' chains, the soles and Geometry's lengths (see the module docstring)."""
-    pose = _Pose(tree, roles.axes)
+    pose = Pose(tree, roles.axes)
     pose.angles = {j.model_joint: j.offset for j in roles.joints}
     pose.update()
     where = tree.source
@@ -121,7 +122,7 @@ def measure(tree: BodyTree, roles: Roles) -> Measured:
     return Measured(origin, (right, left), (soles[0], soles[1]), lengths)
 
 
-def _torso(pose: _Pose, roles: Roles, origin: Array) -> dict[str, float]:
+def _torso(pose: Pose, roles: Roles, origin: Array) -> dict[str, float]:
     """torso_height, torso_depth and (with arms) shoulder_width, upper_arm, forearm [m]."""
     from robot.body.limbs import torso_links
 

@@ -13,7 +13,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                        description="Commanded vs present joint positions, loop timing, "
                                    "temperatures and loads of a recorded walk; or the "
                                    "channels and joint angles of a curves CSV.")
-    p.add_argument("file", metavar="FILE", help="run record (.csv/.jsonl) or curves CSV")
+    p.add_argument("file", metavar="FILE", help="run record (.csv/.jsonl/.mcap) or curves CSV")
     p.add_argument("--out", required=True, metavar="FILE.png", help="PNG to write")
     return one_line_errors(p)
 

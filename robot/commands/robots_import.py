@@ -19,6 +19,7 @@ from robot.config.model_import import build, check_servo, read_map, summary
 from robot.config.model_text import robot_file_text
 from robot.config.robot_file import parse_robot
 from robot.errors import ConfigError
+from robot.gait.ik_chain import check_layout
 from robot.servo.models import BUS_FAMILIES, MODELS, factory_baud
 
 MISSING = ("error", "box")
@@ -92,6 +93,8 @@ def run_import(args: argparse.Namespace) -> int:
     imp = build(tree, servo=servo, joint_map=recipe.joints, file=path.name,
                 source=source, licence=licence)
     imp.warnings[:0] = warnings
+    for leg in imp.model.legs:   # a leg the closed-form IK cannot solve is refused here
+        check_layout(leg, where=str(path))
     baud = args.baud or int(recipe.bus.get("baud", 0)) or (  # type: ignore[call-overload]
         1_000_000 if 1_000_000 in _bauds(servo) else factory_baud(servo))
     name = args.name or out.stem

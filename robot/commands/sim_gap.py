@@ -25,7 +25,9 @@ from robot.commands.common import checked, input_file, output_file
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
+from robot.loop.mcap_recorder import is_mcap
 from robot.motion.takes import Take, read_take
+from robot.previs.mcap_read import mcap_take
 from robot.servo.bench_load import BenchLoad, parse_load
 
 Floats = npt.NDArray[np.float64]
@@ -50,7 +52,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p = subparsers.add_parser("sim-gap", help="compare a take recorded on servos with the "
                               "simulation of the same commands", description=__doc__,
                               formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("take", metavar="TAKE", help="a take recorded on a servo bus (.take.jsonl)")
+    p.add_argument("take", metavar="TAKE", help="a take recorded on a servo bus (.take.jsonl; or a .mcap)")
     p.add_argument("--robot", default=None, metavar="NAME|PATH",
                    help="the robot file to simulate (default: the one the take names)")
     p.add_argument("--world", choices=("robot", "bench"), default="robot",
@@ -146,7 +148,8 @@ def plot(robot: RobotConfig, take: Take, sim: Floats, path: str) -> None:
 def run(args: argparse.Namespace) -> int:
     from sim.mujoco.take_replay import replay
 
-    take = read_take(checked("TAKE", input_file, args.take))
+    path = checked("TAKE", input_file, args.take)
+    take = mcap_take(path) if is_mcap(path) else read_take(path)
     plot_path = None if args.plot is None else checked("--plot", output_file, args.plot)
     robot = robot_for(take, args.robot)
     loads = loads_from(args.load)

@@ -14,7 +14,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robot.config.joint_names import ARM_NAMES, EXTRA_NAME, HIP_YAW_NAMES, JOINT_NAMES, LEG_NAMES
+from robot.config.joint_names import (
+    ANKLE_ROLL_NAMES,
+    ARM_NAMES,
+    EXTRA_NAME,
+    HIP_YAW_NAMES,
+    JOINT_NAMES,
+    LEG_NAMES,
+)
 from robot.config.toml_io import TomlValue, show
 from robot.errors import ConfigError
 from robot.servo import ticks as tick_math
@@ -109,8 +116,8 @@ def check_ticks(robot: RobotConfig) -> None:
 
 
 def check_joint_set(src: str, jtab: Mapping[str, TomlValue]) -> None:
-    """Every leg joint (hip yaw on both sides or neither), all arm joints or none; any
-    other name is an extra joint and needs ``fixed_rad``."""
+    """Every leg joint (hip yaw, ankle roll: on both sides or neither, not both left out),
+    all arm joints or none; any other name is an extra joint and needs ``fixed_rad``."""
     for name, entry in jtab.items():
         if name in JOINT_NAMES:
             continue
@@ -121,16 +128,19 @@ def check_joint_set(src: str, jtab: Mapping[str, TomlValue]) -> None:
             raise ConfigError(f"{src}: joints.{name}: unknown joint; the gait drives "
                               f"{', '.join(JOINT_NAMES)}; an extra joint (e.g. head_pan) "
                               "needs fixed_rad, the angle it is held at [rad]")
-    legs = [n for n in LEG_NAMES if n not in HIP_YAW_NAMES]
+    legs = [n for n in LEG_NAMES if n not in HIP_YAW_NAMES + ANKLE_ROLL_NAMES]
     missing = [n for n in legs if n not in jtab]
     if missing:
         raise ConfigError(f"{src}: joints.{missing[0]}: missing (every leg joint is required; "
-                          "only hip yaw may be left out, on both sides)")
-    yaws = [n for n in HIP_YAW_NAMES if n in jtab]
-    if len(yaws) == 1:
-        absent = next(n for n in HIP_YAW_NAMES if n not in jtab)
-        raise ConfigError(f"{src}: joints.{absent}: missing (hip yaw on both legs, or neither "
-                          "for 5-DoF legs)")
+                          "only hip yaw or ankle roll may be left out, on both sides)")
+    for pair, what in ((HIP_YAW_NAMES, "hip yaw"), (ANKLE_ROLL_NAMES, "ankle roll")):
+        if sum(n in jtab for n in pair) == 1:
+            absent = next(n for n in pair if n not in jtab)
+            raise ConfigError(f"{src}: joints.{absent}: missing ({what} on both legs, or "
+                              "neither for 5-DoF legs)")
+    if not any(n in jtab for n in HIP_YAW_NAMES + ANKLE_ROLL_NAMES):
+        raise ConfigError(f"{src}: joints.r_hip_yaw: missing (a leg needs hip yaw or ankle "
+                          "roll: without both, 4 joints cannot place a foot and keep it level)")
     arms = [n for n in ARM_NAMES if n in jtab]
     if arms and len(arms) != len(ARM_NAMES):
         absent = next(n for n in ARM_NAMES if n not in jtab)

@@ -15,6 +15,7 @@ What each joint gets (robot/body/roles.py finds the roles, signs and offsets):
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,9 +36,9 @@ REST = {"hip_pitch": -0.55, "knee": 1.1, "ankle_pitch": -0.55}
 #: What ``--map`` may say of a model joint: its name (an extra joint's), its servo's id,
 #: limits in the project's convention (min_rad, max_rad) or the model's (model_range,
 #: [rad]: where a vendor documents them so) and where they come from, a slew limit, the
-#: angle an extra joint is held at.
+#: angle an extra joint is held at, weld (true: no servo drives it; welded at the model's zero).
 MAP_KEYS = {"name", "servo_id", "min_rad", "max_rad", "model_range", "max_speed_rad_s",
-            "limits_source", "fixed_rad"}
+            "limits_source", "fixed_rad", "weld"}
 
 
 @dataclass(frozen=True)
@@ -117,7 +118,19 @@ def _order(name: str) -> tuple[int, int]:
 
 def build(tree: BodyTree, *, servo: ServoModel, joint_map: dict[str, dict[str, object]],
           file: str, source: str = "", licence: str = "") -> Imported:
-    """Roles, measurements and joint tables of ``tree`` (see the module docstring)."""
+    """Roles, measurements and joint tables of ``tree`` (see the module docstring). A
+    model joint the map marks ``weld = true`` (one no servo drives: a PWM servo off the
+    bus, a passive part) is welded at the model's zero."""
+    welded = [n for n, e in joint_map.items() if e.get("weld") is True]
+    missing = [n for n in welded if n not in tree.joint_link]
+    if missing:
+        raise ConfigError(f"--map: joints.{missing[0]}: the model has no joint of that name; "
+                          f"valid: {', '.join(tree.joint_link)}")
+    if welded:
+        tree = dataclasses.replace(tree, links=tuple(
+            dataclasses.replace(link, joint=None) if link.joint and link.joint.name in welded
+            else link for link in tree.links))
+        joint_map = {n: e for n, e in joint_map.items() if n not in welded}
     roles = find_roles(tree)
     m = measure(tree, roles)
     warnings: list[str] = []

@@ -25,7 +25,8 @@ class Recorder:
         self.path = Path(path)
         if self.path.suffix not in FORMATS:
             raise ConfigError(f"--record {path}: unknown format {self.path.suffix!r}; "
-                              f"valid: {', '.join(FORMATS)}, or .take.jsonl (a take for biped play)")
+                              f"valid: {', '.join(FORMATS)}, .mcap, or .take.jsonl (a take for biped "
+                              "play)")
         self.names = joint_names
         self.ids = ids
         self._file: IO[str] | None = None

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import IO, Any
 
@@ -18,10 +18,14 @@ class TakeWriter:
     """Writes a take as the run goes: ``open()`` writes the header, ``event()`` a timeline
     line (from the loop thread, via ``robot.motion.scripted.RecordingEngine``), and calling it with
     the loop's telemetry writes the tick. A failed write (disk full) is kept and raised at
-    the next tick, so the streamer ends the run as an observer fault (ramp out, torque off)."""
+    the next tick, so the streamer ends the run as an observer fault (ramp out, torque off).
+    ``show_time``: a chased show's time (robot/timecode/chased.py): each tick's ``t``, from
+    the first tick it is known."""
 
-    def __init__(self, path: str | Path, header: TakeHeader) -> None:
+    def __init__(self, path: str | Path, header: TakeHeader, *,
+                 show_time: Callable[[], float | None] | None = None) -> None:
         self.path = Path(path)
+        self.show_time = show_time
         if not is_take(self.path):
             raise ConfigError(f"{path}: a take file name ends in {SUFFIX}")
         self.header = header
@@ -57,6 +61,15 @@ class TakeWriter:
         if self._file is None or tel.tick == self._last_tick or not tel.q_cmd:
             return
         self._last_tick = tel.tick
+        if self.show_time is not None:          # a chased show: t is its show time, from
+            shown = self.show_time()            # the first tick the timecode was heard
+            if shown is None:
+                return
+            self.ticks += 1
+            self._line({"tick": tel.tick, "t": round(shown, 9), "state": tel.state,
+                        "q": tel.q_cmd, **({"present": tel.q_present}
+                                           if tel.fresh and tel.q_present else {})})
+            return
         if self._t0 is None:
             self._t0 = tel.t
         self.ticks += 1

@@ -84,7 +84,8 @@ class Studio:
             params=self.c.params, bus=self.c.bus.kind, balance=o.balance,
             note="recorded from the panel")
         path = self.takes_dir / f"{take}{SUFFIX}"
-        self.c.start(run=Record(take, str(path), header), received=received)
+        mcap = str(path.with_name(f"{take}.mcap")) if o.mcap else None
+        self.c.start(run=Record(take, str(path), header, mcap=mcap), received=received)
         return take
 
     def play(self, name: object, *, received: float | None = None) -> dict[str, Any]:

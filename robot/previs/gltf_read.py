@@ -5,7 +5,10 @@ The first skin's joints are the bones (a joint's parent: its nearest ancestor th
 joint; the nodes above the root bone, e.g. Blender's armature object, fold into the root's
 rest); the first animation's rotation and translation channels on them are sampled at a
 uniform frame rate, the smallest key spacing of the animation (LINEAR: slerp, STEP: the key
-before, CUBICSPLINE: its value through the keys). Node scale is taken as 1. pygltflib reads
+before, CUBICSPLINE: its value through the keys). An animation of LINEAR tracks only is
+*sampled* (Blender bakes every frame so; ``Rig.sampled``: the import's spline recovers what
+lies between the frames); one with a CUBICSPLINE or STEP track is keyframes, whose curves
+the import follows with the monotone cubic (robot/motion/interp.py). Node scale is taken as 1. pygltflib reads
 the container; accessors are decoded here with numpy (float, or normalised integers as the
 spec allows for rotations).
 """
@@ -176,5 +179,6 @@ def read_gltf(path: str | Path) -> Rig:
     parents = tuple(index[bone_parent(j)] if bone_parent(j) != -1 else -1 for j in order)
     leaf_ends = tuple((index[up[c]], tuple(float(v) for v in _rest(doc.nodes[c])[1]))
                       for c in range(len(doc.nodes)) if c not in joints and up.get(c) in index)
+    sampled = all((s.interpolation or "LINEAR") == "LINEAR" for s in channels.values())
     return Rig.from_local(names, parents, offsets, rest, local, root, nominal_frame_s(step),
-                          ends=leaf_ends, source=src)  # type: ignore[arg-type]
+                          ends=leaf_ends, source=src, sampled=sampled)  # type: ignore[arg-type]

@@ -2,9 +2,13 @@
 joint stream at the control rate, its violations, and the take that `biped play` streams.
 
 The stream's rate is the smallest whole multiple of the animation's frame rate at or
-above ``min_rate`` (every frame is a tick: a round trip compares frame for frame);
-between frames the joints follow the monotone cubic through them (robot/motion/interp.py
-``smooth``: no overshoot, so no limit is crossed that the frames do not cross). Where the
+above ``min_rate`` (every frame is a tick: a round trip compares frame for frame).
+Between the frames of a sampled animation (a BVH, a glTF of LINEAR tracks: ``Rig.sampled``)
+the joints follow the C2 cubic spline through them (robot/motion/interp.py ``spline``: a
+peak between two frames comes back, the acceleration does not step at each frame; kept
+inside the joint limits where the frames are, so no limit is crossed that the frames do
+not cross); between sparse keyframes (a glTF's CUBICSPLINE or STEP tracks) the monotone
+cubic (``smooth``: no overshoot). Where the
 animation walks, the gait's travel is planned from the root's motion (robot/previs/
 travel.py) and written as the take's parameter timeline (robot/motion/show_walk.py).
 """
@@ -25,6 +29,7 @@ from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.motion.interp import smooth
+from robot.motion.kinks import sampled
 from robot.motion.show import Show
 from robot.motion.takes import TakeHeader
 from robot.previs.bone_map import BoneMap
@@ -92,7 +97,10 @@ def import_animation(path: str | Path, robot: RobotConfig, bone_map: BoneMap, ho
         raise ConfigError(f"{path}: {frames.t[-1]:.0f} s at {rate:g} Hz is {n} ticks, more "
                           f"than a take holds ({MAX_TICKS}); lower --rate or cut the animation")
     t = np.arange(n) / rate
-    raw = smooth(frames.t, frames.q, t) if len(frames.t) > 1 else frames.q[:1].copy()
+    raw = (frames.q[:1].copy() if len(frames.t) < 2 else
+           sampled(frames.t, frames.q, t, lo=np.array([j.min_rad for j in robot.joints]),
+                  hi=np.array([j.max_rad for j in robot.joints]))
+           if rig.sampled else smooth(frames.t, frames.q, t))
     found = check(robot, t, raw, max_accel=max_accel, joints=frames.animated)
     q = clamp(robot, t, raw, max_accel=max_accel) if found else raw
     plans: tuple[WalkPlan, ...] = ()

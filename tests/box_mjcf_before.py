@@ -3,8 +3,9 @@ sim/mujoco/mjcf_robot.py wrote it straight from a robot file before the box mode
 body tree (commit 8f95a8c, issue 31): default classes for the joint groups, capsules by
 ``fromto``, ``diaginertia`` boxes, written element by element from ``Geometry`` and
 ``Masses``. It shares with the code under test only the inputs (the robot file, the
-extra joints' layout, the servo law of sim/mujoco/servo_law.py) and the scene; the body,
-the classes, the inertials, the shapes and the sites are this file's own.
+extra joints' layout), the servo law (sim/mujoco/mjcf_robot.py ``servo_attributes``) and
+the scene; the body, the classes, the inertials, the shapes and the sites are this file's
+own.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import numpy.typing as npt
 from robot.config.extra_joints import UNIT, extra_axis, extra_layout, link_length
 from robot.config.joint_names import JOINT_NAMES
 from robot.config.robot import RobotConfig
-from sim.mujoco.servo_law import robot_servos
+from sim.mujoco.mjcf_robot import servo_attributes
 
 AXES = {"hip_yaw": "0 0 1", "hip_roll": "1 0 0", "hip_pitch": "0 1 0", "knee": "0 1 0",
         "ankle_pitch": "0 1 0", "ankle_roll": "1 0 0", "shoulder_pitch": "0 1 0",
@@ -32,29 +33,9 @@ CONTACT = {"r_leg": ("2", "5"), "l_leg": ("4", "3"), "body": ("0", "1")}
 SERVO_DENSITY = 1500.0  # [kg/m^3], a servo's average density (sets link thickness)
 
 
-def servo_attributes(robot: RobotConfig) -> dict[str, tuple[dict[str, str], dict[str, str]]]:
-    """Per joint name: (joint attributes, actuator attributes) of its servo with the torque
-    on (``sim.mujoco.servo_law``: the firmware law at the robot's gains and voltage, the
-    motor's back-EMF and the gearbox as damping, frictionloss and armature)."""
-    a = robot_servos(robot)
-    out = {}
-    for i, j in enumerate(robot.joints):
-        joint = {"armature": num(a.armature[i]), "damping": num(a.viscous[i] + a.back_emf[i]),
-                 "frictionloss": num(a.coulomb[i] + a.stribeck[i])}
-        act = {"kp": num(a.kp[i]), "kv": num(a.kv[i]),
-               "forcerange": num(-a.force[i], a.force[i])}
-        out[j.name] = (joint, act)
-    return out
-
-
 def fmt(*values: float) -> str:
     """Floats as exact shortest round-trip strings (FK tests compare to 1e-9 m)."""
     return " ".join(repr(float(v)) for v in values)
-
-
-def num(*values: float) -> str:
-    """Physical parameters to 6 significant digits (readability over round-trip)."""
-    return " ".join(f"{v:.6g}" for v in values)
 
 
 def _sub(parent: ET.Element, tag: str, **attrs: str) -> ET.Element:

@@ -1,10 +1,10 @@
 """A servo at rest stops short of its goal, and the model's friction is what holds it
 (issue 34; docs/servos.md, "At rest"). Oracle: the real XL330-M288 recordings
-(../shared/servo_logs/bam/xl330 beside the repository, Rhoban/bam): each opens with the servo at rest on goal 0, torque
-on, the arm hanging, several pulses off the goal while the firmware keeps pushing (Present
-PWM); the bundled model's friction at rest must hold what the recording shows held:
-the motor's torque (PWM of 885, times the stall torque at the log's supply) plus gravity
-on the arm pushing the same way.
+(../shared/servo_logs/bam/xl330 beside the repository, Rhoban/bam): each opens with the
+servo at rest on goal 0, torque on, the arm hanging, several pulses off the goal while
+the firmware keeps pushing (Present PWM); the bundled model's friction at rest must hold
+what the recording shows held: the motor's torque (PWM of 885, times the stall torque at
+the log's supply) plus gravity on the arm pushing the same way.
 """
 
 from __future__ import annotations

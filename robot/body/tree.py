@@ -4,8 +4,9 @@ centre of mass, inertia, collision shapes and named frames.
 One description, two sources: the box model built from a robot file's dozen lengths
 (robot/body/boxes.py) and a builder's own URDF or MJCF (robot/body/urdf_read.py,
 mjcf_read.py, through ``biped robots import``); robot/config/body_tree.py gives either
-in the robot's terms. The simulation and ``biped mjcf`` (sim/mujoco/mjcf_body.py), the leg
-IK's chains (robot/body/legs.py) and the previs skeleton read this.
+in the robot's terms. The simulation and ``biped mjcf`` build MuJoCo from it
+(sim/mujoco/mjcf_body.py), and an imported robot's leg IK chains are measured on it
+(robot/body/legs.py).
 
 Frames: each link's frame is given relative to its parent's at the zero pose of every
 joint (all hinge angles 0, in the model's own convention); the root link's frame is the

@@ -14,6 +14,17 @@ from bvhio import BvhContainer, BvhJoint, writeBvh
 from pyglm import glm
 from SpatialTransform import Pose
 
+#: A four-joint hierarchy in our skeleton's names, the right knee's Xrotation its pitch (15
+#: channels a frame: the root's 6, then 3 each), up to its MOTION line.
+KNEE_HIERARCHY = [
+    "HIERARCHY", "ROOT pelvis", "{", "OFFSET 0 0 0",
+    "CHANNELS 6 Xposition Yposition Zposition Yrotation Zrotation Xrotation",
+    "JOINT r_hip", "{", "OFFSET -5 0 0", "CHANNELS 3 Yrotation Zrotation Xrotation",
+    "JOINT r_knee", "{", "OFFSET 0 -10 0", "CHANNELS 3 Zrotation Yrotation Xrotation",
+    "End Site", "{", "OFFSET 0 -10 0", "}", "}", "}",
+    "JOINT l_hip", "{", "OFFSET 5 0 0", "CHANNELS 3 Yrotation Zrotation Xrotation",
+    "End Site", "{", "OFFSET 0 -20 0", "}", "}", "}", "MOTION"]
+
 #: The chosen motion: joint → angle [rad] at time t [s]; each inside the default robot's
 #: limits and speeds.
 ANGLES: dict[str, Callable[[float], float]] = {

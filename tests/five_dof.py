@@ -45,3 +45,14 @@ def five_dof_with_head(tmp_path: Path) -> Path:
 def five_dof_robot() -> RobotConfig:
     """The robot, parsed from memory."""
     return parse_robot(tomllib.loads(five_dof_text()), source="five.toml")
+
+
+def no_ankle_roll_text() -> str:
+    """The bundled legs-only robot without ankle roll (hip yaw kept): the 5-DoF legs of
+    the Open Duck Mini, on the box model."""
+    return re.sub(r"(?ms)^\[joints\.[rl]_ankle_roll\].*?(?=^\[)", "", LEGS.read_text())
+
+
+def no_ankle_roll_robot() -> RobotConfig:
+    """That robot, parsed from memory."""
+    return parse_robot(tomllib.loads(no_ankle_roll_text()), source="no-ankle-roll.toml")

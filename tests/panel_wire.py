@@ -70,13 +70,14 @@ class Panel:
 
 
 @contextmanager
-def launched(emu: Emulator, robot_toml: Path, tmp: Path, *extra: str,
+def launched(emu: Emulator | None, robot_toml: Path, tmp: Path, *extra: str,
              rate: float = 200.0, start: bool = False) -> Iterator[Panel]:
-    """`biped panel` on ``emu`` (``--no-start`` unless ``start``; stderr collected in
-    ``Panel.err``); SIGTERM and a wait for its exit at the end (killed if it will not
-    end)."""
-    cmd = [sys.executable, "-m", "robot.cli", "panel", "--bus", emu.protocol, "--port",
-           emu.port, "--robot", str(robot_toml), "--http-port", "0", "--rate", f"{rate:g}",
+    """`biped panel` on ``emu`` (None: the sim bus; ``--no-start`` unless ``start``;
+    stderr collected in ``Panel.err``); SIGTERM and a wait for its exit at the end
+    (killed if it will not end)."""
+    bus = ["--bus", "sim"] if emu is None else ["--bus", emu.protocol, "--port", emu.port]
+    cmd = [sys.executable, "-m", "robot.cli", "panel", *bus,
+           "--robot", str(robot_toml), "--http-port", "0", "--rate", f"{rate:g}",
            "--presets-dir", str(tmp / "presets"), "--studio-dir", str(tmp / "studio"),
            *extra, *([] if start else ["--no-start"])]
     proc = subprocess.Popen(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
@@ -230,3 +231,24 @@ def gone(pid: int) -> bool:
         return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "Z"
     except OSError:
         return True
+
+
+def patient_robot_file(tmp: Path) -> Path:
+    """The bundled 18-Dynamixel robot with bus_harness.PATIENT_TIMEOUT_MS (a starved
+    emulator on a loaded machine), written under ``tmp``."""
+    from bus_harness import PATIENT_TIMEOUT_MS
+
+    from robot.config.bundled import ROBOTS_DIR
+    text = (ROBOTS_DIR / "biped18-dynamixel.toml").read_text()
+    path = tmp / "robot.toml"
+    path.write_text(text.replace("timeout_ms = 20.0", f"timeout_ms = {PATIENT_TIMEOUT_MS}"))
+    return path
+
+
+def osc_datagram(address: str, *args: float | str) -> bytes:
+    """One OSC message, built by python-osc's builder (not by the code under test)."""
+    from pythonosc.osc_message_builder import OscMessageBuilder
+    b = OscMessageBuilder(address)
+    for a in args:
+        b.add_arg(a)
+    return bytes(b.build().dgram)

@@ -65,7 +65,7 @@ def run_cli(argv: list[str], capsys: pytest.CaptureFixture[str],
             monkeypatch: pytest.MonkeyPatch) -> tuple[int, str, str]:
     """(exit code, stdout, stderr) of ``biped <argv>`` in-process. Only the command under test
     is built (others may be mid-edit); argparse's own exit counts like a returned code."""
-    monkeypatch.setattr(cli, "COMMANDS", (argv[0],))
+    monkeypatch.setattr(cli, "COMMANDS", (cli.command_of(argv) or argv[0],))  # import_
     try:
         code = cli.main(argv)
     except SystemExit as e:
@@ -146,8 +146,8 @@ def big_int_cases() -> Iterator[tuple[str, str, str, str]]:
     yield "bus", "baud", "bus.baud", f"one of {DXL_BAUDS}"
     yield "bus", "retries", "bus.retries", "[0, 10]"
     yield "bus", "timeout_ms", "bus.timeout_ms", "[1, 1000] ms"
-    for g in GEOMETRY:
-        yield "geometry", g, f"geometry.{g}", "[0.001, 2] m"
+    for g in GEOMETRY:   # the sole's centre may sit behind the ankle (an imported foot)
+        yield "geometry", g, f"geometry.{g}", "[-0.5, 0.5] m" if g == "foot_forward" else "[0.001, 2] m"
     for m in MASSES:
         yield "mass", m, f"mass.{m}", "[0.001, 100] kg"
     for k, rng in JOINT_RANGES.items():

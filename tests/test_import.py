@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from anim_files import ANGLES, map_toml, write_blender_bvh, write_blender_gltf
+from anim_files import ANGLES, KNEE_HIERARCHY, map_toml, write_blender_bvh, write_blender_gltf
 
 import robot.cli as cli
 from robot.config.gait_file import load_gait
@@ -84,16 +84,25 @@ def test_export_then_import_round_trips(tmp_path: Path, suffix: str) -> None:
     assert np.abs(take.q[::7] - qt.T).max() < 1e-4
 
 
+@pytest.mark.parametrize("suffix", [".bvh", ".glb"])
+def test_what_lies_between_the_frames_comes_back(tmp_path: Path, suffix: str) -> None:
+    """The gait at 30 fps, imported again, against the gait itself at every tick of 210 Hz
+    (6 ticks of 7 between frames): within 0.005 rad on every joint. The monotone cubic was
+    0.0183 rad off at the right knee (it flattens the peaks and rounds the kinks of the
+    swing's lift), a C2 spline alone 0.0197 (it rings at the kinks): robot/motion/kinks.py."""
+    anim, out = tmp_path / f"walk{suffix}", tmp_path / "walk.take.jsonl"
+    assert cli.main(["export", "--gait", "walk", "--seconds", "2", "--fps", "30",
+                     "--out", str(anim)]) == 0
+    assert cli.main(["import", str(anim), "--out", str(out)]) == 0
+    take = read_take(out)
+    t = np.arange(len(take.t)) / take.header.rate_hz
+    _, qt = GaitEngine(load_robot(), load_gait("walk").params).curves(t, with_channels=False)
+    assert np.abs(take.q - qt.T).max(axis=0).max() < 0.005
+
+
 def _knee_bvh(path: Path, knee_deg: list[float], fps: float = 30.0) -> None:
     """Our skeleton's names, only the right knee moving (Xrotation: the robot's pitch)."""
-    lines = ["HIERARCHY", "ROOT pelvis", "{", "OFFSET 0 0 0",
-             "CHANNELS 6 Xposition Yposition Zposition Yrotation Zrotation Xrotation",
-             "JOINT r_hip", "{", "OFFSET -5 0 0", "CHANNELS 3 Yrotation Zrotation Xrotation",
-             "JOINT r_knee", "{", "OFFSET 0 -10 0", "CHANNELS 3 Zrotation Yrotation Xrotation",
-             "End Site", "{", "OFFSET 0 -10 0", "}", "}", "}",
-             "JOINT l_hip", "{", "OFFSET 5 0 0", "CHANNELS 3 Yrotation Zrotation Xrotation",
-             "End Site", "{", "OFFSET 0 -20 0", "}", "}", "}",
-             "MOTION", f"Frames: {len(knee_deg)}", f"Frame Time: {1 / fps:.6f}"]
+    lines = [*KNEE_HIERARCHY, f"Frames: {len(knee_deg)}", f"Frame Time: {1 / fps:.6f}"]
     lines += [f"0 25 0 0 0 0 0 0 0 0 0 {d} 0 0 0" for d in knee_deg]
     path.write_text("\n".join(lines) + "\n")
 

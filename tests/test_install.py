@@ -28,13 +28,13 @@ from robot.errors import ConfigError
 
 REPO = Path(__file__).resolve().parent.parent
 #: What the distribution is built from (pyproject.toml's packages and readme).
-SOURCES = ("pyproject.toml", "README.md", "robot", "sim")
+SOURCES = ("pyproject.toml", "README.md", "LICENSE", "robot", "sim")
 
 
 @pytest.fixture(scope="module")
-def wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def built(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
     """A wheel built from a clean copy of the sources (a stale build/ directory in the
-    checkout cannot add files to it)."""
+    checkout cannot add files to it), and what the build backend printed (pip -v)."""
     tmp = tmp_path_factory.mktemp("wheel")
     src = tmp / "src"
     for name in SOURCES:
@@ -44,11 +44,30 @@ def wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
         else:
             src.mkdir(exist_ok=True)
             shutil.copy2(REPO / name, src / name)
-    r = subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", str(src),
+    r = subprocess.run([sys.executable, "-m", "pip", "wheel", "-v", "--no-deps", str(src),
                         "-w", str(tmp / "dist")], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stdout + r.stderr
-    (built,) = (tmp / "dist").glob("biped-*.whl")
-    return built
+    (whl,) = (tmp / "dist").glob("biped-*.whl")
+    return whl, r.stdout + r.stderr
+
+
+@pytest.fixture(scope="module")
+def wheel(built: tuple[Path, str]) -> Path:
+    return built[0]
+
+
+def test_the_licence_is_an_spdx_string_with_its_file_and_the_build_does_not_warn(
+        built: tuple[Path, str]) -> None:
+    """The packaging guide's form (core metadata 2.4): License-Expression and License-File;
+    the TOML-table form made setuptools print a deprecation warning on every build."""
+    whl, log = built
+    assert "Warning" not in log and "deprecated" not in log, log
+    with zipfile.ZipFile(whl) as z:
+        (meta,) = [n for n in z.namelist() if n.endswith(".dist-info/METADATA")]
+        text = z.read(meta).decode()
+        assert any(n.endswith(".dist-info/licenses/LICENSE") for n in z.namelist())
+    assert "License-Expression: MIT\n" in text and "License-File: LICENSE\n" in text
+    assert (REPO / "LICENSE").read_text().startswith("MIT License")
 
 
 @pytest.fixture(scope="module")

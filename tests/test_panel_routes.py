@@ -96,7 +96,8 @@ def spied(controller: PanelController, studio: Studio
 def test_the_table_holds_the_documented_endpoints(spied: tuple[int, list, list]) -> None:
     _, routes, _ = spied
     expected = {("GET", p) for p in ("/", "/index.html", "/panel.js", "/panel.css", "/input.js",
-                                     "/studio.js", "/api/state", "/api/params", "/api/presets",
+                                     "/studio.js", "/midi.js", "/api/state", "/api/params",
+                                     "/api/presets",
                                      "/api/live", "/api/takes", "/api/sequences",
                                      "/api/show/audio")}
     expected |= {("POST", "/api/" + p) for p in (

@@ -2,20 +2,24 @@
 
 ``TickKernel.pose`` must give exactly what ``expressions.channels`` → ``targets.body_targets``
 → ``engine.solve`` give on Python floats, for any parameters, phase, envelope and trim
-(including unreachable targets, turning and the 5-DoF legs). Compared as the bits of each
-float (``struct``), so -0.0 and 0.0 differ.
+(including unreachable targets, turning and the 5-DoF legs), and for legs with real
+offsets (robot.gait.ik_chain: 6-DoF, without hip yaw, without ankle roll in both hip
+orders, with and without Newton steps). Compared as the bits of each float (``struct``),
+so -0.0 and 0.0 differ.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import struct
 
 import pytest
-from five_dof import five_dof_robot
+from five_dof import five_dof_robot, no_ankle_roll_robot
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from robot.body.legs import LegChain
 from robot.config.bundled import ROBOTS_DIR
 from robot.config.params import SPECS, GaitParams
 from robot.config.robot import RobotConfig
@@ -27,6 +31,33 @@ from robot.gait.vectorised import solve
 
 ROBOTS = {p.stem: load_robot(p) for p in sorted(ROBOTS_DIR.glob("*.toml"))}
 ROBOTS["five-dof"] = five_dof_robot()      # no hip yaw: turn steers by step length
+
+
+def chains(robot: RobotConfig, yaw_off: tuple[float, float]) -> RobotConfig:
+    """``robot`` with real legs' offsets (robot.gait.ik_chain's closed form): the yaw axis
+    ``yaw_off`` (x, inward) [m] off the hip, the roll axis 12 mm above the pitch axis, 6 mm
+    sideways, the ankle roll 10 mm below the ankle pitch, the sole 10 mm ahead."""
+    g = robot.geometry
+
+    def leg(side: str, out: float) -> LegChain:
+        hip = (0.002, out * g.hip_width / 2, 0.01)
+        return LegChain(side, hip, g.thigh, g.shin, (0.01, out * 0.002, -g.ankle_height),
+                        yaw_axis=((hip[0] + yaw_off[0], hip[1] - out * yaw_off[1])
+                                  if robot.has_hip_yaw else None),
+                        roll_drop=0.012, lateral=out * 0.006,
+                        ankle_drop=0.01 if robot.has_ankle_roll else 0.0,
+                        has_ankle_roll=robot.has_ankle_roll,
+                        order="roll_yaw" if yaw_off[1] < 0 else "yaw_roll")
+    return dataclasses.replace(robot, leg_chains=(leg("r", -1.0), leg("l", 1.0)))
+
+
+_DYN = ROBOTS["biped18-dynamixel"]
+ROBOTS["chain-6dof"] = chains(_DYN, (0.016, 0.0))            # closed form
+ROBOTS["chain-6dof-newton"] = chains(_DYN, (0.016, 0.01))    # yaw axis off sideways too
+ROBOTS["chain-no-yaw"] = chains(ROBOTS["five-dof"], (0.0, 0.0))
+ROBOTS["no-ankle-roll"] = no_ankle_roll_robot()             # the box legs, 5-DoF
+ROBOTS["chain-no-ankle-roll"] = chains(ROBOTS["no-ankle-roll"], (-0.016, 0.01))
+ROBOTS["chain-no-ankle-roll-roll-yaw"] = chains(ROBOTS["no-ankle-roll"], (0.01, -0.01))
 KERNELS = {name: TickKernel(r) for name, r in ROBOTS.items()}
 
 

@@ -53,7 +53,7 @@ from robot.balance.capturability import (
     ray_exit,
     region,
 )
-from robot.balance.capture_robot import Reach, reach, sole, swing
+from robot.balance.capture_robot import Reach, reach, sole, swing, zero_width
 from robot.config.robot import RobotConfig
 
 #: The step-time grid's spacing [samples of the swing's 5 ms grid]: 10 ms.
@@ -139,7 +139,7 @@ def _later(robot: RobotConfig, stance: float, half: float, sign: float) -> Float
 def numbers(robot: RobotConfig, stance: float, spread: float = 0.0) -> Numbers:
     """The numbers for ``robot`` walking at ``stance`` with feet ``spread`` [m] outward."""
     r = reach(robot, stance, spread=spread)
-    hw = robot.geometry.hip_width
+    hw = zero_width(robot)
     sw = swing(robot, stance, "roll", spread, 0.5 * (r.out - hw))
     sw_in = swing(robot, stance, "roll", spread, 0.5 * (r.inward - hw))
     return Numbers(robot, stance, sole(robot), r, sw.times,
@@ -173,10 +173,12 @@ def _support(n: Numbers, foot: Foot) -> Box:
 def _first_reach(n: Numbers, step_side: int, foot: Foot) -> tuple[Floats, Floats, Floats, Floats]:
     """Where the stepping foot (``step_side`` 0 right, 1 left) can land relative to the
     standing ankle within each grid time: x lo, x hi, y lo, y hi [m]."""
-    r, hw = n.reach, n.robot.geometry.hip_width
+    r, hw = n.reach, zero_width(n.robot)
     dx = foot.ankle[0] - foot.hip[0]
     out_sign = 1.0 if step_side == 1 else -1.0
-    dy = out_sign * (foot.ankle[1] - foot.hip[1])
+    # outward of where the ankle hangs at the zero pose (an imported leg's lateral offset)
+    chain = n.robot.legs[step_side]
+    dy = out_sign * (foot.ankle[1] - foot.hip[1] - chain.lateral)
     fx, bx = 0.5 * r.forward, 0.5 * r.back
     oy, iy = 0.5 * (r.out - hw), 0.5 * (r.inward - hw)
     dx, dy = min(max(dx, -bx), fx), min(max(dy, iy), oy)

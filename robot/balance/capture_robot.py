@@ -6,18 +6,22 @@ fast its servos swing it there.
   sole's toe (foot_forward + foot_length / 2 ahead), heel (foot_length / 2 -
   foot_forward behind) and edges (foot_width / 2 each side), each no further than the
   ankle servo can hold the whole robot's weight: stall torque / (m g), the ankle pitch
-  servo's toward toe and heel, the ankle roll servo's toward the edges (the stall from the
-  servo law at the robot's gains and voltage: robot.servo.law.Law.stall).
-- **Reach** (``reach``): the legs straddle at the walk's hip height h = stance x
-  leg_length over the ankles, each foot flat, the pelvis midway; a step of length l puts
-  one sole l / 2 ahead of its hip and the other l / 2 behind, and the largest l forward
-  and backward (and the widest step out, at no stride) are where robot.gait.ik.leg_ik
-  still reaches both feet with every joint inside its limits (bisection to 0.1 mm).
+  servo's toward toe and heel, the ankle roll servo's toward the edges (a leg without
+  ankle roll: the hip roll's), the stall from the servo law at the robot's gains and
+  voltage (robot.servo.law.Law.stall), m the body tree's mass.
+- **Reach** (``reach``): the legs (the IK's chains, robot.config.robot.RobotConfig.legs)
+  straddle at the walk's hip height h = stance x (thigh + shin) over the ankles, each
+  foot flat, the pelvis midway; a step of length l puts one sole l / 2 ahead of where it
+  hangs at the zero pose and the other l / 2 behind, and the largest l forward and
+  backward (and the widest step out, at no stride) are where the chain IK
+  (robot.gait.ik_chain.chain_leg_ik) still reaches both feet with every joint inside its
+  limits (bisection to 0.1 mm).
   Inward the soles keep FOOT_GAP_M between them (the legs do not collide and no foot
   crosses the other: the narrowest step is foot_width + FOOT_GAP_M, ankle to ankle).
-- **Swing** (``swing``): the swinging leg is a rigid body of point masses (the robot
-  file's link masses at the link centres of the walk's stance pose) about the hip pitch
-  axis (steps forward and back) and the hip roll axis (steps sideways), its servo the hip
+- **Swing** (``swing``): the swinging leg is a rigid body (every link its hip joint moves,
+  from the robot's body tree: the box model of its ``[geometry]`` and ``[mass]``, or an
+  imported ``[model]``) in the walk's stance pose, about the hip pitch axis (steps
+  forward and back) and the hip roll axis (steps sideways), its servo the hip
   pitch or roll joint's at the robot's gains and voltage, its goal slewed at the joint's
   ``max_speed_rad_s`` (what the driver and the simulated servo do); robot.servo.move_time
   integrates the motion of the leg's line from hip to ankle, and the foot's offset from
@@ -36,8 +40,11 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.balance.capturability import Box, Interval
+from robot.body.legs import fk
+from robot.config.body_tree import robot_tree
 from robot.config.robot import RobotConfig
-from robot.gait.ik import hip_centre, leg_ik, leg_reach
+from robot.gait.ik import leg_reach
+from robot.gait.ik_chain import chain_leg_ik
 from robot.servo.firmware import law_terms
 from robot.servo.law import Law
 from robot.servo.move_time import GRAVITY, Load, trajectory
@@ -65,27 +72,43 @@ def _limits_ok(robot: RobotConfig, side: str, q: tuple[float, ...]) -> bool:
             j = robot.joint(joint)
             if not j.min_rad - 1e-9 <= v <= j.max_rad + 1e-9:
                 return False
-        elif abs(v) > 1e-9:        # a joint the robot lacks must not be needed
-            return False
     return True
+
+
+def zero_width(robot: RobotConfig) -> float:
+    """How far apart the soles stand at the zero pose, sideways [m] (the box model's:
+    hip_width; an imported leg's chain may put them further out)."""
+    (_, right, _), _ = fk(robot.legs[0], (0.0,) * 6)
+    (_, left, _), _ = fk(robot.legs[1], (0.0,) * 6)
+    return float(left - right)
+
+
+def leg_length(robot: RobotConfig) -> float:
+    """Hip pitch axis to ankle with the knee straight [m] (the IK's leg: robot.legs)."""
+    leg = robot.legs[0]
+    return leg.thigh + leg.shin
 
 
 @dataclass(frozen=True)
 class Leg:
-    """One robot's legs at one hip height: ``h`` [m] hip to ankle."""
+    """One robot's legs (the IK's chains, robot.body.legs) at one hip height: the ankle
+    ``h`` [m] below the hip pitch axis."""
 
     robot: RobotConfig
     h: float
 
     def solve(self, side: str, dx: float, dy: float) -> tuple[float, ...] | None:
         """The leg's angles with its sole flat, ``dx`` ahead of and ``dy`` outward from
-        its hip, the ankle ``h`` below it; None if out of reach or of a joint's limits."""
-        g = self.robot.geometry
-        hx, hy, hz = hip_centre(g, side)
+        where it stands at the zero pose (straight below the hip), raised to the height
+        ``h``; None if out of reach or of a joint's limits."""
+        chain = self.robot.legs[0 if side == "r" else 1]
+        (x0, y0, z0), _ = fk(chain, (0.0,) * 6)
         out = dy if side == "l" else -dy
         knee = self.robot.joint(f"{side}_knee")
-        ik = leg_ik(g, side, (hx + dx, hy + out, hz - self.h - g.ankle_height),
-                    span=leg_reach(g, knee.min_rad, knee.max_rad))
+        raise_by = chain.thigh + chain.shin - self.h
+        ik = chain_leg_ik(chain, (float(x0) + dx, float(y0) + out, float(z0) + raise_by),
+                          span=leg_reach(self.robot.geometry, knee.min_rad, knee.max_rad)
+                          if chain.simple else None)
         q = tuple(float(v) for v in ik.q)
         return q if bool(ik.reachable) and _limits_ok(self.robot, side, q) else None
 
@@ -123,25 +146,28 @@ def reach(robot: RobotConfig, stance: float, *, spread: float = 0.0) -> Reach:
     """The steps the legs reach at the walk's ``stance`` (its share of the leg length,
     robot.config.params) with the feet ``spread`` [m] outward of the hips."""
     g = robot.geometry
-    leg = Leg(robot, stance * g.leg_length)
-    span = 2.0 * g.leg_length
+    length = leg_length(robot)
+    leg = Leg(robot, stance * length)
+    span = 2.0 * length
     fwd = 2.0 * _largest(lambda x: leg.solve("r", x, spread) is not None
                          and leg.solve("l", -x, spread) is not None, span)
     back = 2.0 * _largest(lambda x: leg.solve("r", -x, spread) is not None
                           and leg.solve("l", x, spread) is not None, span)
-    out = g.hip_width + 2.0 * _largest(lambda y: leg.fits(0.0, y), g.leg_length)
+    base = zero_width(robot)
+    out = base + 2.0 * _largest(lambda y: leg.fits(0.0, y), length)
     narrow = g.foot_width + FOOT_GAP_M
-    inward = max(narrow, g.hip_width - 2.0 * _largest(lambda y: leg.fits(0.0, -y),
-                                                        0.5 * (g.hip_width - narrow)))
+    inward = max(narrow, base - 2.0 * _largest(lambda y: leg.fits(0.0, -y),
+                                                 max(0.0, 0.5 * (base - narrow))))
     return Reach(fwd, back, out, inward)
 
 
 def sole(robot: RobotConfig) -> Box:
     """The centre of pressure's region relative to the ankle point [m] (module doc)."""
     g = robot.geometry
-    weight = robot.mass.total * GRAVITY
+    weight = robot_tree(robot).mass * GRAVITY
+    roll_joint = "ankle_roll" if robot.has_ankle_roll else "hip_roll"
     pitch = min(joint_law(robot, f"{s}_ankle_pitch").stall for s in "rl") / weight
-    roll = min(joint_law(robot, f"{s}_ankle_roll").stall for s in "rl") / weight
+    roll = min(joint_law(robot, f"{s}_{roll_joint}").stall for s in "rl") / weight
     toe = min(g.foot_forward + 0.5 * g.foot_length, pitch)
     heel = min(0.5 * g.foot_length - g.foot_forward, pitch)
     edge = min(0.5 * g.foot_width, roll)
@@ -149,24 +175,35 @@ def sole(robot: RobotConfig) -> Box:
 
 
 def leg_load(robot: RobotConfig, h: float, axis: str) -> Load:
-    """The swinging leg as a point-mass pendulum about its hip ``axis`` ("pitch" or
-    "roll") in the stance pose at hip height ``h``."""
-    g, m = robot.geometry, robot.mass
+    """The swinging (right) leg as a rigid body about its hip ``axis`` ("pitch" or "roll")
+    in the stance pose at hip height ``h``: every link the hip joint moves (the robot's
+    body tree, robot.config.body_tree: the box model or an imported model), its inertia
+    about the joint's axis, its mass and its centre of mass's distance from the axis."""
     q = Leg(robot, h).solve("r", 0.0, 0.0)
     if q is None:
         raise ValueError(f"{robot.name}: the leg does not reach its stance at h = {h:.3f} m")
-    hp, kn = q[2], q[3]
-    knee = np.array([-g.thigh * math.sin(hp), -g.thigh * math.cos(hp)])
-    ankle = knee + np.array([-g.shin * math.sin(hp + kn), -g.shin * math.cos(hp + kn)])
-    points = [(m.thigh, 0.5 * knee), (m.shin, 0.5 * (knee + ankle)), (m.ankle_link, ankle),
-              (m.foot, ankle + np.array([g.foot_forward, -0.5 * g.ankle_height]))]
-    mass = sum(w for w, _ in points)
-    centre = sum((w * p for w, p in points), np.zeros(2)) / mass
-    if axis == "pitch":
-        inertia = sum(w * float(p @ p) for w, p in points)
-    else:
-        inertia = sum(w * float(p[1] ** 2) for w, p in points)
-    return Load(inertia, mass, float(np.hypot(*centre)))
+    tree = robot_tree(robot)
+    names = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
+    pos, rot = tree.poses({f"r_{n}": v for n, v in zip(names, q, strict=True)})
+    i = tree.joint_link[f"r_hip_{axis}"]
+    hinge = tree.links[i].joint
+    assert hinge is not None
+    u = rot[i] @ np.asarray(hinge.axis, float)
+    anchor = pos[i] + rot[i] @ np.asarray(hinge.pos, float)
+    inertia = mass = 0.0
+    moment = np.zeros(3)
+    for k, link in enumerate(tree.links):
+        if link.inertial is None or i not in tree.chain(k):
+            continue
+        m = link.inertial.mass
+        c = pos[k] + rot[k] @ np.asarray(link.inertial.com, float) - anchor
+        perp = c - float(c @ u) * u
+        body = rot[k] @ link.inertial.matrix() @ rot[k].T
+        inertia += m * float(perp @ perp) + float(u @ body @ u)
+        mass += m
+        moment += m * perp
+    arm = float(np.linalg.norm(moment)) / mass if mass > 0 else 0.0
+    return Load(inertia, mass, arm)
 
 
 @dataclass(frozen=True)
@@ -185,7 +222,7 @@ def swing(robot: RobotConfig, stance: float, axis: str, start: float, target: fl
     offsets outward) from ``start`` toward ``target`` [m] (module doc). The leg turns as
     one body about the hip: its line from hip to ankle at atan(offset / h), what the hip
     servo turns (the knee keeps the length)."""
-    h = stance * robot.geometry.leg_length
+    h = stance * leg_length(robot)
     load = leg_load(robot, h, axis)
     joint = robot.joint(f"r_hip_{axis}")
     law = joint_law(robot, f"r_hip_{axis}")

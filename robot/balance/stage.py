@@ -51,7 +51,12 @@ FOOT_GAP_M = 0.005
 
 class JointSlots(NamedTuple):
     """Indices of the corrected joints (right, left) in a robot's joint vector; a joint
-    the robot lacks is left out."""
+    the robot lacks is left out, except the ankle roll: on legs without one its
+    correction goes to the hip roll. With the sole flat on the ground the torso's roll
+    is -(hip_roll + ankle_roll) (robot.balance.law), so the hip roll turns the torso as
+    the ankle roll would, and the leg below it, rigid about x down to the sole, presses
+    the sole's edge down as the ankle's torque would: dropping the term would take the
+    roll's proportional feedback (``bal_ankle_pp``) away altogether."""
 
     ankle_pitch: list[int]
     ankle_roll: list[int]
@@ -64,8 +69,8 @@ class JointSlots(NamedTuple):
 
         def both(joint: str) -> list[int]:
             return [index[f"{s}_{joint}"] for s in ("r", "l") if f"{s}_{joint}" in index]
-        return cls(both("ankle_pitch"), both("ankle_roll"), both("hip_pitch"),
-                   both("hip_roll"))
+        ankle_roll = both("ankle_roll") or both("hip_roll")
+        return cls(both("ankle_pitch"), ankle_roll, both("hip_pitch"), both("hip_roll"))
 
 
 def apply(q: np.ndarray, corr: Correction, slots: JointSlots) -> np.ndarray:

@@ -11,8 +11,11 @@ from typing import Any
 
 import numpy as np
 
+from robot.bench.legs import OFFSETS, offset_legs
 from robot.bus.servo_map import ServoMap
+from robot.config.bundled import ROBOTS_DIR
 from robot.config.gait_file import load_gait
+from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from robot.gait import vectorised
 from robot.gait.engine import GaitEngine, within_steering_budget
@@ -25,22 +28,59 @@ def percentiles_us(samples_s: list[float] | np.ndarray) -> dict[str, float]:
             "max_us": float(a.max())}
 
 
-def bench_tick(*, ticks: int = 20000, robot_path: str | None = None,
-               gait: str = "walk", dt: float = 0.005) -> dict[str, Any]:
-    """One tick of gait + targets + IK + tick mapping, timed one by one."""
-    robot = load_robot(robot_path)
+def _ticker(robot: RobotConfig, gait: str, dt: float) -> Callable[[], object]:
+    """One tick of ``robot``'s gait engine and servo map, warmed up to full amplitude."""
     engine = GaitEngine(robot, load_gait(gait).params)
     smap = ServoMap(robot)
     engine.start()
     for _ in range(500):  # warm up, and ramp in to full amplitude
         smap.goals(engine.tick(dt))
+    return lambda: smap.goals(engine.tick(dt))
+
+
+def _time_ticks(tick: Callable[[], object], ticks: int) -> list[float]:
     samples = []
     clock = time.perf_counter
     for _ in range(ticks):
         t0 = clock()
-        smap.goals(engine.tick(dt))
+        tick()
         samples.append(clock() - t0)
+    return samples
+
+
+def bench_tick(*, ticks: int = 20000, robot_path: str | None = None,
+               gait: str = "walk", dt: float = 0.005) -> dict[str, Any]:
+    """One tick of gait + targets + IK + tick mapping, timed one by one."""
+    robot = load_robot(robot_path)
+    samples = _time_ticks(_ticker(robot, gait, dt), ticks)
     return {"joints": len(robot.joints), "ticks": ticks, **percentiles_us(samples)}
+
+
+def bench_ticks(*, ticks: int = 20000, gait: str = "walk", dt: float = 0.005,
+                rounds: int = 10) -> dict[str, Any]:
+    """``bench_tick`` for every bundled robot, and for the default robot with the offset
+    legs of robot.bench.legs; those are timed back to back with the default robot's box
+    legs, in ``rounds`` alternating slices, and reported with the ratio of the medians
+    (meaningful on a loaded machine, where the microseconds are not)."""
+    out: dict[str, Any] = {}
+    for path in sorted(ROBOTS_DIR.glob("*.toml")):
+        robot = load_robot(str(path))
+        out[path.stem] = {"joints": len(robot.joints), "ticks": ticks,
+                          "legs": "box" if all(leg.simple for leg in robot.legs) else "chain",
+                          **percentiles_us(_time_ticks(_ticker(robot, gait, dt), ticks))}
+    base = load_robot(None)
+    for name in OFFSETS:
+        box, offset = _ticker(base, gait, dt), _ticker(offset_legs(base, name), gait, dt)
+        box_s: list[float] = []
+        offset_s: list[float] = []
+        for _ in range(rounds):
+            box_s += _time_ticks(box, ticks // rounds)
+            offset_s += _time_ticks(offset, ticks // rounds)
+        got, ref = percentiles_us(offset_s), percentiles_us(box_s)
+        out[f"{base.name} with {name} legs"] = {
+            "ticks": len(offset_s), **got, "box_legs_median_us": ref["median_us"],
+            "ratio_to_box_legs": got["median_us"] / ref["median_us"]}
+    return out
 
 
 def _best_s(run: Callable[[], object], repeats: int) -> float:
@@ -70,7 +110,7 @@ def bench_vectorised(*, frames: int = 1_000_000, repeats: int = 3,
 
 def run_core_bench(*, quick: bool = False) -> dict[str, Any]:
     return {
-        "tick": bench_tick(ticks=2000 if quick else 20000),
+        "tick": bench_ticks(ticks=2000 if quick else 20000),
         "vectorised": bench_vectorised(frames=100_000 if quick else 1_000_000),
     }
 

@@ -18,6 +18,7 @@ SECTIONS: dict[str, str] = {
     "panel": "robot.bench.panel:run_panel_bench",
     "panel-flood": "robot.bench.panel_flood:run_flood_bench",
     "panel-soak": "robot.bench.panel_soak:run_soak_bench",
+    "osc": "robot.bench.osc:run_osc_bench",
 }
 #: Run only when named with --only (an hour by default).
 ON_REQUEST = ("panel-soak",)

@@ -12,6 +12,7 @@ from robot.commands.common import (
     gait_from,
     one_line_errors,
     output_file,
+    plot_output,
     rate_hz,
     robot_from,
     seconds,
@@ -36,7 +37,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--rate", type=rate_hz, default=100.0, help="samples per second [Hz]")
     p.add_argument("--out", required=True, type=output_file, metavar="FILE.csv",
                    help="CSV to write")
-    p.add_argument("--plot", type=output_file, metavar="FILE.png", help="also write a plot")
+    p.add_argument("--plot", type=plot_output, metavar="FILE.png", help="also write a plot")
     return one_line_errors(p)
 
 

@@ -35,6 +35,12 @@ if TYPE_CHECKING:
 PROTOCOLS = ("dynamixel", "dynamixel1", "feetech", "lx")
 MOTIONS = ("model", "travel")
 ALIVE_CHECK_S = 0.5          # how often the emulator process is checked [s]
+#: Said once when the host discards its own output (sim.emulator.server, packet mode).
+FLUSH_WARNING = ("biped emulate: warning: the host flushed its output buffer (tcflush "
+                 "TCOFLUSH; pyserial reset_output_buffer / flushOutput): on a pseudo-terminal "
+                 "that discards the packets the kernel has not yet passed on, so some never "
+                 "reach the servos (a USB adapter has sent them by then). pypot does it before "
+                 "every packet: see docs/third_party.md")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -95,6 +101,14 @@ def _plug_from_stdin(emu: Emulator, count: int, stop: threading.Event) -> None:
                   "send 'all' to connect the whole chain", file=sys.stderr, flush=True)
 
 
+def _flush_warning(emu: Emulator) -> bool:
+    """Say FLUSH_WARNING if the host has flushed its output; whether it was said."""
+    if not emu.counters().get("host_output_flushes"):
+        return False
+    print(FLUSH_WARNING, file=sys.stderr, flush=True)
+    return True
+
+
 def run(args: argparse.Namespace) -> int:
     from sim.emulator.chain import Emulator
 
@@ -126,11 +140,15 @@ def run(args: argparse.Namespace) -> int:
             if args.factory_new:
                 threading.Thread(target=_plug_from_stdin, args=(emu, args.factory_new, stop),
                                  daemon=True).start()
+            warned = False
             while not stop.wait(ALIVE_CHECK_S):
                 if not emu.alive:
                     print("biped emulate: error: the emulator process exited",
                           file=sys.stderr)
                     return 1
+                warned = warned or _flush_warning(emu)
+            if not warned:
+                _flush_warning(emu)
     finally:
         for s, handler in old.items():
             signal.signal(s, handler)

@@ -22,10 +22,18 @@ import argparse
 import json
 from pathlib import Path
 
-from robot.commands.common import bounded_float, checked, input_file, one_line_errors, output_file
+from robot.commands.common import (
+    bounded_float,
+    checked,
+    input_file,
+    one_line_errors,
+    output_file,
+    plot_output,
+)
 from robot.commands.identify_record_cli import add_record_parser, run_record_command
 from robot.config.servo_file import load_servo_file, physics_for, servo_file_text
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
 from robot.servo.models import MODELS
 from robot.servo.pendulum_log import PendulumLog, read_log, split_logs
 from robot.servo.physics import FITTED, ServoPhysics
@@ -68,8 +76,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     return one_line_errors(p)
 
 
-def _logs(paths: list[str]) -> list[PendulumLog]:
-    return [read_log(checked("LOG", input_file, p)) for p in paths]
+def _logs(paths: list[str], law: str) -> list[PendulumLog]:
+    """The logs, each checked (robot.servo.log_rules) for a servo of firmware ``law``."""
+    return [read_log(checked("LOG", input_file, p), law=law) for p in paths]
 
 
 def _model(text: str) -> ServoPhysics:
@@ -96,9 +105,9 @@ def _errors(logs: list[PendulumLog], physics: ServoPhysics, offset: float,
 
 def _check(args: argparse.Namespace) -> int:
     if args.plot is not None:
-        checked("--plot", output_file, args.plot)
+        checked("--plot", plot_output, args.plot)
     physics = _model(args.model)
-    logs = _logs(args.logs)
+    logs = _logs(args.logs, physics.law)
     errors = _errors(logs, physics, args.offset, args.plot)
     mean = sum(errors) / len(errors)
     if args.json:
@@ -127,8 +136,11 @@ def _fit(args: argparse.Namespace) -> int:
     if args.trials < 10:
         raise ConfigError(f"--trials: expected at least 10, got {args.trials}")
     train_paths, held_paths = split_logs([Path(p) for p in args.logs], args.holdout)
-    train, held = _logs([str(p) for p in train_paths]), _logs([str(p) for p in held_paths])
+    if not train_paths:   # one log, all of it held out
+        raise ConfigError("need at least 2 logs with --holdout > 0 (or --holdout 0)")
     start = physics_for(args.motor)
+    train = _logs([str(p) for p in train_paths], start.law)
+    held = _logs([str(p) for p in held_paths], start.law)
     source = f"fitted by biped identify fit on {len(train)} logs ({', '.join(p.name for p in train_paths)})"
     print(f"fitting {', '.join(params)} of {args.motor} on {len(train)} logs "
           f"({len(held)} held out), {args.trials} trials ...")
@@ -141,7 +153,7 @@ def _fit(args: argparse.Namespace) -> int:
            "train_logs": [p.name for p in train_paths], "held_out_logs": [p.name for p in held_paths]}
     if held_err:
         fit["held_out_error_rad"] = sum(held_err) / len(held_err)
-    out.write_text(servo_file_text(result.physics, fit=fit, comment=(
+    write_text(out, servo_file_text(result.physics, fit=fit, comment=(
         f"{args.motor} servo model fitted by `biped identify fit` (docs/servos.md).")))
     for path, e in zip([*train_paths, *held_paths], [*train_err, *held_err], strict=True):
         print(f"  {'held out' if path in held_paths else 'train   '} {path.name}: {e:.4f} rad")

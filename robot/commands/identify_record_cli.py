@@ -6,7 +6,9 @@ import argparse
 from pathlib import Path
 
 from robot.commands.common import bounded_float, bounded_int, one_line_errors
+from robot.config.servo_file import physics_for
 from robot.errors import ConfigError
+from robot.servo import log_rules
 from robot.servo.bench_load import MAX_LENGTH, MAX_MASS
 from robot.servo.models import MODELS
 
@@ -23,12 +25,10 @@ def add_record_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[
                      metavar="N", help="the servo's id")
     rec.add_argument("--motor", required=True, metavar="NAME",
                      help=f"its model: {', '.join(MODELS)}")
-    rec.add_argument("--mass", required=True, metavar="KG",
-                     type=bounded_float(0.0, MAX_MASS, "kg", what="a mass"),
-                     help="the weight on the arm [kg]")
-    rec.add_argument("--length", required=True, metavar="M",
-                     type=bounded_float(0.0, MAX_LENGTH, "m", what="a length"),
-                     help="from the shaft to the weight [m]")
+    rec.add_argument("--mass", required=True, metavar="KG", type=float,
+                     help=f"the weight on the arm [kg] (up to {MAX_MASS:g})")
+    rec.add_argument("--length", required=True, metavar="M", type=float,
+                     help=f"from the shaft to the weight [m] (up to {MAX_LENGTH:g})")
     rec.add_argument("--out", required=True, metavar="DIR", help="directory for the logs")
     rec.add_argument("--kp", default=DEFAULT_KP, metavar="A,B",
                      help=f"P gain register values, one set of runs each (default {DEFAULT_KP})")
@@ -49,23 +49,28 @@ def add_record_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[
                      help="seconds per run (default 6)")
 
 
-def _kps(text: str) -> list[int]:
+def _kps(text: str, motor: str) -> list[int]:
+    """The P register values of ``--kp``, each one ``motor``'s register can hold."""
     try:
         kps = [int(x) for x in text.split(",")]
     except ValueError:
         kps = []
-    if not kps or any(k < 0 for k in kps):
+    if not kps:
         raise ConfigError(f"--kp: expected gain register values like {DEFAULT_KP}, got {text!r}")
-    return kps
+    law = physics_for(motor).law if motor in MODELS else None   # an unknown one: refused later
+    return [log_rules.register_value("--kp", k, law=law) for k in kps]
 
 
 def run_record_command(args: argparse.Namespace) -> int:
     from robot.commands.identify_record import run_record
     from robot.run.signals import installed
 
+    # the rules every log is read by, before a servo moves (robot/servo/log_rules.py)
+    log_rules.rig("--", mass=args.mass, length=args.length)
+    kps = _kps(args.kp, args.motor)
     written, stopped = run_record(args.bus, args.port, motor=args.motor, sid=args.sid,
                                   zero=args.zero, span=args.span, mass=args.mass,
-                                  length=args.length, kps=_kps(args.kp), seconds=args.seconds,
+                                  length=args.length, kps=kps, seconds=args.seconds,
                                   out=Path(args.out), amplitude=args.amplitude,
                                   timeout_ms=args.timeout_ms)
     for path in written:

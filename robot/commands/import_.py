@@ -21,6 +21,7 @@ import numpy as np
 
 from robot.commands.common import (
     add_robot_args,
+    audio_offset,
     bounded_float,
     checked,
     input_file,
@@ -78,7 +79,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                         "(docs/animatronics.md)")
     p.add_argument("--audio", default=None, metavar="SOUND",
                    help="soundtrack of the show (a path relative to the take)")
-    p.add_argument("--audio-offset", type=float, default=0.0, metavar="SECONDS",
+    p.add_argument("--audio-offset", type=audio_offset, default=0.0, metavar="SECONDS",
                    help="show time [s] at which the audio starts (default: 0)")
     p.set_defaults(set=[])
     return p
@@ -102,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
         efficiency = replace(efficiency, forward=args.travel_efficiency, forward_by_speed=())
     got = import_animation(args.file, robot, bone_map, hold, up=args.up,
                            min_rate=args.rate, max_accel=args.max_accel, params=params,
-                           efficiency=efficiency)
+                           efficiency=efficiency, progress=True)
     frames = got.frames
     for w in got.walks:
         print(w.line())
@@ -124,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
                 cues=tuple(sorted(cues, key=lambda c: c.t)), up=frames.up,
                 travel_m=tuple(float(v) for v in frames.travel[-1]))  # type: ignore[arg-type]
     write_stream_take(args.out, robot, params, got, show,
-                      note=f"imported from {Path(args.file).name}")
+                      note=f"imported from {Path(args.file).name}", progress=True)
     held = [n for n in robot.joint_names if n not in frames.animated]
     fwd, left, _ = frames.travel[-1]
     fps = 1.0 / (frames.t[1] - frames.t[0]) if len(frames.t) > 1 else 0.0

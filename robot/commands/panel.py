@@ -6,7 +6,9 @@ SIGINT/SIGTERM starts a safe stop (ramp out, rest, then torque off, or hold with
 ``--hold``); a second one stops at once with torque off; any later one is ignored. Either
 way the bus is closed before the process exits: 130 after SIGINT, 143 after SIGTERM
 (never killed by the signal), 2 for bad options, 1 when torque could not be confirmed
-off at the end (the last line says which servos).
+off at the end (the last line says which servos) or when the control loop's process died
+(SIGKILL, the OOM killer): then this process opens the port and turns torque off itself
+(robot.panel.loop_lost).
 """
 
 from __future__ import annotations
@@ -20,11 +22,13 @@ from pathlib import Path
 from typing import Any
 
 from robot.commands.common import add_set_arg, bus_from, params_from, robot_from
+from robot.commands.show_args import add_show_args, show_options
 from robot.commands.walk import add_walk_args
 from robot.errors import ConfigError
 from robot.panel.controller import BusSpec, LoopOptions, PanelController
 from robot.panel.presets import PresetStore, user_presets_dir
 from robot.panel.server import build_server, is_loopback, panel_url, serve_in_thread
+from robot.panel.show_control import PanelShowControl
 from robot.panel.studio import Studio, user_data_dir
 from robot.run.signals import stop_on_signals
 
@@ -60,6 +64,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                    help=f"where takes and keyframe sequences are kept (default: "
                         f"{user_data_dir()}: takes/, keyframes/)")
     p.add_argument("--no-start", action="store_true", help="serve without starting the gait")
+    p.add_argument("--mcap", action="store_true", help="each recorded take also as NAME.mcap "
+                   "beside it (opens in Foxglove; docs/show-control.md)")
+    add_show_args(p)
     return p
 
 
@@ -98,6 +105,8 @@ def _farewell(report: dict[str, Any], *, aborted: bool) -> tuple[str, bool]:
     on = sorted(i for i, v in torque.items() if v)
     if not report:
         return "torque untouched (the bus was never opened)", True
+    if report.get("sim"):
+        return "the simulation ended with the control loop process; nothing to turn off", False
     if report.get("holding") and not aborted and not failed:
         return "torque left ON (holding)", True
     if failed or on:
@@ -123,11 +132,14 @@ def run(args: argparse.Namespace) -> int:
     controller = PanelController(
         robot, BusSpec(kind, port=args.port, baud=args.baud, options=options), params,
         options=LoopOptions(rate_hz=args.rate, read_every=args.read_every, hold=args.hold,
-                            balance=not args.no_balance, imu_noise=args.imu_noise),
+                            balance=not args.no_balance, imu_noise=args.imu_noise,
+                            mcap=args.mcap),
         presets=presets, preset=gait.name)
     studio_dir = Path(args.studio_dir) if args.studio_dir else user_data_dir()
     studio = Studio(controller, takes_dir=studio_dir / "takes",
                     keys_dir=studio_dir / "keyframes")
+    shows = show_options(args, studio_dir=studio_dir)    # files checked: nothing moved yet
+    show = PanelShowControl(controller, shows) if shows.on else None
     signals = _Deferred()
     server = None
     report: dict[str, Any] = {}
@@ -137,7 +149,8 @@ def run(args: argparse.Namespace) -> int:
             _give_way()
             try:
                 server = build_server(controller, host=args.host, port=args.http_port,
-                                      token=token, studio=studio)
+                                      token=token, studio=studio,
+                                      more_routes=show.routes() if show else None)
             except OSError as e:
                 raise ConfigError(f"--http-port {args.http_port}: cannot serve on "
                                   f"{args.host}: {e.strerror or e}") from e
@@ -149,20 +162,31 @@ def run(args: argparse.Namespace) -> int:
                   f"{url}{query}{also}", flush=True)
             if token and not args.token:
                 print(f"biped panel: access token {token}", flush=True)
+            if show is not None:
+                show.open(server.routes)
+                if show.osc is not None:
+                    print(f"biped panel: OSC on {show.osc.host}:{show.osc.port}", flush=True)
             if not args.no_start and not signals.stop:
                 controller.start()
             while not signals.stop and controller.loop.gone is None:
                 time.sleep(0.1)
             if controller.loop.gone is not None:
                 log.error("%s", controller.loop.gone)
-            end = "hold" if args.hold else "torque off"
-            print(f"biped panel: stopping (ramp out, rest, {end}; again: torque off now)",
-                  flush=True)
+                print("biped panel: stopping (the control loop is gone: torque off from "
+                      "this process)" if kind != "sim" else "biped panel: stopping", flush=True)
+            else:
+                end = "hold" if args.hold else "torque off"
+                print(f"biped panel: stopping (ramp out, rest, {end}; again: torque off now)",
+                      flush=True)
         finally:
             report = controller.shutdown(abort=lambda: signals.abort)  # first: a second
             if server is not None:                                    # signal acts at once
                 server.shutdown()
                 server.server_close()
+            if show is not None:
+                show.close()
         line, safe = _farewell(report, aborted=signals.abort)
+        if report.get("lost") and safe:
+            line += " (by this process: the control loop process had ended)"
         print(f"biped panel: stopped; {line}", flush=True)
-    return latch.exit_code(None) if safe else 1
+    return latch.exit_code(None) if safe and not report.get("lost") else 1

@@ -14,28 +14,43 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from robot.commands.balance_args import add_balance_args, imu_for
+from robot.commands.chase_args import (
+    add_chase_args,
+    chase_events,
+    chased,
+    live,
+    stop_when_lost,
+    summary,
+)
 from robot.commands.common import (
     add_bus_args,
+    audio_offset,
     bus_from,
     checked,
     input_file,
     output_file,
     params_from,
+    plot_output,
     rate_hz,
     seconds,
 )
 from robot.commands.physics_check import physics_check, physics_watch
+from robot.commands.show_args import add_show_args, show_options
 from robot.commands.walk import servo_words
 from robot.config.bundled import DEFAULT_GAIT
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
+from robot.loop.clock import MonotonicClock
+from robot.loop.mcap_recorder import McapRecorder, is_mcap
 from robot.loop.recorder import Recorder
 from robot.loop.soundtrack import Soundtrack
 from robot.loop.take_writer import TakeWriter
@@ -49,6 +64,7 @@ from robot.motion.takes import SUFFIX, Take, TakeHeader, is_take, read_take
 from robot.previs.show_check import plot_check
 from robot.run.run import Run
 from robot.run.spec import RunOptions, RunSpec
+from robot.showctl.play_target import play_show_control
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
@@ -69,26 +85,28 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--realtime", action="store_true", help="pace the simulation to the wall clock")
     p.add_argument("--view", action="store_true", help="open the MuJoCo viewer (needs a display)")
     p.add_argument("--record", default=None, metavar="PATH",
-                   help=f"record the replay (.csv, .jsonl or NAME{SUFFIX})")
+                   help=f"record the replay (.csv, .jsonl, .mcap or NAME{SUFFIX})")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--audio", default=None, type=input_file, metavar="SOUND",
                    help="play this soundtrack in sync (default: the file's own show.audio); "
                         "the sim then runs in real time")
-    p.add_argument("--audio-offset", type=float, default=None, metavar="SECONDS",
+    p.add_argument("--audio-offset", type=audio_offset, default=None, metavar="SECONDS",
                    help="show time [s] at which the audio starts (default: the file's, or 0)")
     p.add_argument("--player", default=None, metavar="CMD",
                    help="audio player reading a WAV on stdin (default: aplay, paplay, else "
                         "ffplay)")
-    p.add_argument("--check-plot", default=None, type=output_file, metavar="FILE.png",
+    p.add_argument("--check-plot", default=None, type=plot_output, metavar="FILE.png",
                    help="sim bus: plot the physics check (support margin, torque by limb, "
                         "headroom per joint)")
     p.add_argument("--no-root-travel", action="store_true",
                    help="an imported take: play the legs as authored where the gait would "
                         "walk them")
+    add_chase_args(p)
     add_balance_args(p)
     p.add_argument("--balance", action="store_true", help="an imported take (biped import): "
                    "the balance stage corrects the legs while the arms and head perform as "
                    "authored (needs the robot's [imu])")
+    add_show_args(p, midi=False)
     p.set_defaults(set=[])
     return p
 
@@ -108,6 +126,7 @@ def run(args: argparse.Namespace) -> int:
     checked("FILE", input_file, args.file)
     if args.record:
         checked("--record", output_file, args.record)
+    shows = show_options(args)            # OSC, cue list: checked before anything moves
     kind = args.bus or "sim"
     if kind != "sim" and (args.view or args.realtime):
         raise ConfigError("--view and --realtime apply to --bus sim only")
@@ -124,7 +143,7 @@ def run(args: argparse.Namespace) -> int:
         stop = take.stop_tick if take.stop_tick is not None else len(take.t)
         show = show_of(h.show, take.source)
         if show.stream:   # an imported animation: its joints as they are (--balance: legs)
-            travel = Travel() if args.no_root_travel else Travel.of_take(take)
+            travel = Travel() if args.no_root_travel or args.chase else Travel.of_take(take)
             engine = (ShowEngine(robot, h.params, stream=stream_sequence(take), travel=travel)
                       if travel.walks else
                       LayeredEngine(robot, h.params, keyframes=stream_sequence(take),
@@ -137,7 +156,7 @@ def run(args: argparse.Namespace) -> int:
         rate, read_every, limit = h.rate_hz, h.read_every, None
         header = h
     elif Path(args.file).suffix in SUFFIXES:
-        if args.record and is_take(args.record):
+        if args.record and is_take(args.record) and not args.chase:
             raise ConfigError(f"--record {args.record}: a take records a walk's timeline; "
                               "record a sequence's playback as .csv or .jsonl (the sequence "
                               "file itself is what replays it)")
@@ -155,28 +174,44 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"FILE {args.file}: expected a take (NAME{SUFFIX}) or a keyframe "
                           f"sequence ({', '.join(SUFFIXES)})")
     soundtrack = _soundtrack(args, show)
-    if soundtrack is not None and kind == "sim":
-        args.realtime = True          # the sound plays in real time: so does the show
+    if (soundtrack is not None or live(args.chase)) and kind == "sim":
+        args.realtime = True          # the sound (a live timecode) runs in real time: so does the show
     options: dict[str, Any] = (
         {"realtime": args.realtime, "view": args.view} if kind == "sim" else {})
     bus = bus_from(args, robot, kind=kind, **options)
     imu = imu_for(args, robot, bus)
-    writer: TakeWriter | Recorder | None = None
+    chase = chased(args, engine, getattr(bus, "clock", None) or MonotonicClock())
+    writer: TakeWriter | Recorder | McapRecorder | None = None
     if args.record:
-        writer = (TakeWriter(args.record, header) if is_take(args.record)
+        if chase is not None:      # what was played, as a stream (biped play replays it)
+            header = replace(header, show=replace(show, stream=True).as_json())
+        writer = (TakeWriter(args.record, header,
+                             show_time=None if chase is None else lambda: chase.show_time)
+                  if is_take(args.record)
+                  else McapRecorder(args.record, robot, header, params=lambda: engine.params,
+                                    body=bus) if is_mcap(args.record)
                   else Recorder(args.record, robot.joint_names, robot.ids))
+    if soundtrack is not None and isinstance(writer, McapRecorder):
+        soundtrack.on_cue = _logged(soundtrack.on_cue, writer)
     watch = physics_watch(bus)
-    observers = [o for o in (watch, soundtrack) if o is not None]
+    runs: list[Run[Any]] = []              # the run, once built: what the timecode stops
+    lost = None if chase is None else stop_when_lost(chase, lambda why: runs[0].request_stop(why))
+    events = (chase_events(chase, writer.log)
+              if chase is not None and isinstance(writer, McapRecorder) else None)
+    observers = [o for o in (watch, soundtrack, lost, events) if o is not None]
+    if chase is not None and soundtrack is not None:
+        soundtrack.clock = lambda: chase.show_time
 
     def observe(tel: Telemetry) -> None:
         for o in observers:
             o(tel)
-    spec = RunSpec(robot=robot, source=engine, bus=bus, imu=imu, recorder=writer,
+    spec = RunSpec(robot=robot, source=chase or engine, bus=bus, imu=imu, recorder=writer,
                    observer=observe if observers else None,
                    options=RunOptions(rate_hz=rate, read_every=read_every, hold=args.hold,
                                       seconds=limit, signals=True, watch=watch is not None,
                                       stop_on_fall=watch is not None))
     playing = Run(spec)
+    runs.append(playing)
     try:
         with playing:
             if isinstance(writer, TakeWriter) and isinstance(engine, PlaybackEngine):
@@ -185,10 +220,17 @@ def run(args: argparse.Namespace) -> int:
                 for k, kind_, step in sorted(timeline, key=lambda e: (e[0], e[1])):
                     writer.event(k, **{kind_: dict(step)})
                 writer.event(stop, stop=True)
-            playing.stream()
+            clock = (lambda: chase.show_time) if chase is not None else lambda: engine.time
+            with play_show_control(shows, playing, joints=tuple(robot.joint_names),
+                                   take=Path(args.file).name, show_time=clock, rate_hz=rate,
+                                   announce=lambda line: print(f"biped play: {line}",
+                                                               file=sys.stderr, flush=True)):
+                playing.stream()
     finally:
         if soundtrack is not None:
             soundtrack.close()
+        if chase is not None:
+            chase.close()
     done = playing.result
     stats, record_error, code = done.stats, done.record_error, done.exit_code
     result = {"file": args.file, "robot": robot.name, "bus": kind, "ticks": stats.ticks,
@@ -200,6 +242,8 @@ def run(args: argparse.Namespace) -> int:
         result["audio"] = {"file": str(soundtrack.show.audio_path()),
                            "started_at_show_s": soundtrack.started_at,
                            "warning": soundtrack.warning}
+    if chase is not None:
+        result["chase"] = {**summary(chase), "stopped": chase.ended or stats.stop_reason}
     metrics = done.metrics or {}
     if "distance_m" in metrics:      # the sim: where the robot went (a show that walks)
         result["walked"] = {k: metrics[k] for k in ("distance_m", "lateral_drift_m",
@@ -228,6 +272,15 @@ def run(args: argparse.Namespace) -> int:
             if args.check_plot:
                 print(f"wrote {args.check_plot}")
     return code
+
+
+def _logged(on_cue: Callable[[Cue], None] | None, log: McapRecorder) -> Callable[[Cue], None]:
+    """``on_cue``, and each cue on the record's /events too."""
+    def cue(c: Cue) -> None:
+        log.log(f"cue {c.t:.3f} s: {c.name}")
+        if on_cue is not None:
+            on_cue(c)
+    return cue
 
 
 def _soundtrack(args: argparse.Namespace, show: Show) -> Soundtrack | None:

@@ -15,12 +15,14 @@ from collections import Counter
 from pathlib import Path
 
 from robot.commands.common import one_line_errors
+from robot.commands.robots_import import add_import_parser, run_import
 from robot.config.bundled import ROBOTS_DIR, robot_names
 from robot.config.joint_names import ARM_NAMES, LEG_NAMES
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot, parse_robot
 from robot.config.toml_edit import edit_joints
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -35,6 +37,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     c.add_argument("dest", metavar="DEST",
                    help="the new file (ending in .toml), or an existing directory")
     one_line_errors(c)
+    one_line_errors(add_import_parser(actions))
     return one_line_errors(p)
 
 
@@ -105,23 +108,19 @@ def copy(name: str, dest: Path) -> Path:
                        name=target.stem)
     parse_robot(tomllib.loads(text), source=str(target))    # the copy loads as it is
     try:
-        f = target.open("x", encoding="utf-8")
+        write_text(target, text, exclusive=True)
     except FileExistsError:
         raise ConfigError(f"copy DEST {target}: exists; not overwritten: choose another "
                           "name, or delete it first") from None
-    except OSError as e:
-        raise ConfigError(f"copy DEST {target}: cannot create it: {e.strerror or e}") from e
-    try:
-        with f:
-            f.write(text)
     except OSError as e:             # e.g. a full disk: no half-written robot file is left
-        target.unlink(missing_ok=True)
         raise ConfigError(f"copy DEST {target}: cannot write it: {e.strerror or e}; "
                           "nothing was left there") from e
     return target
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.action == "import":
+        return run_import(args)
     if args.action != "copy":
         _list(args.json)
         return 0

@@ -17,14 +17,15 @@ from robot.commands import push_map
 from robot.commands.common import (
     add_robot_args,
     add_set_arg,
-    output_file,
     params_from,
+    plot_output,
     positive_int,
     robot_from,
     seconds,
 )
 from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
+from robot.previs.figure_file import save_figure
 from robot.tuning.push_map import limits_of
 from robot.tuning.robustness import (
     STRAIGHT_DEG,
@@ -57,7 +58,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                    help="skip the open-loop runs (--no-balance)")
     p.add_argument("--jobs", type=positive_int, default=None,
                    help="parallel runs (default: the number of cores)")
-    p.add_argument("--out", type=output_file, default=None, metavar="PNG",
+    p.add_argument("--out", type=plot_output, default=None, metavar="PNG",
                    help="write the survival picture here")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     push_map.add_args(p)
@@ -207,5 +208,5 @@ def plot_survival(table: Sequence[tuple[str, dict[bool, tuple[int, int]]]], out:
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     ax.grid(axis="x", alpha=0.3)
     fig.tight_layout()
-    fig.savefig(out, dpi=90)
+    save_figure(fig, out)
     plt.close(fig)

@@ -14,13 +14,21 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robot.config.joint_names import ARM_NAMES, EXTRA_NAME, HIP_YAW_NAMES, JOINT_NAMES, LEG_NAMES
+from robot.config.joint_names import (
+    ANKLE_ROLL_NAMES,
+    ARM_NAMES,
+    EXTRA_NAME,
+    HIP_YAW_NAMES,
+    JOINT_NAMES,
+    LEG_NAMES,
+)
 from robot.config.toml_io import TomlValue, show
 from robot.errors import ConfigError
 from robot.servo import ticks as tick_math
 from robot.servo.models import BUS_FAMILIES, MODELS, bauds
 
 if TYPE_CHECKING:
+    from robot.body.model import BodyModel
     from robot.config.robot import BusConfig, JointConfig, RobotConfig
 
 #: Decimal places of the radian ranges printed in messages (rounded inward, so a value
@@ -108,8 +116,8 @@ def check_ticks(robot: RobotConfig) -> None:
 
 
 def check_joint_set(src: str, jtab: Mapping[str, TomlValue]) -> None:
-    """Every leg joint (hip yaw on both sides or neither), all arm joints or none; any
-    other name is an extra joint and needs ``fixed_rad``."""
+    """Every leg joint (hip yaw, ankle roll: on both sides or neither, not both left out),
+    all arm joints or none; any other name is an extra joint and needs ``fixed_rad``."""
     for name, entry in jtab.items():
         if name in JOINT_NAMES:
             continue
@@ -120,16 +128,19 @@ def check_joint_set(src: str, jtab: Mapping[str, TomlValue]) -> None:
             raise ConfigError(f"{src}: joints.{name}: unknown joint; the gait drives "
                               f"{', '.join(JOINT_NAMES)}; an extra joint (e.g. head_pan) "
                               "needs fixed_rad, the angle it is held at [rad]")
-    legs = [n for n in LEG_NAMES if n not in HIP_YAW_NAMES]
+    legs = [n for n in LEG_NAMES if n not in HIP_YAW_NAMES + ANKLE_ROLL_NAMES]
     missing = [n for n in legs if n not in jtab]
     if missing:
         raise ConfigError(f"{src}: joints.{missing[0]}: missing (every leg joint is required; "
-                          "only hip yaw may be left out, on both sides)")
-    yaws = [n for n in HIP_YAW_NAMES if n in jtab]
-    if len(yaws) == 1:
-        absent = next(n for n in HIP_YAW_NAMES if n not in jtab)
-        raise ConfigError(f"{src}: joints.{absent}: missing (hip yaw on both legs, or neither "
-                          "for 5-DoF legs)")
+                          "only hip yaw or ankle roll may be left out, on both sides)")
+    for pair, what in ((HIP_YAW_NAMES, "hip yaw"), (ANKLE_ROLL_NAMES, "ankle roll")):
+        if sum(n in jtab for n in pair) == 1:
+            absent = next(n for n in pair if n not in jtab)
+            raise ConfigError(f"{src}: joints.{absent}: missing ({what} on both legs, or "
+                              "neither for 5-DoF legs)")
+    if not any(n in jtab for n in HIP_YAW_NAMES + ANKLE_ROLL_NAMES):
+        raise ConfigError(f"{src}: joints.r_hip_yaw: missing (a leg needs hip yaw or ankle "
+                          "roll: without both, 4 joints cannot place a foot and keep it level)")
     arms = [n for n in ARM_NAMES if n in jtab]
     if arms and len(arms) != len(ARM_NAMES):
         absent = next(n for n in ARM_NAMES if n not in jtab)
@@ -177,3 +188,28 @@ def check_joint_extras(src: str, jp: str, j: JointConfig, bus: BusConfig, *,
     if j.fixed_rad is not None and not j.min_rad <= j.fixed_rad <= j.max_rad:
         raise ConfigError(f"{src}: {jp}.fixed_rad: {j.fixed_rad:g} is outside the joint "
                           f"limits [{j.min_rad:g}, {j.max_rad:g}]")
+
+
+def check_model_joints(src: str, body: BodyModel, joints: list[JointConfig]) -> None:
+    """Every joint of an imported robot names one hinge of its model (``model_joint``,
+    ``model_sign`` +-1), and every hinge of the model is a joint of the file."""
+    hinges = body.tree.joint_link
+    seen: dict[str, str] = {}
+    for j in joints:
+        where = f"{src}: joints.{j.name}"
+        if j.model_joint is None:
+            raise ConfigError(f"{where}.model_joint: missing (an imported robot names each "
+                              "joint's hinge in [model.links])")
+        if j.model_joint not in hinges:
+            raise ConfigError(f"{where}.model_joint: the model has no joint {j.model_joint!r}; "
+                              f"valid: {', '.join(hinges)}")
+        if j.model_joint in seen:
+            raise ConfigError(f"{where}.model_joint: {j.model_joint!r} is also "
+                              f"joints.{seen[j.model_joint]}'s")
+        seen[j.model_joint] = j.name
+        if j.model_sign not in (1, -1):
+            raise ConfigError(f"{where}.model_sign: expected +1 or -1, got {show(j.model_sign)}")
+    missing = [h for h in hinges if h not in seen]
+    if missing:
+        raise ConfigError(f"{src}: model joint {missing[0]!r} is no joint of the file; add a "
+                          "[joints.NAME] with model_joint = ... (an extra joint: fixed_rad)")

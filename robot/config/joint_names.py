@@ -1,6 +1,6 @@
 """The joints the gait drives, by name (sides r/l; legs then arms), and the rules for the
-joints a robot file may have: every leg joint (hip yaw optional on both sides: 5-DoF
-legs), all arm joints or none, and extra joints (head pan, tilt, ...) held at a fixed
+joints a robot file may have: every leg joint (hip yaw or ankle roll optional, on both
+sides: 5-DoF legs; not both), all arm joints or none, and extra joints (head pan, tilt, ...) held at a fixed
 angle."""
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ LEG_NAMES = tuple(f"{s}_{j}" for s in SIDES for j in LEG_JOINTS)
 ARM_NAMES = tuple(f"{s}_{j}" for s in SIDES for j in ARM_JOINTS)
 JOINT_NAMES = LEG_NAMES + ARM_NAMES
 HIP_YAW_NAMES = ("r_hip_yaw", "l_hip_yaw")
+ANKLE_ROLL_NAMES = ("r_ankle_roll", "l_ankle_roll")
 #: Names of extra joints: lowercase letters, digits and '_', starting with a letter.
 EXTRA_NAME = re.compile(r"^[a-z][a-z0-9_]{0,31}\Z")  # \Z: "$" lets a final newline in
 

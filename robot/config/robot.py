@@ -11,6 +11,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 
+from robot.body.legs import LegChain
+from robot.body.model import BodyModel
 from robot.config.imu_file import ImuConfig
 from robot.config.joint_names import ARM_NAMES, JOINT_NAMES, LEG_NAMES
 from robot.config.servo_file import physics_for
@@ -26,6 +28,8 @@ RETRIES = Range(0, 10)
 TIMEOUT_MS = Range(1.0, 1000.0, "ms")
 #: Geometry: 1 mm (no servo link is smaller; 0 divides by zero in IK) to 2 m.
 LENGTH = Range(0.001, 2.0, "m")
+#: An offset that may be 0 or negative (a sole centred on or behind the ankle) [m].
+OFFSET = Range(-0.5, 0.5, "m")
 #: Link masses: 1 g to 100 kg.
 MASS = Range(0.001, 100.0, "kg")
 #: Joint limits: one turn, centred on zero.
@@ -81,7 +85,7 @@ class Geometry:
     ankle_height: float = field(metadata=spec(LENGTH))
     foot_length: float = field(metadata=spec(LENGTH))
     foot_width: float = field(metadata=spec(LENGTH))
-    foot_forward: float = field(metadata=spec(LENGTH))
+    foot_forward: float = field(metadata=spec(OFFSET))
     torso_height: float = field(metadata=spec(LENGTH))
     torso_depth: float = field(metadata=spec(LENGTH))
     shoulder_width: float = field(default=0.0, metadata=spec(LENGTH))  # arms only
@@ -145,6 +149,11 @@ class JointConfig:
     #: dual-axis servos (2XL430-W250, 2XC430-W250): the case this joint's axis sits in; the
     #: two joints naming one case share it (two ids, one baud rate; setup-motors sets both)
     case: str | None = None
+    #: an imported robot's joint in its model's terms (robot/body/model.py): the model's
+    #: name for it, and model angle = model_sign * angle + model_offset [rad]
+    model_joint: str | None = None
+    model_sign: int = 1
+    model_offset: float = field(default=0.0, metadata=spec(ANGLE))
 
 
 @dataclass(frozen=True)
@@ -152,7 +161,7 @@ class RobotConfig:
     name: str
     bus: BusConfig
     geometry: Geometry
-    mass: Masses
+    mass: Masses | None
     joints: tuple[JointConfig, ...]
     rest: Mapping[str, float] = field(default_factory=dict)
     source: str = "<memory>"
@@ -165,6 +174,24 @@ class RobotConfig:
     #: Servo physics read from the model files the robot file names, per joint name
     #: (joints without one use their model's bundled physics: ``servo_physics``).
     physics: Mapping[str, ServoPhysics] = field(default_factory=dict)
+    #: An imported robot's own body (the ``[model]`` section, robot/body/model.py); None:
+    #: the box model built from ``geometry`` and ``mass``.
+    body: BodyModel | None = None
+    #: The legs' axes and offsets (right, left; robot.body.legs) the IK solves; None: the
+    #: ``body``'s legs, else the box model's from ``geometry`` (see ``legs``).
+    leg_chains: tuple[LegChain, LegChain] | None = None
+
+    def __post_init__(self) -> None:
+        if self.leg_chains is None and self.body is None:
+            return
+        for leg, side in zip(self.legs, ("r", "l"), strict=True):
+            if leg.side != side or (leg.has_yaw, leg.has_ankle_roll) != (
+                    self.has_hip_yaw, self.has_ankle_roll):
+                raise ConfigError(
+                    f"{self.source}: leg_chains: the {side} leg's chain (side {leg.side!r}, "
+                    f"hip yaw {leg.has_yaw}, ankle roll {leg.has_ankle_roll}) does not match "
+                    f"the joints (hip yaw {self.has_hip_yaw}, ankle roll "
+                    f"{self.has_ankle_roll}); expected (right, left) chains of these joints")
 
     def joint(self, name: str) -> JointConfig:
         for j in self.joints:
@@ -185,6 +212,29 @@ class RobotConfig:
     def has_hip_yaw(self) -> bool:
         """False for 5-DoF legs (no hip yaw: the gait cannot turn by yawing the feet)."""
         return "r_hip_yaw" in self.joint_names
+
+    @cached_property
+    def has_ankle_roll(self) -> bool:
+        """False for 5-DoF legs without ankle roll (the foot's roll goes with the leg's)."""
+        return "r_ankle_roll" in self.joint_names
+
+    @cached_property
+    def legs(self) -> tuple[LegChain, LegChain]:
+        """The right and left leg as the IK sees them: ``leg_chains``, else the imported
+        ``body``'s, else the box model's from ``geometry`` (hip centre (0, -/+ hip_width / 2, 0), the yaw axis
+        through it when the robot has hip yaw, sole ``ankle_height`` below the ankle)."""
+        if self.leg_chains is not None:
+            return self.leg_chains
+        if self.body is not None:
+            return self.body.legs
+        g = self.geometry
+
+        def box(side: str, sign: float) -> LegChain:
+            y = sign * g.hip_width / 2
+            return LegChain(side, (0.0, y, 0.0), g.thigh, g.shin, (0.0, 0.0, -g.ankle_height),
+                            yaw_axis=(0.0, y) if self.has_hip_yaw else None,
+                            has_ankle_roll=self.has_ankle_roll)
+        return box("r", -1.0), box("l", 1.0)
 
     def servo(self, joint: JointConfig) -> ServoModel:
         """The servo model of ``joint`` (its own ``model``, else the bus's)."""

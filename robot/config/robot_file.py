@@ -15,11 +15,13 @@ from robot.config.checks import (
     check_cases,
     check_joint_extras,
     check_joint_set,
+    check_model_joints,
     check_ticks,
 )
 from robot.config.gains_file import check_fits, parse_gains, split_gains
 from robot.config.imu_file import parse_imu
 from robot.config.joint_names import ARM_NAMES, HIP_YAW_NAMES, JOINT_NAMES
+from robot.config.model_file import parse_model
 from robot.config.params import BALANCE, SPECS, canonical_name, check_value
 from robot.config.robot import ANGLE, BusConfig, Geometry, JointConfig, Masses, RobotConfig
 from robot.config.servo_file import servo_files
@@ -38,11 +40,12 @@ def load_robot(name_or_path: str | Path | None = None) -> RobotConfig:
 def parse_robot(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> RobotConfig:
     """A validated robot from a robot file's table (ConfigError, one line, on any problem)."""
     src = source
-    allowed = {"name", "bus", "geometry", "mass", "joints", "rest", "imu", "balance"}
+    allowed = {"name", "bus", "geometry", "mass", "joints", "rest", "imu", "balance", "model"}
     unknown = sorted(set(data) - allowed)
     if unknown:
         raise ConfigError(f"{src}: {unknown[0]}: unknown key; valid: {', '.join(sorted(allowed))}")
-    for key in ("name", "bus", "geometry", "mass", "joints"):
+    body = parse_model(src, data["model"]) if "model" in data else None
+    for key in ("name", "bus", "geometry", "joints") + (() if body else ("mass",)):
         if key not in data:
             raise ConfigError(f"{src}: {key}: missing")
     name = data["name"]
@@ -54,15 +57,20 @@ def parse_robot(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> R
     check_bus(src, bus)
     bus = replace(bus, gains=parse_gains(src, "bus.gains", bus_gains, bus.servo))
     geometry = build(Geometry, src, "geometry", data["geometry"])
-    mass = build(Masses, src, "mass", data["mass"])
+    if body is not None and "mass" in data:
+        raise ConfigError(f"{src}: mass: an imported robot's masses are its model's "
+                          "([model.links]); remove [mass]")
+    mass = build(Masses, src, "mass", data["mass"]) if body is None else None
 
     jtab = table(src, "joints", data["joints"])
     check_joint_set(src, jtab)
-    if any(n in jtab for n in HIP_YAW_NAMES) and mass.hip_yaw_link == 0.0:
+    if mass is not None and any(n in jtab for n in HIP_YAW_NAMES) and mass.hip_yaw_link == 0.0:
         raise ConfigError(f"{src}: mass.hip_yaw_link: missing (the robot has hip yaw joints; "
                           "only 5-DoF legs leave it out)")
     if any(n in jtab for n in ARM_NAMES):
         for sect, obj in (("geometry", geometry), ("mass", mass)):
+            if obj is None:
+                continue
             for f in ("shoulder_width", "upper_arm", "forearm"):
                 if getattr(obj, f, None) == 0.0:
                     raise ConfigError(f"{src}: {sect}.{f}: missing (the robot has arms)")
@@ -114,8 +122,10 @@ def parse_robot(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> R
             raise ConfigError(f"{where}: not a balance gain (a gait parameter belongs in a "
                               f"gait preset); valid: {gains}")
         balance[canon] = check_value(canon, v, where=where)
+    if body is not None:
+        check_model_joints(src, body, joints)
     robot = RobotConfig(name=name, bus=bus, geometry=geometry, mass=mass, joints=tuple(joints),
-                        rest=rest, source=src, imu=imu, balance=balance,
+                        rest=rest, source=src, imu=imu, balance=balance, body=body,
                         physics=servo_files(src, bus.servo_file, [
                             (j.name, j.servo_file, j.model or bus.model) for j in joints]))
     check_ticks(robot)

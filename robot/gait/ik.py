@@ -33,10 +33,13 @@ REACH_TOL = 1e-12
 
 class LegIK(NamedTuple):
     """Leg joint angles [rad]: hip_yaw, hip_roll, hip_pitch, knee, ankle_pitch, ankle_roll;
-    reachable: False (per sample) where the target was clamped."""
+    reachable: False (per sample) where the target was clamped; roll_lost: on a leg without
+    ankle roll (robot.gait.ik_chain), the roll [rad] of the target foot about its own x
+    axis that the leg could not take (target = achieved @ rot_x(roll_lost)); else 0."""
 
     q: tuple[Num, Num, Num, Num, Num, Num]
     reachable: Num
+    roll_lost: Num = 0.0
 
 
 class ArmIK(NamedTuple):
@@ -136,13 +139,20 @@ def leg_ik(g: Geometry, side: str, sole: Vec, foot_rot: Rot = xm.IDENTITY, *,
     afterwards would move the foot off that line. Degenerate targets divide by nothing:
     an ankle point at the hip centre folds the knee as far as it may.
     """
-    a, b = g.thigh, g.shin
+    return leg_ik_at(hip_centre(g, side), g.thigh, g.shin, g.ankle_height, sole, foot_rot,
+                     span=span)
+
+
+def leg_ik_at(hip: Vec, a: float, b: float, ankle_height: float, sole: Vec,
+              foot_rot: Rot = xm.IDENTITY, *, span: Reach | None = None) -> LegIK:
+    """``leg_ik`` for the hip centre ``hip`` [m], thigh ``a``, shin ``b`` and ankle height
+    [m] of a leg whose axes meet as the box model's do (robot.body.legs.LegChain.simple)."""
     lo, hi = span if span is not None else (abs(a - b), a + b)
-    hx, hy, hz = hip_centre(g, side)
+    hx, hy, hz = hip
     # Ankle point: the sole plus the foot's own up vector times the ankle height.
-    ax = sole[0] + foot_rot[2] * g.ankle_height
-    ay = sole[1] + foot_rot[5] * g.ankle_height
-    az = sole[2] + foot_rot[8] * g.ankle_height
+    ax = sole[0] + foot_rot[2] * ankle_height
+    ay = sole[1] + foot_rot[5] * ankle_height
+    az = sole[2] + foot_rot[8] * ankle_height
     rx, ry, rz = xm.apply_t(foot_rot, (hx - ax, hy - ay, hz - az))  # ankle → hip, foot frame
     c = xm.sqrt(rx * rx + ry * ry + rz * rz)
     reachable = (c >= lo - REACH_TOL) & (c <= hi + REACH_TOL)

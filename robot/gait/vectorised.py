@@ -25,7 +25,8 @@ import numpy.typing as npt
 from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.gait import expressions as gait
-from robot.gait.ik import Reach, arm_ik, arm_reach, leg_ik, leg_reach
+from robot.gait.ik import Reach, arm_ik, arm_reach, reach
+from robot.gait.ik_chain import chain_leg_ik
 from robot.gait.targets import BodyTargets, body_targets
 from robot.gait.xmath import Num
 
@@ -38,7 +39,8 @@ def spans(robot: RobotConfig) -> tuple[Reach, Reach, Reach | None, Reach | None]
         j = robot.joint(name)
         return j.min_rad, j.max_rad
     g = robot.geometry
-    r_leg, l_leg = (leg_reach(g, *limits(f"{s}_knee")) for s in "rl")
+    r_leg, l_leg = (reach(leg.thigh, leg.shin, *limits(f"{leg.side}_knee"))
+                    for leg in robot.legs)
     if not robot.has_arms:
         return r_leg, l_leg, None, None
     return r_leg, l_leg, arm_reach(g, *limits("r_elbow")), arm_reach(g, *limits("l_elbow"))
@@ -46,11 +48,13 @@ def spans(robot: RobotConfig) -> tuple[Reach, Reach, Reach | None, Reach | None]
 
 def solve(t: BodyTargets, robot: RobotConfig) -> tuple[list[Num], Num]:
     """IK for every joint of ``robot`` (its joint order) within what its knee and elbow
-    limits let the chains span (``spans``), and a reachable flag."""
+    limits let the chains span (``spans``), and a reachable flag. The legs are
+    ``robot.legs`` (robot.gait.ik_chain: the box model's closed form for simple chains)."""
     g = robot.geometry
     r_leg, l_leg, r_arm, l_arm = spans(robot)
-    r = leg_ik(g, "r", t.r_sole, t.r_foot, span=r_leg)
-    lft = leg_ik(g, "l", t.l_sole, t.l_foot, span=l_leg)
+    r_chain, l_chain = robot.legs
+    r = chain_leg_ik(r_chain, t.r_sole, t.r_foot, span=r_leg)
+    lft = chain_leg_ik(l_chain, t.l_sole, t.l_foot, span=l_leg)
     q: list[Num] = [*r.q, *lft.q]
     ok = r.reachable & lft.reachable
     if robot.has_arms:

@@ -11,7 +11,9 @@ costs the show no tick. No player, no audio device, a player that fails: one war
 the show runs silent.
 
 Show time: 0 at the first tick of the source after the ramp in (the state "walking");
-the audio's start plays at ``audio_offset_s`` of show time (robot/motion/show.py).
+the audio's start plays at ``audio_offset_s`` of show time (robot/motion/show.py). A
+chased show (``clock``) gives its own show time: a jump in it restarts the player at the
+new place and the cues from there.
 """
 
 from __future__ import annotations
@@ -32,8 +34,26 @@ from robot.motion.show import Cue, Show
 
 log = logging.getLogger(__name__)
 
+#: A chased show's time this far [s] from the loop's run: a jump; the player restarts.
+SEEK_S = 0.25
 #: Players fed a WAV on standard input, in the order tried.
 STDIN_PLAYERS = (("aplay", "-q", "-"), ("paplay",))
+
+
+def _unreadable(path: Path, e: Exception) -> ConfigError:
+    why = (str(e) if str(e) else "it ends before its header is whole" if isinstance(
+        e, EOFError) else type(e).__name__)
+    return ConfigError(f"audio {path}: not a readable WAV file: {why}")
+
+
+def check_wav(path: Path) -> None:
+    """ConfigError naming ``path`` and why, unless its header reads as a PCM WAV file's
+    (read before the show starts: a WAV that cannot play is refused, not a silent show)."""
+    try:
+        with wave.open(str(path), "rb") as w:
+            w.getparams()
+    except (OSError, EOFError, wave.Error) as e:
+        raise _unreadable(path, e) from None
 
 
 def wav_from(path: Path, skip_s: float) -> bytes:
@@ -44,7 +64,7 @@ def wav_from(path: Path, skip_s: float) -> bytes:
             w.setpos(min(params.nframes, int(round(max(0.0, skip_s) * params.framerate))))
             frames = w.readframes(params.nframes)
     except (OSError, EOFError, wave.Error) as e:
-        raise ConfigError(f"audio {path}: not a readable WAV file: {e}") from None
+        raise _unreadable(path, e) from None
     out = io.BytesIO()
     with wave.open(out, "wb") as w:
         w.setparams(params)
@@ -83,17 +103,28 @@ class Soundtrack:
         self._proc: subprocess.Popen[bytes] | None = None
         self._thread: threading.Thread | None = None
         self.warning: str | None = None
+        #: the show time [s] to follow instead of the loop's (a chased show), or None
+        self.clock: Callable[[], float | None] | None = None
+        self._last: tuple[float, float] | None = None
         path = show.audio_path()
         if path is not None and not path.is_file():
             raise ConfigError(f"audio {path}: file not found (relative to the file that "
                               "names it)")
+        if path is not None and (player is not None or path.suffix.lower() == ".wav"):
+            check_wav(path)             # fed to the player as a WAV: it must read as one
 
     def __call__(self, tel: Telemetry) -> None:
-        if self.start is None:
-            if tel.state != "walking":
+        if self.clock is not None:               # a chased show: its own show time
+            chased = self.clock()
+            if chased is None or tel.state != "walking":
                 return
-            self.start = tel.t
-        t = tel.t - self.start
+            t = self._follow(chased, tel.t)
+        else:
+            if self.start is None:
+                if tel.state != "walking":
+                    return
+                self.start = tel.t
+            t = tel.t - self.start
         cues = self.show.cues
         while self._next_cue < len(cues) and cues[self._next_cue].t <= t:
             if self.on_cue is not None:
@@ -104,6 +135,19 @@ class Soundtrack:
             self._thread = threading.Thread(target=self._play, args=(t,), daemon=True,
                                             name="soundtrack")
             self._thread.start()
+
+    def _follow(self, t: float, loop_t: float) -> float:
+        """Show time ``t`` [s] at loop time ``loop_t``; a jump (away from where the last
+        tick's show time and the loop's time since put it by more than ``SEEK_S``) restarts
+        the player there and puts the cues after ``t`` next."""
+        last = self._last
+        self._last = (t, loop_t)
+        if last is not None and abs(t - (last[0] + loop_t - last[1])) > SEEK_S:
+            old, self._proc, self._thread = self._proc, None, None   # the next tick starts one
+            if old is not None:          # ended from a thread of its own, not the loop's
+                threading.Thread(target=_end, args=(old,), daemon=True).start()
+            self._next_cue = sum(1 for c in self.show.cues if c.t < t)
+        return t
 
     def _play(self, show_t: float) -> None:
         path = self.show.audio_path()
@@ -119,6 +163,8 @@ class Soundtrack:
             return
         self._proc = proc
         _, err = proc.communicate(data if stdin else None)
+        if proc is not self._proc:           # superseded by a seek (a chased jump)
+            return
         if proc.returncode not in (0, None) and not self._done.is_set():
             first = err.decode(errors="replace").strip().splitlines()[:1]
             self._warn(f"audio {path}: {cmd[0]} exited {proc.returncode}"
@@ -131,12 +177,20 @@ class Soundtrack:
     def close(self) -> None:
         """Stop the player (the show ended or was stopped)."""
         self._done.set()
-        proc = self._proc
-        if proc is not None and proc.poll() is None:
-            proc.terminate()
-            try:
-                proc.wait(timeout=2.0)
-            except subprocess.TimeoutExpired:
-                proc.kill()
+        self._stop_player()
+
+    def _stop_player(self) -> None:
+        if self._proc is not None:
+            _end(self._proc)
         if self._thread is not None:
             self._thread.join(timeout=2.0)
+
+
+def _end(proc: subprocess.Popen[bytes]) -> None:
+    """Stop a player process (terminate, then kill after 2 s)."""
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(timeout=2.0)
+        except subprocess.TimeoutExpired:
+            proc.kill()

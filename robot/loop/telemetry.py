@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from robot.bus.base import ServoState
+from robot.imu.base import ImuSample
 from robot.loop.latency import SampleStats
 
 
@@ -14,11 +15,14 @@ from robot.loop.latency import SampleStats
 class Telemetry:
     """A snapshot of the loop for the CLI, the panel and recorders (joint order).
 
-    state: "idle" | "ramp_in" | "walking" | "ramp_out" | "rest" | "pose" | "stopped" |
-    "estop"; period_error_ms: lateness of the last tick start [ms]; clamped: the joints
-    (names, joint order) held at a limit in this tick's command: by the source (the gait
-    engine clamps what its IK asks beyond a limit) or by the loop (a feedback correction
-    beyond one); empty when none was.
+    state: "idle" | "ramp_in" | "waiting" (a chased show before its start timecode) |
+    "walking" | "ramp_out" | "rest" | "pose" | "stopped" | "estop"; period_error_ms:
+    lateness of the last tick start [ms]; clamped: the joints (names, joint order) held at
+    a limit in this tick's command: by the source (the gait engine clamps what its IK asks
+    beyond a limit) or by the loop (a feedback correction beyond one); empty when none
+    was; imu: the balance stage's last IMU sample (None: no IMU in the run). t and t_read [s]
+    are on the loop's clock (the wall clock on servos, the simulation's on the sim bus):
+    t the tick's start, t_read when the last read-back's reply was in.
     """
 
     t: float = 0.0
@@ -32,7 +36,9 @@ class Telemetry:
     amplitude: float = 0.0
     stop_reason: str | None = None
     fresh: bool = False  # True on ticks that read the servos back
+    t_read: float = 0.0
     clamped: tuple[str, ...] = ()
+    imu: ImuSample | None = None
 
 
 TickObserver = Callable[[Telemetry], None]

@@ -7,7 +7,15 @@
 - ``smooth``: the monotone piecewise-cubic Hermite interpolant (Fritsch & Carlson 1980,
   with the harmonic-mean slopes of Fritsch & Butland 1984): continuous velocity, passes
   through the keyframes without stopping, never overshoots them (no value outside the
-  range of the two keyframes of a segment), zero slope at local extrema.
+  range of the two keyframes of a segment), zero slope at local extrema. For sparse
+  keyframes (a hand's, a glTF's cubic or step track).
+- ``spline``: the C2 cubic spline through samples with not-a-knot ends (de Boor, *A
+  Practical Guide to Splines*, ch. IV): continuous acceleration, exact on any cubic,
+  error O(h^4) on a smooth curve, so it recovers a peak that falls between two frames of
+  a sampled animation (BVH frames, a glTF's sampled or linear track). It may overshoot
+  where the samples turn sharply; ``spline(..., lo=, hi=)`` keeps it inside the joint
+  limits wherever the two samples of a segment are (a limit the samples cross is not
+  hidden). Fewer than four samples: ``smooth``.
 
 Before the first keyframe the first value holds, after the last one the last value.
 """
@@ -20,7 +28,7 @@ import numpy.typing as npt
 from robot.motion import ramp
 
 Array = npt.NDArray[np.float64]
-METHODS = ("min_jerk", "smooth")
+METHODS = ("min_jerk", "smooth")  # a keyframe file's choices
 
 
 def _segment(times: Array, t: Array) -> tuple[npt.NDArray[np.intp], Array, Array]:
@@ -76,6 +84,60 @@ def smooth(times: Array, values: Array, t: Array) -> Array:
     s2, s3 = s * s, s * s * s
     return ((2 * s3 - 3 * s2 + 1) * values[i] + (s3 - 2 * s2 + s) * hh * m[i]
             + (-2 * s3 + 3 * s2) * values[i + 1] + (s3 - s2) * hh * m[i + 1])
+
+
+def _second_derivatives(times: Array, values: Array) -> Array:
+    """The spline's second derivatives at the samples (k, j), not-a-knot ends: the third
+    derivative is continuous at the second and the last-but-one sample. A tridiagonal
+    system in the k - 2 inner unknowns (the ends eliminated), solved by the Thomas
+    algorithm for every joint at once."""
+    h = np.diff(times)
+    d = np.diff(values, axis=0) / h[:, None]
+    rhs = 6.0 * (d[1:] - d[:-1])                           # (k - 2, j)
+    n = len(rhs)
+    sub, diag, sup = h[:-1].copy(), 2.0 * (h[:-1] + h[1:]), h[1:].copy()
+    # M0 = ((h0 + h1) M1 - h0 M2) / h1, and the mirror image at the other end.
+    h0, h1, hl, hm = h[0], h[1], h[-1], h[-2]
+    diag[0] += h0 * (h0 + h1) / h1
+    sup[0] -= h0 * h0 / h1
+    diag[-1] += hl * (hl + hm) / hm
+    sub[-1] -= hl * hl / hm
+    c, r = np.empty(n), np.empty_like(rhs)
+    c[0], r[0] = sup[0] / diag[0], rhs[0] / diag[0]
+    for i in range(1, n):
+        w = diag[i] - sub[i] * c[i - 1]
+        c[i] = sup[i] / w if i < n - 1 else 0.0
+        r[i] = (rhs[i] - sub[i] * r[i - 1]) / w
+    inner = np.empty_like(rhs)
+    inner[-1] = r[-1]
+    for i in range(n - 2, -1, -1):
+        inner[i] = r[i] - c[i] * inner[i + 1]
+    m = np.empty_like(values)
+    m[1:-1] = inner
+    m[0] = ((h0 + h1) * inner[0] - h0 * inner[1]) / h1
+    m[-1] = ((hl + hm) * inner[-1] - hl * inner[-2]) / hm
+    return m
+
+
+def spline(times: Array, values: Array, t: Array, *, lo: Array | None = None,
+           hi: Array | None = None) -> Array:
+    """values: (k, j) samples; t: (n,) → (n, j); ``lo`` / ``hi`` (j,): limits [rad] the
+    curve stays inside where both samples of its segment do."""
+    times, values, t = np.asarray(times, float), np.asarray(values, float), np.asarray(t, float)
+    if len(times) < 4:
+        return smooth(times, values, t)
+    m = _second_derivatives(times, values)
+    i, t0, h = _segment(times, t)
+    hh = h[:, None]
+    a = np.clip((t - t0) / h, 0.0, 1.0)[:, None]           # share of the segment gone
+    b = 1.0 - a
+    out = (b * values[i] + a * values[i + 1]
+           + hh * hh / 6.0 * ((b ** 3 - b) * m[i] + (a ** 3 - a) * m[i + 1]))
+    if lo is not None and hi is not None:
+        floor = np.minimum(np.minimum(values[i], values[i + 1]), lo)
+        ceiling = np.maximum(np.maximum(values[i], values[i + 1]), hi)
+        out = np.clip(out, floor, ceiling)
+    return np.asarray(out, dtype=np.float64)
 
 
 def interpolate(method: str, times: Array, values: Array, t: Array) -> Array:

@@ -252,3 +252,9 @@ def read_take(path: str | Path) -> Take:
                 source=str(p), starts=tuple(starts), stops=tuple(stops),
                 present=read if np.isfinite(read).any() else None,
                 present_t=np.asarray(read_t, dtype=float), blends=blends)
+
+
+def header_of(where: str, data: JsonValue) -> TakeHeader:
+    """A take header from its JSON object (as ``TakeHeader.as_json`` writes it), checked;
+    ConfigError naming ``where`` and the field."""
+    return _header(where, data)

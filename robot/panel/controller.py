@@ -25,6 +25,7 @@ from typing import Any
 from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.loop.telemetry import LoopStats
+from robot.panel.loop_lost import take_over
 from robot.panel.loop_process import LoopProcess, LoopUnavailable
 from robot.panel.loop_state import LoopStateReader
 from robot.panel.options import (
@@ -247,12 +248,16 @@ class PanelController:
         ``timeout`` [s] (default ``stop_budget_s()``); then the loop closes the bus,
         leaving torque on only if the last run ended holding and nothing aborted. Returns
         what the wire was told: ``holding``, ``torque`` {id: bool}, ``failed`` lines
-        (empty dict when the loop never started)."""
+        (empty dict when the loop never started); a loop process that died is taken over
+        (torque off from here: robot.panel.loop_lost), its report says ``lost``."""
         with self._lock:
             self._closing = True
             loop = self._loop
         if loop is None:
             return {}
+        if loop.gone is not None:        # killed: nobody holds the bus (robot.panel.loop_lost)
+            loop.close()
+            return take_over(self.robot, self.bus, why=loop.gone)
         budget = self.stop_budget_s() if timeout is None else timeout
         pending = loop.send("shutdown")
         end, stopped = time.monotonic() + budget, False
@@ -275,6 +280,8 @@ class PanelController:
                 log.error("the control loop did not close; ending it")
                 break
         loop.close()
+        if not result and loop.gone is not None:    # it died while stopping
+            return take_over(self.robot, self.bus, why=loop.gone)
         return result
 
 

@@ -26,6 +26,7 @@ from robot.bus.lease import BusLease, Session
 from robot.bus.servo_map import ServoMap
 from robot.config.params import GaitParams
 from robot.imu import Imu
+from robot.loop.mcap_recorder import Alongside
 from robot.loop.take_writer import TakeWriter
 from robot.motion.posing import limb_joints
 from robot.panel.idle_pose import IdlePose
@@ -191,7 +192,7 @@ class LoopHost:
                 self._run = None
         return None
 
-    def _stream(self, kind: RunKind, run: Run[Any], recorder: TakeWriter | None,
+    def _stream(self, kind: RunKind, run: Run[Any], recorder: TakeWriter | Alongside | None,
                 session: Session) -> None:
         """Stream the run, close it, and report how it ended."""
         stats = None

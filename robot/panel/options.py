@@ -22,13 +22,15 @@ class PanelStateError(BipedError):
 class LoopOptions:
     """rate_hz: control rate [Hz]; read_every: read back every N ticks; hold: keep torque
     on at the rest pose after a stop; balance: IMU feedback for each run when the robot
-    has an ``[imu]``; imu_noise: a simulated IMU's noise scale (None: the robot file's)."""
+    has an ``[imu]``; imu_noise: a simulated IMU's noise scale (None: the robot file's);
+    mcap: each recorded take also writes NAME.mcap beside it (robot/loop/mcap_recorder.py)."""
 
     rate_hz: float = 200.0
     read_every: int = 10
     hold: bool = False
     balance: bool = False
     imu_noise: float | None = None
+    mcap: bool = False
 
 
 #: The options of a panel given none.

@@ -32,7 +32,8 @@ _HTML, _JS = "text/html; charset=utf-8", "text/javascript; charset=utf-8"
 #: URL path → (file in robot/panel/static/, Content-Type).
 STATIC = {"/": ("index.html", _HTML), "/index.html": ("index.html", _HTML),
           "/panel.js": ("panel.js", _JS), "/panel.css": ("panel.css", "text/css; charset=utf-8"),
-          "/input.js": ("input.js", _JS), "/studio.js": ("studio.js", _JS)}
+          "/input.js": ("input.js", _JS), "/studio.js": ("studio.js", _JS),
+          "/midi.js": ("midi.js", _JS)}
 
 
 @dataclass(frozen=True)

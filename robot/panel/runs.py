@@ -15,6 +15,7 @@ from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
+from robot.loop.mcap_recorder import Alongside, McapRecorder
 from robot.loop.take_writer import TakeWriter
 from robot.motion.keyframes import Sequence, parse_sequence
 from robot.motion.layered import LayeredEngine
@@ -40,6 +41,7 @@ class Record:
     take: str
     path: str
     header: TakeHeader
+    mcap: str | None = None      # the take as MCAP too, at this path
 
     @property
     def owner(self) -> str:
@@ -97,7 +99,7 @@ class Built:
     moves); ``driver``: what drives the run instead of the sliders (None: the sliders)."""
 
     engine: GaitEngine
-    recorder: TakeWriter | None = None
+    recorder: TakeWriter | Alongside | None = None
     driver: str | None = None
 
 
@@ -107,8 +109,13 @@ def build(kind: RunKind, robot: RobotConfig, params: GaitParams) -> Built:
     if isinstance(kind, Walk):
         return Built(GaitEngine(robot, params))
     if isinstance(kind, Record):
-        writer = TakeWriter(kind.path, dataclasses.replace(kind.header, params=params))
-        return Built(RecordingEngine(robot, params, sink=writer.event), recorder=writer)
+        header = dataclasses.replace(kind.header, params=params)
+        writer = TakeWriter(kind.path, header)
+        recording = RecordingEngine(robot, params, sink=writer.event)
+        if kind.mcap is None:
+            return Built(recording, recorder=writer)
+        mcap = McapRecorder(kind.mcap, robot, header, params=lambda: recording.params)
+        return Built(recording, recorder=Alongside(writer, mcap))
     if isinstance(kind, Play):
         take = read_take(kind.path)
         h = take.header

@@ -17,6 +17,8 @@ Endpoints (JSON in and out; errors are ``{"error": "..."}``, never an empty repl
   POST /api/record {"name"?} | /api/play {"name"}   record a take (ends with stop), replay
   POST /api/pose/release {"limb"} | /api/pose/capture | /api/pose/clear | /api/pose/save
        {"name"} | /api/sequence/play {"name", "layer": bool}: posing by hand (panel.studio)
+  GET  /api/showctl | POST /api/midi/learn {"param"}   show control, with --osc or --midi
+                     (robot.panel.show_control)
 
 The endpoints are a table (``robot.panel.routes``); this module is the HTTP plumbing
 around it: the server (its connection caps and deadlines, robot.panel.admission) and one
@@ -119,20 +121,23 @@ class PanelServer(ThreadingHTTPServer):
 def build_server(controller: PanelController, *, host: str = "127.0.0.1", port: int = 0,
                  token: str | None = None, read_timeout_s: float = READ_TIMEOUT_S,
                  head_timeout_s: float = HEAD_TIMEOUT_S, admission: Admission | None = None,
-                 studio: Studio | None = None) -> PanelServer:
+                 studio: Studio | None = None, more_routes: Routes | None = None
+                 ) -> PanelServer:
     """A PanelServer bound to (host, port) (port 0: ephemeral) serving the panel for
     ``controller``. Call ``serve_forever()`` (e.g. in a thread) and ``shutdown()``, then
     ``server_close()`` (which also closes the WebSockets).
     read_timeout_s: a body not received this long after its headers is answered 408;
     head_timeout_s: a request line and headers not received this long after the accept
     drop the connection; admission: the connection caps (robot.panel.admission);
-    studio: takes and keyframes (default: in the user's data directory)."""
+    studio: takes and keyframes (default: in the user's data directory);
+    more_routes: endpoints beyond the panel's own (show control's)."""
     if not is_loopback(host) and not token:
         raise ConfigError(f"--host {host}: serving beyond loopback needs a token (--token)")
     room = studio or Studio(controller)
     hub = LiveHub(lambda: live_snapshot(controller, room))
     return PanelServer((host, port), guard=Guard.for_bind(host, token=token),
-                       routes=route_table(controller, room, hub), hub=hub,
+                       routes={**route_table(controller, room, hub), **(more_routes or {})},
+                       hub=hub,
                        read_timeout_s=read_timeout_s, head_timeout_s=head_timeout_s,
                        admission=admission)
 

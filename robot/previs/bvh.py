@@ -29,6 +29,7 @@ import numpy.typing as npt
 
 from robot.config.extra_joints import extra_layout, link_length
 from robot.config.robot import RobotConfig
+from robot.files.atomic import write_text
 from robot.gait.ik import leg_fk_full
 
 Array = npt.NDArray[np.float64]
@@ -166,7 +167,7 @@ def write_bvh(path: str | Path, robot: RobotConfig, q: Array, frame_s: float, *,
     lines += ["MOTION", f"Frames: {len(q)}", f"Frame Time: {frame_s:.6f}"]
     data = np.column_stack(cols)
     lines += [" ".join(num(v) for v in row) for row in data.tolist()]
-    Path(path).write_text("\n".join(lines) + "\n")
+    write_text(path, "\n".join(lines) + "\n")
     return len(q)
 
 

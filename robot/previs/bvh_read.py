@@ -7,14 +7,26 @@ differ and all are read: 3 or 6 channels per joint (Blender writes positions on 
 joint: only the root's position is kept, as the skeleton's travel), any of the six Euler
 orders per joint, any up axis, any length unit. Bad input is one ConfigError naming the
 file and the line or joint.
+
+Memory: the frames are parsed as a stream, ``CHUNK_BYTES`` of text at a time, into one
+array of the frame count the header declares, so a long motion-capture take costs its
+numbers (8 bytes each, then the rotations), never its text as Python words. What the
+header declares is checked first, before a frame is read: at most ``MAX_SECONDS`` of
+animation (an hour, what a take is sized for: robot.motion.takes.MAX_BYTES) and at most
+``MAX_BONE_FRAMES`` bone-frames (the rotations' memory: 72 bytes each). ``progress``
+shows a bar (tqdm, on stderr) while the frames of a file over ``PROGRESS_BYTES`` are read.
 """
 
 from __future__ import annotations
 
 import math
+import re
+from collections.abc import Iterator
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
+from tqdm import tqdm
 
 from robot.errors import ConfigError
 from robot.previs.rig import Array, Rig, nominal_frame_s
@@ -22,6 +34,18 @@ from robot.previs.rotations import compose
 
 #: Largest BVH read [bytes].
 MAX_BYTES = 1 << 29
+#: Longest animation read [s]: an hour (a take of an hour at 200 Hz is ~0.3 GB).
+MAX_SECONDS = 3600.0
+#: Most frames x joints read: their rotations take 72 bytes each (720 MB at the limit).
+MAX_BONE_FRAMES = 10_000_000
+#: The hierarchy and the MOTION header must fit in this much of the file's start [bytes].
+HEAD_BYTES = 1 << 22
+#: Frame text parsed at a time [bytes].
+CHUNK_BYTES = 1 << 20
+#: Files whose frames take longer than a moment to read [bytes]: they show a progress bar.
+PROGRESS_BYTES = 1 << 24
+_FRAME_TIME = re.compile(rb"Frame\s+Time:\s*\S+", re.IGNORECASE)
+_SPACES = (b" ", b"\n", b"\t", b"\r")
 
 
 class _Tokens:
@@ -55,16 +79,27 @@ class _Tokens:
         return v
 
 
-def read_bvh(path: str | Path) -> Rig:
+def read_bvh(path: str | Path, *, progress: bool = False) -> Rig:
+    """The rig of the BVH file ``path`` (see the module docstring; ``progress``: a bar
+    while the frames of a large file are read)."""
     p = Path(path)
     try:
-        if p.stat().st_size > MAX_BYTES:
+        size = p.stat().st_size
+        if size > MAX_BYTES:
             raise ConfigError(f"{p}: larger than {MAX_BYTES >> 20} MiB; not an animation")
-        text = p.read_text()
+        with p.open("rb") as f:
+            return _read(f, p, size, progress=progress)
     except FileNotFoundError:
         raise ConfigError(f"{p}: file not found") from None
     except (OSError, UnicodeDecodeError) as e:
         raise ConfigError(f"{p}: cannot read it as a BVH file: {e}") from None
+
+
+def _read(f: BinaryIO, p: Path, size: int, *, progress: bool) -> Rig:
+    head = f.read(HEAD_BYTES)
+    m = _FRAME_TIME.search(head)
+    cut = m.end() if m else len(head)
+    text = head[:cut].decode()
     tok = _Tokens(text, str(p))
     tok.expect("HIERARCHY")
     names: list[str] = []
@@ -119,18 +154,18 @@ def read_bvh(path: str | Path) -> Rig:
     if n < 1 or not frame_s > 0:
         raise ConfigError(f"{p}: Frames {n}, Frame Time {frame_s:g}: expected at least one "
                           "frame and a positive frame time [s]")
+    seconds = n * frame_s
+    if seconds > MAX_SECONDS or n * len(names) > MAX_BONE_FRAMES:
+        raise ConfigError(
+            f"{p}: {n} frames of {len(names)} joints at {1 / nominal_frame_s(frame_s):g} fps "
+            f"({seconds:.0f} s): "
+            f"more than can be imported at once (at most {MAX_SECONDS:.0f} s and "
+            f"{MAX_BONE_FRAMES:,} joint-frames); cut the animation into parts")
     width = sum(len(c) for c in channels)
-    values = tok.words[tok.i:]
-    if len(values) != n * width:
-        raise ConfigError(f"{p}: MOTION has {len(values)} numbers; {n} frames of {width} "
-                          f"channels need {n * width}")
-    try:
-        data: Array = np.array(values, dtype=float).reshape(n, width)
-    except ValueError:
-        raise ConfigError(f"{p}: MOTION: a frame value is not a number") from None
-    if not np.all(np.isfinite(data)):
-        row = int(np.argwhere(~np.isfinite(data))[0, 0])
-        raise ConfigError(f"{p}: MOTION frame {row}: a value is not finite")
+    bar = tqdm(total=size, initial=cut, unit="B", unit_scale=True, leave=False,
+               desc=f"reading {p.name}", disable=not progress or size < PROGRESS_BYTES)
+    with bar:
+        data = _frames(_chunks(f, head[cut:], bar), p, n, width)
     pose = np.empty((n, len(names), 3, 3))
     root = np.zeros((n, 3))
     col = 0
@@ -149,3 +184,51 @@ def read_bvh(path: str | Path) -> Rig:
     return Rig(tuple(names), tuple(parents), np.array(offsets), pose, root,
                nominal_frame_s(frame_s),
                tuple(ends), str(p))
+
+
+def _chunks(f: BinaryIO, first: bytes, bar: tqdm) -> Iterator[bytes]:  # type: ignore[type-arg]
+    """The frame text: what the head read held past the header, then the rest of the
+    file ``CHUNK_BYTES`` at a time."""
+    if first:
+        yield first
+    while chunk := f.read(CHUNK_BYTES):
+        bar.update(len(chunk))
+        yield chunk
+
+
+def _frames(chunks: Iterator[bytes], p: Path, n: int, width: int) -> Array:
+    """The ``n`` x ``width`` frame values from the text in ``chunks`` (a number may be cut
+    between two chunks: the words after the last whitespace wait for the next one)."""
+    out = np.empty(n * width)
+    filled, carry, want = 0, b"", n * width
+    for chunk in chunks:
+        buf = carry + chunk
+        last = max(buf.rfind(c) for c in _SPACES)
+        words, carry = buf[:last + 1].split(), buf[last + 1:]
+        filled = _store(out, filled, words, p, want, width)
+    filled = _store(out, filled, carry.split(), p, want, width)
+    if filled != want:
+        raise ConfigError(f"{p}: MOTION has {filled} numbers; {n} frames of {width} "
+                          f"channels need {want}")
+    data = out.reshape(n, width)
+    if not np.all(np.isfinite(data)):
+        row = int(np.argwhere(~np.isfinite(data))[0, 0])
+        raise ConfigError(f"{p}: MOTION frame {row}: a value is not finite")
+    return data
+
+
+def _store(out: Array, filled: int, words: list[bytes], p: Path, want: int,
+           width: int) -> int:
+    """Put ``words`` into ``out`` from ``filled`` on; the new fill."""
+    if not words:
+        return filled
+    if filled + len(words) > want:
+        raise ConfigError(f"{p}: MOTION has more than {want} numbers; "
+                          f"{want // width} frames of {width} channels need {want}")
+    try:
+        out[filled:filled + len(words)] = np.array(words, dtype=np.float64)
+    except ValueError:
+        row = filled // width
+        raise ConfigError(f"{p}: MOTION near frame {row}: a frame value is not a number") \
+            from None
+    return filled + len(words)

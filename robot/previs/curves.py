@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import io
 from pathlib import Path
 from typing import Any
 
@@ -10,7 +11,9 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.config.joint_names import limb_groups
+from robot.files.atomic import write_text
 from robot.gait.expressions import CHANNELS
+from robot.previs.figure_file import save_figure
 
 # Channels grouped by body part, as the paper groups its expressions.
 CHANNEL_GROUPS: dict[str, tuple[str, ...]] = {
@@ -34,10 +37,11 @@ def write_csv(path: str | Path, times: npt.NDArray[np.float64],
     """Columns: ``t`` [s], every channel of equations.md, ``q_<joint>`` [rad]."""
     header = ["t", *CHANNELS, *(f"q_{n}" for n in joint_names)]
     data = np.column_stack([times, *(channels[c] for c in CHANNELS), *q])
-    with Path(path).open("w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(header)
-        w.writerows(data.tolist())  # repr precision: the channels round-trip exactly
+    text = io.StringIO()
+    w = csv.writer(text)
+    w.writerow(header)
+    w.writerows(data.tolist())  # repr precision: the channels round-trip exactly
+    write_text(path, text.getvalue())
 
 
 def palette(n: int) -> list[tuple[float, float, float, float]]:
@@ -108,5 +112,5 @@ def plot_curves(path: str | Path, times: npt.NDArray[np.float64],
     import matplotlib.pyplot as plt
 
     fig = curves_figure(times, channels, joint_names, q, title=title)
-    fig.savefig(path, dpi=90)
+    save_figure(fig, path)
     plt.close(fig)

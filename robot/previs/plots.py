@@ -17,6 +17,8 @@ from robot.config.toml_io import parse_json
 from robot.errors import ConfigError
 from robot.gait.expressions import CHANNELS
 from robot.previs.curves import outside_legend, palette, plot_curves
+from robot.previs.figure_file import save_figure
+from robot.previs.mcap_read import mcap_rows
 
 Array = npt.NDArray[np.float64]
 
@@ -43,10 +45,28 @@ def _num(v: Any) -> float:
 
 
 def read_table(path: str | Path) -> Table:
-    """Read a .csv or .jsonl file of rows into columns; ConfigError (one line naming the
+    """Read a .csv, .jsonl or .mcap file of rows into columns; ConfigError (one line naming the
     file, the line and the column) unless it has at least two rows, a finite ``t`` in each
     and only plain values (no NUL byte, no nested JSON)."""
     p = Path(path)
+    if p.suffix == ".mcap":                     # robot/loop/mcap_recorder.py
+        rows = mcap_rows(p)
+        names = list(rows[0]) if rows else []
+    else:
+        rows, names = _text_rows(p)
+    if rows and p.suffix == ".jsonl" and "take" in rows[0]:
+        rows, names = _take_rows(rows)
+    if not rows or "t" not in names:
+        raise ConfigError(f"{path}: no rows with a 't' column; expected a `biped walk "
+                          "--record` or `biped curves` file")
+    _check_rows(p, rows)
+    cols = {n: np.array([_num(r.get(n)) for r in rows]) for n in names if n != "state"}
+    states = tuple(str(r.get("state", "")) for r in rows)
+    return Table(cols, states, str(p))
+
+
+def _text_rows(p: Path) -> tuple[list[dict[str, Any]], list[str]]:
+    path = p
     try:
         with p.open(newline="") as f:
             if p.suffix == ".jsonl":
@@ -57,20 +77,13 @@ def read_table(path: str | Path) -> Table:
                 names = next(reader, [])
                 rows = [dict(zip(names, r, strict=False)) for r in reader]
             else:
-                raise ConfigError(f"{path}: unknown format {p.suffix!r}; valid: .csv, .jsonl")
+                raise ConfigError(f"{path}: unknown format {p.suffix!r}; valid: .csv, .jsonl, "
+                                  ".mcap")
     except FileNotFoundError:
         raise ConfigError(f"{path}: file not found") from None
     except (UnicodeDecodeError, csv.Error, OSError) as e:
         raise ConfigError(f"{path}: not a valid record file: {e}") from None
-    if rows and p.suffix == ".jsonl" and "take" in rows[0]:
-        rows, names = _take_rows(rows)
-    if not rows or "t" not in names:
-        raise ConfigError(f"{path}: no rows with a 't' column; expected a `biped walk "
-                          "--record` or `biped curves` file")
-    _check_rows(p, rows)
-    cols = {n: np.array([_num(r.get(n)) for r in rows]) for n in names if n != "state"}
-    states = tuple(str(r.get("state", "")) for r in rows)
-    return Table(cols, states, str(p))
+    return rows, names
 
 
 def _json_row(p: Path, k: int, line: str) -> dict[str, Any]:
@@ -211,5 +224,5 @@ def plot_record(table: Table, out: str | Path) -> None:
     import matplotlib.pyplot as plt
 
     fig = record_figure(table)
-    fig.savefig(out, dpi=90)
+    save_figure(fig, out)
     plt.close(fig)

@@ -44,7 +44,9 @@ class Rig:
     each bone's rest position relative to its parent's [file units]; pose (n, B, 3, 3):
     each bone's rotation relative to its parent's, from rest, in world-rest axes; root
     (n, 3): the root's position [file units]; frame_s: time per frame [s]; ends: chain
-    end sites (parent index, offset) that have no bone of their own."""
+    end sites (parent index, offset) that have no bone of their own; sampled: the frames
+    sample a curve (a BVH's, a glTF's LINEAR tracks), not sparse keyframes (a glTF's
+    CUBICSPLINE or STEP tracks): the import interpolates them with the spline."""
 
     names: tuple[str, ...]
     parents: tuple[int, ...]
@@ -54,12 +56,13 @@ class Rig:
     frame_s: float
     ends: tuple[tuple[int, tuple[float, float, float]], ...] = ()
     source: str = "<memory>"
+    sampled: bool = True
 
     @staticmethod
     def from_local(names: tuple[str, ...], parents: tuple[int, ...], offsets: Array,
                    rest: Array, local: Array, root: Array, frame_s: float, *,
                    ends: tuple[tuple[int, tuple[float, float, float]], ...] = (),
-                   source: str = "<memory>") -> Rig:
+                   source: str = "<memory>", sampled: bool = True) -> Rig:
         """From node rotations as a glTF file animates them: ``rest`` (B, 3, 3) each
         node's rest rotation relative to its parent, ``local`` (n, B, 3, 3) the animated
         ones. The pose in world-rest axes is W0p L L0^-1 W0p^-1 (W0p: the parent's rest
@@ -75,7 +78,7 @@ class Rig:
         flat_ends = tuple((p, tuple(float(v) for v in world[p] @ np.asarray(o)))
                           for p, o in ends)
         return Rig(names, parents, flat, pose, root, frame_s, flat_ends,  # type: ignore[arg-type]
-                   source)
+                   source, sampled)
 
     @property
     def frames(self) -> int:

@@ -25,6 +25,7 @@ from robot.balance.stage import Balance, attitude_reader
 from robot.bus.servo_map import ServoMap
 from robot.errors import BusError, ConfigError
 from robot.gait.engine import GaitEngine
+from robot.imu.last import LastSample
 from robot.loop.ending import finish
 from robot.loop.source import Feedback, SourceT
 from robot.loop.streamer import Streamer
@@ -51,6 +52,7 @@ class Run(Generic[SourceT]):
         self._result: RunResult | None = None
         self._wall0 = 0.0
         self._imu_opened = False
+        self._imu_last: LastSample | None = None
         self._signals = contextlib.ExitStack()
 
     @property
@@ -94,10 +96,11 @@ class Run(Generic[SourceT]):
         if spec.imu is not None:
             spec.imu.open()
             self._imu_opened = True
+        feedback = self._feedback()       # first: the observers see what its IMU read
         self._streamer = Streamer(ServoMap(spec.robot), spec.bus, spec.source,
                                   rate_hz=o.rate_hz, read_every=o.read_every,
                                   hold_at_end=o.hold, observer=self._observer(),
-                                  feedback=self._feedback())
+                                  feedback=feedback)
 
     def _feedback(self) -> Feedback | None:
         spec = self.spec
@@ -106,7 +109,8 @@ class Run(Generic[SourceT]):
         if not isinstance(spec.source, GaitEngine):
             raise ConfigError(f"run: balance needs a gait engine, not a "
                               f"{type(spec.source).__name__}")
-        return Balance(spec.source, attitude_reader(spec.imu), present=self._read_back)
+        self._imu_last = LastSample(spec.imu)          # what it read, for the recorders
+        return Balance(spec.source, attitude_reader(self._imu_last), present=self._read_back)
 
     def _read_back(self) -> list[float] | None:
         """The joint angles [rad] the loop read back on its last tick, else None."""
@@ -116,6 +120,12 @@ class Run(Generic[SourceT]):
     def _observer(self) -> Callable[[Telemetry], None]:
         spec = self.spec
         observers: list[Callable[[Telemetry], None]] = []
+        if self._imu_last is not None:
+            imu = self._imu_last
+
+            def imu_sample(tel: Telemetry) -> None:
+                tel.imu = imu.last
+            observers.append(imu_sample)
         watch = self.watch
         if watch is not None:
             observers.append(watch)

@@ -15,6 +15,7 @@ from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.imu import Imu, open_imu
+from robot.loop.mcap_recorder import McapRecorder, is_mcap
 from robot.loop.recorder import Recorder
 from robot.loop.take_writer import TakeWriter
 from robot.motion.keyframes import Sequence
@@ -57,24 +58,30 @@ def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
               switches: tuple[PresetSwitch, ...] = ()) -> RunSpec[GaitEngine]:
     """The run of a walk with ``params`` (preset ``gait``, for a take's header), a
     keyframe layer on the arms, a recording (NAME.take.jsonl: the parameter
-    timeline; .csv or .jsonl: the joint stream) and preset ``switches`` (blended live,
+    timeline; .csv or .jsonl: the joint stream; .mcap: the run's channels,
+    robot.loop.mcap_recorder) and preset ``switches`` (blended live,
     robot.run.switching; a take records them as blends)."""
     options = options or RunOptions()
     recorder: Recording | None = None
     engine: GaitEngine
+    header = TakeHeader(
+        robot=robot.name, robot_file=robot.source, joints=robot.joint_names,
+        rate_hz=options.rate_hz, read_every=options.read_every, gait=gait,
+        params=params, bus=bus.kind, balance=imu is not None,
+        keyframes=keyframes.as_json() if keyframes else None)
     if record and is_take(record):
-        take = TakeWriter(record, TakeHeader(
-            robot=robot.name, robot_file=robot.source, joints=robot.joint_names,
-            rate_hz=options.rate_hz, read_every=options.read_every, gait=gait,
-            params=params, bus=bus.kind, balance=imu is not None,
-            keyframes=keyframes.as_json() if keyframes else None))
+        take = TakeWriter(record, header)
         engine = RecordingEngine(robot, params, sink=take.event, keyframes=keyframes)
         recorder = take
     else:
-        if record:
-            recorder = Recorder(record, robot.joint_names, robot.ids)
         engine = (LayeredEngine(robot, params, keyframes=keyframes) if keyframes
                   else GaitEngine(robot, params))
+        if record and is_mcap(record):
+            source = engine
+            recorder = McapRecorder(record, robot, header, params=lambda: source.params,
+                                    body=bus)
+        elif record:
+            recorder = Recorder(record, robot.joint_names, robot.ids)
     return RunSpec(robot=robot, source=engine, bus=bus, options=options, imu=imu,
                    recorder=recorder,
                    observer=PresetSwitcher(engine, switches) if switches else None)

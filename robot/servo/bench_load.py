@@ -11,6 +11,7 @@ one; the text form is ``MASS@LENGTH`` (kg @ m), e.g. ``0.5@0.1``.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from robot.errors import ConfigError
@@ -21,6 +22,10 @@ G = 9.81                 # [m/s^2]
 HORN_INERTIA = 1e-6
 MAX_MASS = 10.0          # [kg] what a hobby servo bench could hold, for input checks
 MAX_LENGTH = 1.0         # [m]
+#: [kg], [m]: a lighter weight or a shorter arm is no pendulum (the horn outweighs it, and
+#: MuJoCo refuses a moving body under 1e-15 kg).
+MIN_MASS = 1e-3
+MIN_LENGTH = 1e-3
 
 
 @dataclass(frozen=True)
@@ -49,8 +54,41 @@ class BenchLoad:
 NONE = BenchLoad()
 
 
+def got(value: float) -> str:
+    return f"(got {value:g})"
+
+
+def must(where: str, what: str, value: float) -> ConfigError:
+    """The one-line refusal ``WHERE must be WHAT (got VALUE)``."""
+    return ConfigError(f"{where} must be {what} {got(value)}")
+
+
+def positive(where: str, value: float, *, least: float, most: float, unit: str) -> float:
+    """``value`` if finite and within [least, most] [unit]; ConfigError otherwise."""
+    if not (math.isfinite(value) and value > 0):
+        raise must(where, "a finite number > 0", value)
+    if value < least:
+        raise must(where, f"at least {least:g} {unit}", value)
+    if value > most:
+        raise must(where, f"at most {most:g} {unit}", value)
+    return value
+
+
+def rig(where: str, *, mass: float, length: float, arm_mass: float = 0.0) -> None:
+    """The rule for a weight on an arm: ``mass`` [kg] at ``length`` [m] within
+    MIN..MAX_MASS and MIN..MAX_LENGTH, a uniform arm of ``arm_mass`` 0..MAX_MASS [kg];
+    ``where``: the prefix of the fields' names (``"LOG: "``, ``"--"`` for options)."""
+    positive(f"{where}mass", mass, least=MIN_MASS, most=MAX_MASS, unit="kg")
+    positive(f"{where}length", length, least=MIN_LENGTH, most=MAX_LENGTH, unit="m")
+    if not (math.isfinite(arm_mass) and 0 <= arm_mass):
+        raise must(f"{where}arm_mass", "a finite number >= 0", arm_mass)
+    if arm_mass > MAX_MASS:
+        raise must(f"{where}arm_mass", f"at most {MAX_MASS:g} kg", arm_mass)
+
+
 def parse_load(text: str, *, where: str) -> BenchLoad:
-    """``MASS@LENGTH`` [kg @ m] → a load; ConfigError naming ``where`` otherwise."""
+    """``MASS@LENGTH`` [kg @ m] → a load (mass 0: nothing on it; any other keeps ``rig``);
+    ConfigError naming ``where`` otherwise."""
     mass_s, sep, length_s = text.partition("@")
     try:
         mass, length = float(mass_s), float(length_s)
@@ -59,4 +97,6 @@ def parse_load(text: str, *, where: str) -> BenchLoad:
     if not sep or not (0 <= mass <= MAX_MASS and 0 <= length <= MAX_LENGTH):
         raise ConfigError(f"{where}: expected MASS@LENGTH with 0..{MAX_MASS:g} kg and "
                           f"0..{MAX_LENGTH:g} m (e.g. 0.5@0.1), got {text!r}")
+    if mass:
+        rig(f"{where}: ", mass=mass, length=length)
     return BenchLoad(mass=mass, length=length)

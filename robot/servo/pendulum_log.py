@@ -7,12 +7,17 @@ uniform arm, optional), ``kp`` (the position P register during the run), ``vin``
 ``motor``, ``trajectory`` (a name), ``entries``: one per sample with ``timestamp`` [s],
 ``goal_position``, ``position`` [rad] (0: arm hanging down), ``speed`` [rad/s], ``load``,
 ``input_volts`` [V], ``temp`` [deg C], ``torque_enable``.
+
+What a log must satisfy (finite numbers, a real weight on a real arm, time moving forward
+over a plausible span, a ``kp`` its register can hold): ``robot.servo.log_rules``; every
+log read is checked, so ``identify fit`` and ``check`` never replay a broken one.
 """
 
 from __future__ import annotations
 
 import gzip
 import json
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -20,6 +25,8 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.errors import ConfigError
+from robot.files.atomic import write_bytes
+from robot.servo import log_rules as rules
 
 Floats = npt.NDArray[np.float64]
 #: The resampling period of ``identify check`` and ``fit`` [s].
@@ -86,11 +93,33 @@ def _num(src: str, data: dict[str, object], key: str) -> float:
     v = data.get(key)
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise ConfigError(f"{src}: {key}: expected a number, got {v!r}")
-    return float(v)
+    try:
+        return float(v)
+    except OverflowError:           # a JSON integer of hundreds of digits
+        return math.inf if v > 0 else -math.inf
 
 
-def parse_log(data: object, *, source: str) -> PendulumLog:
-    """A log from its decoded JSON (ConfigError, one line, naming what is wrong)."""
+def checked_log(log: PendulumLog, *, law: str | None = None) -> PendulumLog:
+    """``log`` if it keeps every rule of ``robot.servo.log_rules`` (``law``: the firmware
+    law it will be replayed with, for the range of its ``kp``; None: any); ConfigError
+    of one line naming the log and the field otherwise."""
+    where = log.source
+    rules.rig(f"{where}: ", mass=log.mass, length=log.length, arm_mass=log.arm_mass)
+    rules.supply(f"{where}: vin", log.vin)
+    rules.register_value(f"{where}: kp", log.kp, law=law)
+    rules.times(where, log.t)
+    for name, values in (("goal_position", log.goal), ("position", log.position)):
+        rules.samples(where, name, values, most=rules.MAX_ANGLE, unit="rad")
+    rules.samples(where, "speed", log.speed, most=rules.MAX_SPEED, unit="rad/s")
+    for name, values in (("load", log.load), ("input_volts", log.input_volts),
+                         ("temp", log.temp)):
+        rules.samples(where, name, values)
+    return log
+
+
+def parse_log(data: object, *, source: str, law: str | None = None) -> PendulumLog:
+    """A log from its decoded JSON, checked (``checked_log``; ConfigError, one line,
+    naming what is wrong)."""
     if not isinstance(data, dict):
         raise ConfigError(f"{source}: expected a JSON object with 'entries'")
     entries = data.get("entries")
@@ -106,23 +135,24 @@ def parse_log(data: object, *, source: str) -> PendulumLog:
                 col.append(0.0)
                 continue
             col.append(_num(f"{source}: entries[{i}]", e, k))
-        enable.append(bool(e.get("torque_enable", True)))
+        enable.append(rules.flag(f"{source}: entries[{i}].torque_enable",
+                                 e.get("torque_enable", True)))
     t = np.array(cols["timestamp"])
-    if not np.all(np.diff(t) > 0):
-        raise ConfigError(f"{source}: entries: timestamps must increase")
+    rules.times(source, t)          # before t - t[0] turns an infinite stamp into NaN
+    kp = rules.register_value(f"{source}: kp", _num(source, data, "kp"), law=law)
     motor, trajectory = data.get("motor", ""), data.get("trajectory", "")
-    return PendulumLog(
+    return checked_log(PendulumLog(
         source=source, mass=_num(source, data, "mass"), length=_num(source, data, "length"),
-        kp=int(_num(source, data, "kp")), vin=_num(source, data, "vin"), motor=str(motor),
+        kp=kp, vin=_num(source, data, "vin"), motor=str(motor),
         trajectory=str(trajectory), t=t - t[0], goal=np.array(cols["goal_position"]),
         position=np.array(cols["position"]), speed=np.array(cols["speed"]),
         torque_enable=np.array(enable), load=np.array(cols["load"]),
         input_volts=np.array(cols["input_volts"]), temp=np.array(cols["temp"]),
-        arm_mass=_num(source, data, "arm_mass") if "arm_mass" in data else 0.0)
+        arm_mass=_num(source, data, "arm_mass") if "arm_mass" in data else 0.0), law=law)
 
 
-def read_log(path: str | Path) -> PendulumLog:
-    """Read a ``.json`` or ``.json.gz`` pendulum log."""
+def read_log(path: str | Path, *, law: str | None = None) -> PendulumLog:
+    """Read a ``.json`` or ``.json.gz`` pendulum log, checked (``parse_log``)."""
     p = Path(path)
     try:
         raw = p.read_bytes()
@@ -132,16 +162,18 @@ def read_log(path: str | Path) -> PendulumLog:
         raise ConfigError(f"{p}: file not found") from None
     except (OSError, EOFError, gzip.BadGzipFile) as e:
         raise ConfigError(f"{p}: cannot read: {e}") from e
-    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+    except (ValueError, RecursionError) as e:   # JSON, UTF-8, a 5000-digit number, nesting
         raise ConfigError(f"{p}: not a JSON pendulum log: {e}") from e
-    return parse_log(data, source=str(p))
+    return parse_log(data, source=str(p), law=law)
 
 
 def write_log(log: PendulumLog, path: str | Path) -> Path:
-    """Write ``log`` as JSON (gzip-compressed when ``path`` ends in .gz)."""
+    """Write ``log`` as JSON (gzip-compressed when ``path`` ends in .gz), whole or not at
+    all (a temporary name, renamed); a log that breaks a rule (``checked_log``) is refused
+    before anything is written, so every log written can be read."""
     p = Path(path)
-    text = json.dumps(log.to_json(), separators=(",", ":")).encode()
-    p.write_bytes(gzip.compress(text, mtime=0) if p.suffix == ".gz" else text)
+    text = json.dumps(checked_log(log).to_json(), separators=(",", ":")).encode()
+    write_bytes(p, gzip.compress(text, mtime=0) if p.suffix == ".gz" else text)
     return p
 
 

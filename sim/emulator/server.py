@@ -8,10 +8,13 @@ Connection messages, requests ``(cmd, args)`` each answered ``("ok", payload)`` 
 from __future__ import annotations
 
 import collections
+import fcntl
 import gc
 import os
 import random
 import select
+import struct
+import termios
 import time
 import tty
 from multiprocessing.connection import Connection
@@ -33,9 +36,10 @@ LOG_MAX = 200_000            # packets kept in the child
 FREEZE_EVERY = 2000
 QUIET_POLL_S = 0.005         # idle wake-up [s]: how fresh ``quiet_at`` stays (see serve)
 DEFAULT_BAUD = 1_000_000     # [bit/s] when neither the pty nor the servos name a rate
+PACKET_DATA = bytes([termios.TIOCPKT_DATA])   # a data read of the master in packet mode
 COUNTER_KEYS = ("rx_bytes", "tx_bytes", "rx_packets", "tx_packets", "rx_bad_checksum",
                 "dropped", "corrupted", "baud_mismatch", "tx_overflow", "cancelled",
-                "late_max_us", "late_over_1ms")
+                "late_max_us", "late_over_1ms", "host_output_flushes")
 
 
 #: Wire protocol codec per bus kind.
@@ -72,6 +76,10 @@ class ChainServer:
         master, slave = os.openpty()
         tty.setraw(slave)
         os.set_blocking(master, False)
+        # Packet mode: each read of the master is a data packet (a 0 byte first) or one
+        # status byte, which tells when the host flushed its output (tcflush TCOFLUSH):
+        # on a pty that discards what the kernel had not yet delivered (docs/third_party.md)
+        fcntl.ioctl(master, termios.TIOCPKT, struct.pack("i", 1))
         self.master: int | None = master
         self.slave: int | None = slave
         self.path = os.ttyname(slave)
@@ -171,11 +179,14 @@ class ChainServer:
         """Read and execute what the host sent (up to 4 kB); False when nothing was there."""
         assert self.master is not None
         try:
-            data = os.read(self.master, 4096)
+            data = os.read(self.master, 4097)
         except OSError:      # EAGAIN, EINTR; EIO: nobody has the slave open
             data = b""
-        if data:
-            self.on_bytes(data, now)
+        if data[:1] == PACKET_DATA:
+            if len(data) > 1:
+                self.on_bytes(data[1:], now)
+        elif data:           # a status byte (packet mode)
+            self.counters["host_output_flushes"] += bool(data[0] & termios.TIOCPKT_FLUSHWRITE)
         return bool(data)
 
     def close_port(self) -> None:

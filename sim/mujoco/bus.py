@@ -31,7 +31,7 @@ from robot.bus.servo_map import ServoMap
 from robot.config.robot import RobotConfig
 from robot.config.world import World
 from robot.errors import BusError
-from sim.mujoco.mjcf import FOOT_GEOMS, build_mjcf, standing_qpos
+from sim.mujoco.mjcf import build_mjcf, foot_geoms, standing_qpos
 from sim.mujoco.observation import BodyObservation
 from sim.mujoco.push_state import body_state
 from sim.mujoco.run_watch import SimRunWatch
@@ -111,7 +111,7 @@ class MujocoBus(BodyObservation, Bus):
         self._law = ChainLaw(model, data, law, self._act, dof, self._qadr)
         self._ground = np.flatnonzero((model.geom_bodyid == 0)
                                       & ((model.geom_contype | model.geom_conaffinity) != 0))
-        self._feet = tuple(model.geom(n).id for n in FOOT_GEOMS)
+        self._feet = foot_geoms(model)
         self._torso = model.body("torso").id
         self._dt = float(model.opt.timestep)
         self._opt = model.opt

@@ -30,8 +30,8 @@ from robot.config.robot_file import load_robot
 from robot.config.world import PUSH_AT_S, PUSH_PHASES
 from robot.gait.engine import GaitEngine
 from robot.loop.streamer import Streamer, Telemetry
-from sim.mujoco.bus import FOOT_GEOMS, MujocoBus
-from sim.mujoco.push_state import sole_corners
+from sim.mujoco.bus import MujocoBus
+from sim.mujoco.geoms import foot_geoms, sole_points
 from sim.mujoco.world import PUSH_WINDOW_S
 
 GRAVITY = 9.81  # [m/s^2]
@@ -97,9 +97,10 @@ def capture_after_push(robot_name: str, direction: str, phase: float,
         root = m.body("torso").id
         com = np.array(d.subtree_com[root])
         vel = np.array(d.subtree_linvel[root])
-        feet = [m.geom(n).id for n in FOOT_GEOMS]
+        feet = foot_geoms(m)
         touching = bus.contacts_feet()
-        corners = [sole_corners(m, d, g) for g, on in zip(feet, touching, strict=True) if on]
+        corners = [np.concatenate([sole_points(m, d, g)[:, :2] for g in foot])
+                   for foot, on in zip(feet, touching, strict=True) if on]
     finally:
         bus.close()
     w0 = math.sqrt(GRAVITY / com[2])

@@ -1,6 +1,6 @@
 """Which feet touch the ground, tick by tick: the gait's flight phase and double support.
 
-A foot is on the ground when its sole geom (``r_foot`` / ``l_foot``, sim.mujoco.mjcf_robot)
+A foot is on the ground when one of its sole geoms (``r_foot`` / ``l_foot``, sim.mujoco.geoms)
 has a contact with a geom outside the robot (the floor, a bump, a stair step). Sampled once
 per control tick while the gait walks, until a fall (the gait's ramp in and out included,
 the ramps to and from the start pose not), so times are multiples of the tick; the time with no foot on the
@@ -12,7 +12,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-FEET = ("r_foot", "l_foot")
+from sim.mujoco.geoms import foot_geoms
 
 
 class FootContacts:
@@ -22,13 +22,14 @@ class FootContacts:
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
         self.data = data
-        self.feet = {mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n) for n in FEET}
-        self._right = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, FEET[0])
-        if min(self.feet) < 0:
-            raise ValueError(f"the model has no foot geoms named {FEET}")
-        #: per geom: a sole, and a part of the robot (anything not on the world body)
-        self._sole = np.zeros(model.ngeom, dtype=bool)
-        self._sole[list(self.feet)] = True
+        right, left = foot_geoms(model)
+        self.feet = set(right) | set(left)
+        #: per geom: which foot's sole (0 none, 1 right, 2 left), and a part of the robot
+        #: (anything not on the world body)
+        self._foot = np.zeros(model.ngeom, dtype=np.int8)
+        self._foot[list(right)] = 1
+        self._foot[list(left)] = 2
+        self._sole = self._foot > 0
         self._robot = np.asarray(model.geom_bodyid) != 0
         self.seconds = [0.0, 0.0, 0.0]     # with 0, 1, 2 feet down [s]
         self.fewest = 2
@@ -41,15 +42,15 @@ class FootContacts:
         # The contact list's columns as arrays (a Python loop over the contacts cost as
         # much as the physics step).
         g1, g2 = self.data.contact.geom1, self.data.contact.geom2
-        soles = np.concatenate((g1[self._sole[g1] & ~self._robot[g2]],
-                                g2[self._sole[g2] & ~self._robot[g1]]))
+        soles = np.concatenate((self._foot[g1[self._sole[g1] & ~self._robot[g2]]],
+                                self._foot[g2[self._sole[g2] & ~self._robot[g1]]]))
         return len(np.unique(soles))
 
     def right_down(self) -> bool:
         """Whether the right sole touches something that is not the robot, now."""
         g1, g2 = self.data.contact.geom1, self.data.contact.geom2
-        return bool(((g1 == self._right) & ~self._robot[g2]).any()
-                    or ((g2 == self._right) & ~self._robot[g1]).any())
+        return bool(((self._foot[g1] == 1) & ~self._robot[g2]).any()
+                    or ((self._foot[g2] == 1) & ~self._robot[g1]).any())
 
     def update(self, t: float) -> None:
         n = self.feet_down()

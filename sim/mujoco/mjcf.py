@@ -1,12 +1,13 @@
 """RobotConfig → MJCF (MuJoCo Menagerie conventions): ``robot.xml`` plus ``scene.xml``.
 
-robot.xml: compiler/option, ``<default>`` classes (one per servo model, nested one per
-joint group carrying axis, joint range and actuator ctrlrange; ``visual`` / ``collision``
-geom classes), the body tree (free joint ``root`` on the ``torso`` body, whose frame is the
-pelvis frame), position actuators named after their joints, IMU sensors, sole and hand
-sites, and a ``home`` keyframe: the robot's rest pose standing with the lowest sole point
-at z = 0. scene.xml includes robot.xml and adds floor, light, skybox and the tracking
-camera ``track``.
+robot.xml: compiler/option, ``<default>`` classes (the robot's; ``visual``, ``collision``
+and the contact classes), the body tree (robot/config/body_tree.py: the box model or the
+imported body, in the robot's terms, written by sim/mujoco/mjcf_body.py; free joint
+``root`` on the ``torso`` body, whose frame is the pelvis frame), position actuators named
+after their joints, IMU sensors, sole and hand sites, and a ``home`` keyframe: the robot's
+rest pose standing with the lowest sole point at z = 0. scene.xml includes robot.xml and
+adds floor, light, skybox and the tracking camera ``track``. Every robot, box model or
+imported, is written the same way, and what ``biped mjcf`` writes is what is simulated.
 
 Servo model (``sim.mujoco.servo_law``, written per joint by
 ``sim.mujoco.mjcf_robot.servo_attributes``): each actuator is the firmware's position law at
@@ -17,7 +18,6 @@ rotor's armature, as with the torque on.
 
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -28,9 +28,13 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 
+from robot.config.body_tree import robot_tree, stand_height
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
-from sim.mujoco.mjcf_robot import add_actuators_and_sensors, add_assets, add_defaults, add_worldbody, fmt
+from robot.files.atomic import write_text
+from sim.mujoco.geoms import foot_geoms, geom_points
+from sim.mujoco.mjcf_body import add_worldbody, has_visuals
+from sim.mujoco.mjcf_robot import add_actuators_and_sensors, add_assets, add_defaults, fmt
 
 if TYPE_CHECKING:
     from sim.mujoco.world import World
@@ -38,7 +42,6 @@ if TYPE_CHECKING:
 ROBOT_FILE = "robot.xml"
 SCENE_FILE = "scene.xml"
 DEFAULT_TIMESTEP = 0.002  # [s]
-FOOT_GEOMS = ("r_foot", "l_foot")
 
 
 @dataclass(frozen=True)
@@ -54,8 +57,8 @@ class Mjcf:
         try:
             out.mkdir(parents=True, exist_ok=True)
             robot_path, scene_path = out / ROBOT_FILE, out / SCENE_FILE
-            robot_path.write_text(self.robot)
-            scene_path.write_text(self.scene)
+            write_text(robot_path, self.robot)
+            write_text(scene_path, self.scene)
         except OSError as e:
             raise ConfigError(f"--out {out}: cannot write MJCF files: {e.strerror}") from e
         return robot_path, scene_path
@@ -78,18 +81,23 @@ def _to_string(root: ET.Element) -> str:
 
 
 def robot_xml(robot: RobotConfig, *, timestep: float = DEFAULT_TIMESTEP,
-              home: npt.NDArray[np.float64] | None = None) -> str:
-    """The robot MJCF; ``home`` (qpos) adds the ``home`` keyframe (ctrl = its joints)."""
+              home: npt.NDArray[np.float64] | None = None,
+              ctrl: npt.NDArray[np.float64] | None = None) -> str:
+    """The robot MJCF; ``home`` (qpos) adds the ``home`` keyframe with ``ctrl`` (default:
+    its joints, in actuator order)."""
+    tree = robot_tree(robot)
     root = ET.Element("mujoco", model=robot.name)
-    ET.SubElement(root, "compiler", angle="radian", autolimits="true")
+    # every link's mass is its own inertial (none from the shapes)
+    ET.SubElement(root, "compiler", angle="radian", autolimits="true", inertiafromgeom="false")
     ET.SubElement(root, "option", timestep=fmt(timestep), integrator="implicitfast")
-    add_defaults(root, robot)
+    add_defaults(root, robot, drawn=not has_visuals(tree))
     add_assets(root)
-    add_worldbody(root, robot)
+    add_worldbody(root, tree, childclass=robot.name, height0=stand_height(robot))
     add_actuators_and_sensors(root, robot)
     if home is not None:
         keyframe = ET.SubElement(root, "keyframe")
-        ET.SubElement(keyframe, "key", name="home", qpos=fmt(*home), ctrl=fmt(*home[7:]))
+        ET.SubElement(keyframe, "key", name="home", qpos=fmt(*home),
+                      ctrl=fmt(*(home[7:] if ctrl is None else ctrl)))
     return _to_string(root)
 
 
@@ -147,7 +155,7 @@ def _joint_qpos(model: mujoco.MjModel, name: str) -> int:
 
 def standing_qpos(model: mujoco.MjModel, pose: Mapping[str, float]) -> npt.NDArray[np.float64]:
     """qpos with the joints at ``pose`` [rad] (missing joints 0), torso upright at x = y = 0
-    and its height [m] chosen so the lowest foot-box point touches z = 0."""
+    and its height [m] chosen so the lowest sole point touches z = 0."""
     data = mujoco.MjData(model)
     qpos = np.zeros(model.nq)
     qpos[3] = 1.0
@@ -155,13 +163,8 @@ def standing_qpos(model: mujoco.MjModel, pose: Mapping[str, float]) -> npt.NDArr
         qpos[_joint_qpos(model, name)] = q
     data.qpos[:] = qpos
     mujoco.mj_kinematics(model, data)
-    lowest = math.inf
-    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
-    for name in FOOT_GEOMS:
-        gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
-        rot = data.geom_xmat[gid].reshape(3, 3)
-        pts = data.geom_xpos[gid] + (corners * model.geom_size[gid]) @ rot.T
-        lowest = min(lowest, float(pts[:, 2].min()))
+    lowest = min(float(geom_points(model, data, g)[:, 2].min())
+                 for foot in foot_geoms(model) for g in foot)
     qpos[2] = -lowest
     return qpos
 
@@ -176,5 +179,6 @@ def build_mjcf(robot: RobotConfig, *, timestep: float | None = None,
     bare = _compile(robot_xml(robot, timestep=dt))
     fixed = {j.name: j.fixed_rad for j in robot.joints if j.fixed_rad is not None}
     home = standing_qpos(bare, {**robot.rest, **fixed})
-    return Mjcf(robot=robot_xml(robot, timestep=dt, home=home),
+    ctrl = home[bare.jnt_qposadr[bare.actuator_trnid[:, 0]]]
+    return Mjcf(robot=robot_xml(robot, timestep=dt, home=home, ctrl=ctrl),
                 scene=scene_xml(robot, world=world))

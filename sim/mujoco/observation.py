@@ -11,6 +11,7 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 
+from sim.mujoco.geoms import sole_points
 from sim.mujoco.view import OffscreenRenderer
 
 
@@ -18,7 +19,7 @@ class BodyObservation:
     """Read-only views of the simulated body (world frame, SI units)."""
 
     _ground: npt.NDArray[np.intp]
-    _feet: tuple[int, ...]
+    _feet: tuple[tuple[int, ...], tuple[int, ...]]  # (right, left) sole geoms
     _renderer: OffscreenRenderer
 
     @property
@@ -49,20 +50,18 @@ class BodyObservation:
         ground = np.isin(pairs, self._ground)
         touching = []
         for foot in self._feet:
-            hit = ((pairs[:, 0] == foot) & ground[:, 1]) | ((pairs[:, 1] == foot) & ground[:, 0])
+            mine = np.isin(pairs, foot)
+            hit = (mine[:, 0] & ground[:, 1]) | (mine[:, 1] & ground[:, 0])
             touching.append(bool(hit.any()))
         return touching[0], touching[1]
 
     def sole_corners(self) -> list[npt.NDArray[np.float64]]:
-        """World corners (4, 3) [m] of the bottom face of each foot box that touches the
-        ground (as of the last step): the support polygon's points."""
+        """World points (n, 3) [m] of the sole of each foot that touches the ground (as of
+        the last step; a box's four bottom corners): the support polygon's points."""
         out = []
         for foot, on in zip(self._feet, self.contacts_feet(), strict=True):
             if on:
-                sx, sy, sz = self.model.geom_size[foot]
-                local = np.array([[x, y, -sz] for x in (-sx, sx) for y in (-sy, sy)])
-                out.append(self.data.geom_xpos[foot] + local @ self.data.geom_xmat[foot]
-                           .reshape(3, 3).T)
+                out.append(np.concatenate([sole_points(self.model, self.data, g) for g in foot]))
         return out
 
     def render(self, width: int, height: int, camera: str = "track") -> npt.NDArray[np.uint8]:

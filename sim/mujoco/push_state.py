@@ -1,11 +1,11 @@
 """The body's state at the moment of a push, as the capture limit needs it
 (robot.balance.capture_limit): the whole robot's centre of mass, its velocity, its height
 over the ground, the mass, and per foot whether it touches the ground, where its ankle
-and hip are and the corners of its sole.
+and hip are and the points of its sole geoms (a box's corners).
 
 Everything is in the torso's heading frame (its yaw only: x forward, y left, as the push
 itself), horizontal, relative to the centre of mass's ground point; the height is over
-the lowest sole corner of the feet on the ground (of both feet when none is down);
+the lowest sole point of the feet on the ground (of both feet when none is down);
 ``push_above_com_m``: how far above the whole robot's centre of mass the push acts (the
 torso's own centre of mass, where the simulation applies it).
 Read from MuJoCo (``mj_subtreeVel`` for the velocity), JSON-ready.
@@ -19,17 +19,25 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from sim.mujoco.geoms import foot_geoms, geom_points
 from sim.mujoco.metrics import yaw_of
-from sim.mujoco.mjcf import FOOT_GEOMS
 
 SIDES = ("r", "l")
 
 
-def sole_corners(model: mujoco.MjModel, data: mujoco.MjData, geom: int) -> np.ndarray:
-    """The world corners (4, 3) [m] of a box sole's bottom face."""
-    sx, sy, sz = model.geom_size[geom]
-    local = np.array([[x, y, -sz] for x in (-sx, sx) for y in (-sy, sy)])
-    return data.geom_xpos[geom] + local @ data.geom_xmat[geom].reshape(3, 3).T
+def sole(model: mujoco.MjModel, data: mujoco.MjData, geoms: tuple[int, ...]) -> np.ndarray:
+    """A foot's points in the world (n, 3) [m]: every point of its sole geoms
+    (sim.mujoco.geoms.geom_points: a box's corners, a mesh's vertices), whose plan is the
+    foot's print on the ground however it is tilted."""
+    return np.concatenate([geom_points(model, data, g) for g in geoms])
+
+
+def _anchor(model: mujoco.MjModel, data: mujoco.MjData, names: tuple[str, ...]) -> np.ndarray:
+    """The world point of the first of the joints ``names`` the model has."""
+    for name in names:
+        if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) >= 0:
+            return np.asarray(data.xanchor[model.joint(name).id])
+    raise ValueError(f"the model has none of the joints {', '.join(names)}")
 
 
 def body_state(model: mujoco.MjModel, data: mujoco.MjData,
@@ -46,18 +54,17 @@ def body_state(model: mujoco.MjModel, data: mujoco.MjData,
     def local(p: np.ndarray) -> list[float]:
         x, y = rot @ (np.asarray(p[:2]) - com[:2])
         return [float(x), float(y)]
-    feet, lowest = [], []
-    for side, geom_name, down in zip(SIDES, FOOT_GEOMS, touching, strict=True):
-        corners = sole_corners(model, data, model.geom(geom_name).id)
+    feet, lowest, soles = [], [], []
+    for side, geoms, down in zip(SIDES, foot_geoms(model), touching, strict=True):
+        points = sole(model, data, geoms)
+        soles.append(float(points[:, 2].min()))
         if down:
-            lowest.append(float(corners[:, 2].min()))
-        feet.append({"down": bool(down),
-                     "ankle": local(data.xanchor[model.joint(f"{side}_ankle_pitch").id]),
-                     "hip": local(data.xanchor[model.joint(f"{side}_hip_roll").id]),
-                     "sole": [local(p) for p in corners]})
-    if not lowest:
-        lowest = [float(min(sole_corners(model, data, model.geom(n).id)[:, 2].min()
-                            for n in FOOT_GEOMS))]
+            lowest.append(soles[-1])
+        ankle = _anchor(model, data, (f"{side}_ankle_pitch", f"{side}_ankle_roll"))
+        hip = _anchor(model, data, (f"{side}_hip_roll", f"{side}_hip_pitch"))
+        feet.append({"down": bool(down), "ankle": local(ankle), "hip": local(hip),
+                     "sole": [local(p) for p in points]})
+    lowest = lowest or soles
     v = rot @ vel[:2]
     torso = float(data.xipos[root][2])        # the push's point: the torso's own centre
     return {"com_height_m": float(com[2] - min(lowest)),

@@ -16,7 +16,7 @@ from robot.bench.stops import STOP_HEADING_DEG, stop_walk
 from robot.bench.variants import write_five_dof
 from robot.config.gait_file import load_gait
 from robot.config.robot_file import load_robot
-from robot.gait.engine import GaitEngine
+from robot.gait.engine import ENVELOPE_MIN_RATE, GaitEngine
 from robot.gait.stop_close import CLOSE_SHARE, ramp_out, swing_share
 from robot.gait.targets import BodyTrim
 from sim.mujoco.metrics import WalkMonitor
@@ -33,15 +33,18 @@ def test_a_foot_is_up_for_its_share_of_the_cycle() -> None:
 
 
 def test_the_ramp_out_finishes_the_swing_then_closes_within_the_next() -> None:
-    stage, ramp = ramp_out(None, 1.0, DT, True, WALK)           # told to stop mid-swing
+    stage, ramp = ramp_out(None, 1.0, DT, True, WALK, least=0.0)           # told to stop mid-swing
     assert (stage, ramp) == ("finish", 1.0)
-    stage, ramp = ramp_out(stage, ramp, DT, False, WALK)        # it lands
+    stage, ramp = ramp_out(stage, ramp, DT, False, WALK, least=0.0)   # it lands
     assert (stage, ramp) == ("close", 1.0)
-    assert ramp_out(stage, ramp, DT, False, WALK) == ("close", 1.0)   # both feet down: holds
+    assert ramp_out(stage, ramp, DT, False, WALK, least=0.0) == ("close", 1.0)  # holds
     swing = CLOSE_SHARE * swing_share(WALK) * WALK.cycle_s
-    stage, ramp = ramp_out(stage, ramp, DT, True, WALK)         # the next foot lifts
+    stage, ramp = ramp_out(stage, ramp, DT, True, WALK, least=0.0)  # the next one lifts
     assert ramp == pytest.approx(1.0 - DT / swing)
-    assert ramp_out(None, 0.5, DT, False, WALK) == ("close", 0.5)    # told in double support
+    assert ramp_out(None, 0.5, DT, False, WALK, least=0.0) == ("close", 0.5)  # both down
+    # The least fall: a stop whose feet never lift again still ends.
+    assert ramp_out("close", 0.5, DT, False, WALK, least=0.01) == ("close", 0.49)
+    assert ramp_out("finish", 0.5, DT, True, WALK, least=0.01)[1] == 0.49
 
 
 def test_the_engine_stops_on_both_feet_within_one_swing_after_the_one_in_progress() -> None:
@@ -63,15 +66,36 @@ def test_the_engine_stops_on_both_feet_within_one_swing_after_the_one_in_progres
     runs = [s for i, s in enumerate(swings) if i == 0 or s != swings[i - 1]]
     assert runs[:3] == ["R", "-", "L"]           # the right swing lands, then the left closes
     first_left = swings.index("L")
-    assert all(a == 1.0 for a in amps[:first_left])    # full stride until the close begins
-    # While both feet are down the envelope holds.
-    for i in range(1, len(amps)):
-        if swings[i] == "-" and swings[i - 1] == "-":
-            assert amps[i] == amps[i - 1]
+    # Full stride until the close begins but for the engine's slowest ramp-out: at
+    # ENVELOPE_MIN_RATE of its rate the ramp variable falls by under 0.07 over those ticks
+    # (smoothstep: the amplitude by under 0.015).
+    least = ENVELOPE_MIN_RATE * DT / (WALK.ramp_cycles * WALK.cycle_s)
+    assert all(a >= 0.985 for a in amps[:first_left])
+    assert amps[first_left - 1] == pytest.approx(
+        1.0 - 3 * (first_left * least) ** 2 + 2 * (first_left * least) ** 3, abs=1e-9)
     # It reaches 0 inside the left swing: within CLOSE_SHARE of one swing's time.
     closing = len(amps) - first_left
     assert closing * DT <= swing_share(WALK) * WALK.cycle_s + DT
     assert e.pose() == pytest.approx(e.start_pose())     # feet side by side, both down
+
+
+def test_a_stop_held_braced_with_both_feet_down_still_ends() -> None:
+    """A robot lying braced on the ground (the phase held, no foot lifts again): the
+    envelope falls at the engine's slowest rate, ENVELOPE_MIN_RATE of its own, and the
+    stop ends within ramp_cycles / ENVELOPE_MIN_RATE cycles."""
+    e = GaitEngine(load_robot("biped18-dynamixel"), WALK)
+    e.start()
+    for _ in range(int(round(5.0 * WALK.cycle_s / DT))):       # double support at 5 cycles
+        e.tick(DT)
+    assert e.lift == (0.0, 0.0)
+    e.trim = BodyTrim(close=1.0, tempo=-1.0, land=1.0)
+    e.stop()
+    n = 0
+    while not e.stopped:
+        e.tick(DT)
+        n += 1
+        assert n * DT <= WALK.ramp_cycles * WALK.cycle_s / ENVELOPE_MIN_RATE + DT
+    assert e.lift == (0.0, 0.0)
 
 
 def test_the_stops_heading_is_measured_from_the_heading_the_walk_walked() -> None:

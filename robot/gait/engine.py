@@ -268,8 +268,9 @@ class GaitEngine:
         if self._running:
             self._ramp = min(1.0, self._ramp + step)
         elif self.trim.close > 0.5:      # a stop that finishes its step (a feedback's)
-            lifted = self.lift != (0.0, 0.0)
-            self._stop, self._ramp = ramp_out(self._stop, self._ramp, gait_dt, lifted, p)
+            least = ENVELOPE_MIN_RATE * step * dt / gait_dt if gait_dt > 0 else step
+            self._stop, self._ramp = ramp_out(self._stop, self._ramp, gait_dt,
+                                              self.lift != (0.0, 0.0), p, least=least)
         else:
             self._ramp = max(0.0, self._ramp - step)
         if self._ramp > 0.0:

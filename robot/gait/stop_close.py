@@ -6,7 +6,9 @@ A walk told to stop keeps its full stride until the swing in progress lands ("fi
 then, in the next swing ("close"), the envelope falls from where it is to 0 within that
 one swing: the foot in the air comes down beside the standing one and the walk ends on
 both feet, side by side. While both feet are down the envelope holds (a stride changed
-under two planted feet scrubs them and turns the body). Measured on the bundled robots
+under two planted feet scrubs them and turns the body), but for the engine's slowest
+ramp-out (ENVELOPE_MIN_RATE of its rate over ``ramp_cycles``: about 0.01 of the stride in
+a double support), which ends a stop whose feet never lift again. Measured on the bundled robots
 (docs/gait.md, "A stop that finishes its step"): the stride shrinking over three cycles
 turned them by up to 2.1-5.8 deg by where in the step the stop came; the small last steps
 drag the feet.
@@ -31,17 +33,19 @@ def swing_share(p: GaitParams) -> float:
 
 
 def ramp_out(stage: str | None, ramp: float, gait_dt: float, lifted: bool,
-             p: GaitParams) -> tuple[str, float]:
+             p: GaitParams, *, least: float) -> tuple[str, float]:
     """One tick of a closing stop: the stage ("finish" while the swing in progress at the
     stop lands, then "close") and the envelope's ramp variable after ``gait_dt`` [s of
     gait time]; ``lifted``: a foot is in the air now; ``stage`` None on the stop's first
-    tick."""
+    tick. ``least``: what the ramp falls by in any case (the engine's slowest ramp-out, so
+    that a stop whose feet never lift again, a robot held braced on the ground, still
+    ends)."""
     if stage is None:
         stage = "finish" if lifted else "close"
     if stage == "finish":
-        return ("finish" if lifted else "close"), ramp
+        return ("finish" if lifted else "close"), max(0.0, ramp - least)
     if not lifted:
-        return stage, ramp
+        return stage, max(0.0, ramp - least)
     swing = CLOSE_SHARE * swing_share(p) * p.cycle_s
     step = 1.0 if not math.isfinite(swing) or swing <= 0.0 else gait_dt / swing
-    return stage, max(0.0, ramp - step)
+    return stage, max(0.0, ramp - max(step, least))

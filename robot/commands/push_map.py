@@ -15,6 +15,7 @@ from pathlib import Path
 from robot.config.gait_file import Gait
 from robot.config.params import GaitParams
 from robot.config.world import PUSH_AT_S
+from robot.previs.figure_file import save_figure
 from robot.tuning.push_map import (
     DIRECTIONS_DEG,
     PHASES,
@@ -174,5 +175,5 @@ def plot_map(cells: Sequence[Cell], out: str | Path, *, title: str) -> None:
     fig.suptitle(f"{title}: survived push [N*s] (solid: balance, dotted: open loop) and "
                  "the 1-step capture limit (dashed)", fontsize=10)
     fig.subplots_adjust(left=0.03, right=0.97, top=0.84, bottom=0.2, wspace=0.35)
-    fig.savefig(out, dpi=80)
+    save_figure(fig, out, dpi=80)
     plt.close(fig)

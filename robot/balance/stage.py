@@ -29,6 +29,7 @@ from robot.balance.law import (
     balance_step,
     commanded_yaw_rate,
 )
+from robot.config.params import GaitParams
 from robot.gait.targets import NO_TRIM, BodyTrim
 from robot.imu.base import Imu
 from robot.imu.tilt import TiltEstimator, tilt_from_quat, wrap
@@ -108,6 +109,8 @@ class Balance:
         self._plan_before: tuple[tuple[float, ...], tuple[float, ...]] | None = None
         self._trim_before: BodyTrim | None = None
         self._w: float | None = None
+        self._phase_p: GaitParams | None = None    # the parameters _height, _inward are for
+        self._height = self._inward = 0.0
         self.state = BalanceState()
         self.last = Correction()
         self._theta = 0.0
@@ -127,16 +130,18 @@ class Balance:
     def gait_phase(self) -> GaitPhase:
         """What the law needs from the engine at this tick."""
         e = self.engine
-        p, g = e.live_params, e.robot.geometry
+        p = e.live_params
+        if p is not self._phase_p:    # the pendulum's height and the feet's room, per set
+            g = e.robot.geometry
+            gap = g.hip_width + 2.0 * p.foot_spread - g.foot_width
+            self._phase_p, self._height = p, p.stance * g.leg_length + g.ankle_height
+            self._inward = max(0.0, 0.5 * (gap - FOOT_GAP_M))
         theta = float(e.phase.theta)
         dtheta = theta - self._theta
         self._theta = theta
-        gap = g.hip_width + 2.0 * p.foot_spread - g.foot_width
-        return GaitPhase(theta=theta, dtheta=dtheta if math.isfinite(dtheta) else 0.0,
-                         amplitude=e.amplitude,
-                         swinging=(e.lift[0] > 0.0, e.lift[1] > 0.0),
-                         height=p.stance * g.leg_length + g.ankle_height,
-                         inward=max(0.0, 0.5 * (gap - FOOT_GAP_M)))
+        lift = e.lift
+        return GaitPhase(theta, dtheta if math.isfinite(dtheta) else 0.0, e.amplitude,
+                         (lift[0] > 0.0, lift[1] > 0.0), self._height, self._inward)
 
     def held(self, q: np.ndarray, dt: float) -> np.ndarray:
         """The joint angles [rad] the servos hold now, as known: the last command plus
@@ -190,11 +195,11 @@ class Balance:
         else:       # switched on later (the panel), it starts afresh: no stale last tick
             self._before = self._plan_before = self._trim_before = self._w = None
         self.state, corr = balance_step(self.state, tilt, p, dt, gait, kin)
+        r_dx, r_dy, l_dx, l_dy = corr.feet
         r_roll, r_pitch, l_roll, l_pitch = corr.level
-        self.engine.trim = BodyTrim(corr.pelvis_roll, corr.pelvis_pitch, *corr.feet,
-                                    turn=corr.turn, tempo=corr.tempo, land=corr.land,
-                                    r_roll=r_roll, r_pitch=r_pitch, l_roll=l_roll,
-                                    l_pitch=l_pitch)
+        self.engine.trim = BodyTrim(corr.pelvis_roll, corr.pelvis_pitch, r_dx, r_dy, l_dx, l_dy,
+                                    corr.turn, corr.tempo, corr.land, r_roll, r_pitch, l_roll,
+                                    l_pitch)
         self.last = corr
         out = apply(q, corr, self.slots)
         self._sent = out
@@ -219,6 +224,5 @@ def attitude_reader(imu: Imu, *, tau_s: float | None = None) -> Callable[[], Att
         else:
             roll, pitch = estimator.update(s)
             heading = None
-        return Attitude(roll=roll, pitch=pitch, roll_rate=gx, pitch_rate=gy, yaw_rate=gz,
-                        heading=heading)
+        return Attitude(roll, pitch, gx, gy, gz, heading)
     return read

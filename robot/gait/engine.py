@@ -39,12 +39,12 @@ __all__ = ["PARAM_TAU_S", "PRESET_BLEND_S", "STEER_BUDGET", "STEER_RATE", "GaitE
 ENVELOPE_MIN_RATE = 0.25
 
 
+_PLAIN_TYPES = frozenset({float, int})
+
+
 def _plain(values: tuple[Num, ...]) -> bool:
-    """Every value a Python float or int (not a numpy scalar or array)."""
-    for v in values:
-        if type(v) is not float and type(v) is not int:
-            return False
-    return True
+    """Every value a Python float or int (not a numpy scalar or array, nor a bool)."""
+    return _PLAIN_TYPES.issuperset(map(type, values))
 
 
 def _smoothstep(x: float) -> float:

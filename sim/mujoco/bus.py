@@ -105,6 +105,10 @@ class MujocoBus(BodyObservation, Bus):
         names = self.robot.joint_names
         self._qadr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names])
         self._act = np.array([model.actuator(n).id for n in names])
+        # ctrl[_ctrl_idx] is ctrl[_act]: a slice when the actuators are the joints in order
+        self._ctrl = data.ctrl
+        self._ctrl_idx: slice | npt.NDArray[np.int64] = (
+            slice(None) if self._act.tolist() == list(range(model.nu)) else self._act)
         dof = np.array([model.jnt_dofadr[model.joint(n).id] for n in names])
         law = robot_servos(self.robot)
         self._law = ChainLaw(model, data, law, self._act, dof, self._qadr)
@@ -244,19 +248,24 @@ class MujocoBus(BodyObservation, Bus):
         if needed), applying delayed goals when they fall due; with realtime, then wait for
         the wall clock. No-op if already past."""
         d = self.data
-        t0 = float(d.time)
+        t0 = d.time
         if deadline <= t0:
             return
-        self._law.tick(self._servos.setpoint, deadline - t0)
-        while (event := self._next_event()) < deadline - _TIME_EPS:
-            if event > d.time:
-                self._physics_to(event)
-                d.time = event
-            self._events_due(event)
+        servos, forces = self._servos, self._forces
+        self._law.tick(servos.setpoint, deadline - t0)
+        events = servos.pending or forces.active   # delayed goals, pushes in progress
+        if events:
+            while (event := self._next_event()) < deadline - _TIME_EPS:
+                if event > d.time:
+                    self._physics_to(event)
+                    d.time = event
+                self._events_due(event)
         self._physics_to(deadline)
         d.time = deadline
-        self._events_due(deadline)
-        self._servos.elapse(d.actuator_force[self._act], deadline - t0)
+        if events:
+            self._events_due(deadline)
+        if servos.add_time(deadline - t0):    # the thermal and saturation bookkeeping
+            servos.flush(d.actuator_force[self._act])
         if self.realtime:
             self._pacer.wait(deadline)
         if self._viewer is not None:
@@ -287,14 +296,16 @@ class MujocoBus(BodyObservation, Bus):
         """Physics steps up to ``stop`` [s]: the setpoints slew before each step until they
         are settled, then the remaining whole steps run in one call, then one short step."""
         m, d, opt, servos, dt = self.model, self.data, self._opt, self._servos, self._dt
+        ctrl, act, law = self._ctrl, self._ctrl_idx, self._law
+        step = mujoco.mj_step
         while (remaining := stop - d.time) > _TIME_EPS:
             if not servos.settled:
-                d.ctrl[self._act] = self._law.ctrl(servos.slew(min(dt, remaining)))
+                ctrl[act] = law.ctrl(servos.slew(dt if dt < remaining else remaining))
             if remaining < dt:
                 opt.timestep = remaining
                 try:
-                    mujoco.mj_step(m, d)
+                    step(m, d)
                 finally:
                     opt.timestep = dt
             else:
-                mujoco.mj_step(m, d, int(remaining / dt + 1e-6) if servos.settled else 1)
+                step(m, d, int(remaining / dt + 1e-6) if servos.settled else 1)

@@ -114,14 +114,14 @@ class SimImu(Imu):
     def exact(self) -> ImuSample:
         """The noise-free, bias-free measurement of the present state, in the torso frame
         (for tests and metrics; the robot should use ``read``)."""
-        if self._adr is None:
+        a = self._adr
+        if a is None:
             raise ImuError("sim imu: not open; call open() (or use `with`) first")
         d = self.bus.data
-        s = d.sensordata
-        a = self._adr
-        quat = tuple(s[a["quat"]:a["quat"] + 4].tolist())
-        return ImuSample(float(d.time), _vec(s, a["gyro"]), _vec(s, a["accel"]),
-                         quat if self.config.fusion else None)  # type: ignore[arg-type]
+        s = d.sensordata.tolist()
+        g, c, q = a["gyro"], a["accel"], a["quat"]
+        return ImuSample(d.time, (s[g], s[g + 1], s[g + 2]), (s[c], s[c + 1], s[c + 2]),
+                         (s[q], s[q + 1], s[q + 2], s[q + 3]) if self.config.fusion else None)
 
     def read(self) -> ImuSample:
         """The newest sample at least ``latency_ms`` old (module docstring), torso frame."""
@@ -191,11 +191,6 @@ def _noisy(v: tuple[float, float, float], bias: tuple[float, float, float], sigm
     """(v + bias) + sigma * z, per axis (the order numpy's normal(0, sigma) adds in)."""
     return (v[0] + bias[0] + sigma * z[0], v[1] + bias[1] + sigma * z[1],
             v[2] + bias[2] + sigma * z[2])
-
-
-def _vec(s: Any, i: int) -> tuple[float, float, float]:
-    x, y, z = s[i:i + 3].tolist()
-    return (x, y, z)
 
 
 def _tuple3(v: Any) -> tuple[float, float, float]:

@@ -112,6 +112,11 @@ class SimServos:
             self.goal[idx] = q
         self.settled = False
 
+    @property
+    def pending(self) -> bool:
+        """Delayed goals are waiting (``latency_s`` > 0)."""
+        return bool(self._pending)
+
     def next_due(self) -> float:
         """Sim time [s] at which the next delayed goal takes effect (inf if none)."""
         return self._pending[0][0] if self._pending else math.inf
@@ -130,12 +135,14 @@ class SimServos:
         if dt != self._vmax_dt:
             self._vmax_dt, self._vmax = dt, self.max_speed * dt
         vmax = self._vmax
-        error = self.goal - self.setpoint
-        within = np.abs(error) <= vmax
-        if within.all():         # the usual tick: every setpoint reaches its goal
+        distance = self.goal - self.setpoint
+        np.abs(distance, out=distance)
+        if np.less_equal(distance, vmax).all():  # the usual tick: every setpoint reaches its goal
             self.setpoint = self.goal.copy()
             self.settled = True
             return self.setpoint
+        error = self.goal - self.setpoint
+        within = np.abs(error) <= vmax
         self.setpoint = np.where(within, self.goal, self.setpoint + np.sign(error) * vmax)
         self.settled = bool(np.all((self.setpoint == self.goal) | ~self.enabled))
         return self.setpoint
@@ -151,12 +158,11 @@ class SimServos:
 
     # ------------------------------------------------------------------ thermal, load
 
-    def elapse(self, force: Floats, span: float) -> None:
-        """``span`` [s] of simulation passed with the actuators at ``force`` [N m] now;
-        the bookkeeping runs once ACCOUNT_PERIOD_S has accumulated (``flush`` forces it)."""
+    def add_time(self, span: float) -> bool:
+        """``span`` [s] of simulation passed: True once ACCOUNT_PERIOD_S has accumulated
+        and the bookkeeping is due (then ``flush`` with the actuators' force now)."""
         self._unaccounted_s += span
-        if self._unaccounted_s >= ACCOUNT_PERIOD_S - _TIME_EPS:
-            self.flush(force)
+        return self._unaccounted_s >= ACCOUNT_PERIOD_S - _TIME_EPS
 
     def flush(self, force: Floats) -> None:
         """Account the time elapsed since the last bookkeeping at ``force`` [N m]."""

@@ -90,6 +90,11 @@ class TimedForces:
         self._count += 1
         heapq.heappush(self._heap, (end_s, self._count, force))
 
+    @property
+    def active(self) -> bool:
+        """A force is on (until ``next_end()``)."""
+        return bool(self._heap)
+
     def next_end(self) -> float:
         """Sim time [s] at which the next force ends (inf if none)."""
         return self._heap[0][0] if self._heap else math.inf

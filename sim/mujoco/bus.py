@@ -18,7 +18,6 @@ constant, then one shorter step to land on ``t``).
 from __future__ import annotations
 
 import logging
-import math
 from collections.abc import Iterable, Mapping
 from typing import Any
 
@@ -37,7 +36,7 @@ from sim.mujoco.run_watch import SimRunWatch
 from sim.mujoco.servo_law import ChainLaw, robot_servos
 from sim.mujoco.servos import AMBIENT_C, SimServos
 from sim.mujoco.view import OffscreenRenderer, SimClock, WallPacer, check_display, launch_viewer
-from sim.mujoco.world import PUSH_WINDOW_S, TimedForces
+from sim.mujoco.world import PUSH_WINDOW_S, TimedForces, heading_force
 from sim.mujoco.world_scene import apply_world_to_model, place_on_floor
 
 __all__ = ["AMBIENT_C", "MujocoBus", "SimClock"]
@@ -105,10 +104,7 @@ class MujocoBus(BodyObservation, Bus):
         names = self.robot.joint_names
         self._qadr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names])
         self._act = np.array([model.actuator(n).id for n in names])
-        # ctrl[_ctrl_idx] is ctrl[_act]: a slice when the actuators are the joints in order
-        self._ctrl = data.ctrl
-        self._ctrl_idx: slice | npt.NDArray[np.int64] = (
-            slice(None) if self._act.tolist() == list(range(model.nu)) else self._act)
+        self._ctrl = data.ctrl   # a view of the actuators' controls
         dof = np.array([model.jnt_dofadr[model.joint(n).id] for n in names])
         law = robot_servos(self.robot)
         self._law = ChainLaw(model, data, law, self._act, dof, self._qadr)
@@ -251,18 +247,16 @@ class MujocoBus(BodyObservation, Bus):
         t0 = d.time
         if deadline <= t0:
             return
-        servos, forces = self._servos, self._forces
+        servos = self._servos
         self._law.tick(servos.setpoint, deadline - t0)
-        events = servos.pending or forces.active   # delayed goals, pushes in progress
-        if events:
-            while (event := self._next_event()) < deadline - _TIME_EPS:
-                if event > d.time:
-                    self._physics_to(event)
-                    d.time = event
-                self._events_due(event)
+        while (event := self._next_event()) < deadline - _TIME_EPS:
+            if event > d.time:
+                self._physics_to(event)
+                d.time = event
+            self._events_due(event)
         self._physics_to(deadline)
         d.time = deadline
-        if events:
+        if servos.pending or self._forces.active:   # delayed goals, pushes in progress
             self._events_due(deadline)
         if servos.add_time(deadline - t0):    # the thermal and saturation bookkeeping
             servos.flush(d.actuator_force[self._act])
@@ -286,26 +280,21 @@ class MujocoBus(BodyObservation, Bus):
         if not window_s > 0:
             raise BusError(f"sim bus: push window must be > 0 s, got {window_s}")
         d = self.data
-        w, x, y, z = d.qpos[3:7].tolist()
-        yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-        c, s = math.cos(yaw), math.sin(yaw)
-        force = np.array([c * jx - s * jy, s * jx + c * jy, 0.0]) / window_s
+        force = heading_force(d.qpos[3:7].tolist(), jx, jy) / window_s
         self._forces.start(d.time + window_s, force, d.xfrc_applied[self._torso])
 
     def _physics_to(self, stop: float) -> None:
         """Physics steps up to ``stop`` [s]: the setpoints slew before each step until they
         are settled, then the remaining whole steps run in one call, then one short step."""
-        m, d, opt, servos, dt = self.model, self.data, self._opt, self._servos, self._dt
-        ctrl, act, law = self._ctrl, self._ctrl_idx, self._law
-        step = mujoco.mj_step
+        m, d, opt, servos, dt, law = self.model, self.data, self._opt, self._servos, self._dt, self._law
         while (remaining := stop - d.time) > _TIME_EPS:
             if not servos.settled:
-                ctrl[act] = law.ctrl(servos.slew(dt if dt < remaining else remaining))
+                self._ctrl[self._act] = law.ctrl(servos.slew(dt if dt < remaining else remaining))
             if remaining < dt:
                 opt.timestep = remaining
                 try:
-                    step(m, d)
+                    mujoco.mj_step(m, d)
                 finally:
                     opt.timestep = dt
             else:
-                step(m, d, int(remaining / dt + 1e-6) if servos.settled else 1)
+                mujoco.mj_step(m, d, int(remaining / dt + 1e-6) if servos.settled else 1)

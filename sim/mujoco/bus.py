@@ -44,8 +44,6 @@ __all__ = ["AMBIENT_C", "MujocoBus", "SimClock"]
 log = logging.getLogger(__name__)
 
 _TIME_EPS = 1e-9  # [s]
-_OVERLOAD = frozenset({"overload"})
-_NO_ERRORS: frozenset[str] = frozenset()
 
 
 class MujocoBus(BodyObservation, Bus):
@@ -212,21 +210,16 @@ class MujocoBus(BodyObservation, Bus):
             idx = np.array(self._indices(goals))
         servos.write(idx, servos.to_rad(goals, idx), d.time)
 
+    def write_joint_goals(self, servo_map: ServoMap, q: npt.NDArray[np.float64]) -> None:
+        if servo_map.ids != self.servo_map.ids:
+            return super().write_joint_goals(servo_map, q)
+        self._servos.write_ticks(servo_map.tick_vector(q), self.data.time)
+
     def read_state(self, ids: Iterable[int]) -> dict[int, ServoState]:
         idx = self._indices(ids)
-        servos = self._servos
-        force = self.data.actuator_force[self._act]
-        servos.flush(force)
-        ticks = self.present_ticks().tolist()
-        load = servos.load_percent(force).tolist()
-        temperature = servos.temperature.tolist()
-        overloaded = servos.overloaded().tolist()
         volts = self.robot.voltage(self.robot.joints[0])   # one supply for the bus
-        sids = self.servo_map.ids
-        return {sids[i]: ServoState(id=sids[i], position=ticks[i], load=load[i],
-                                    temperature=temperature[i], voltage=volts,
-                                    errors=_OVERLOAD if overloaded[i] else _NO_ERRORS)
-                for i in idx}
+        return self._servos.states(idx, self.present_ticks().tolist(),
+                                   self.data.actuator_force[self._act], volts)
 
     # ------------------------------------------------------------------ simulation
 

@@ -31,6 +31,7 @@ from collections.abc import Mapping
 import numpy as np
 import numpy.typing as npt
 
+from robot.bus.base import ServoState
 from robot.bus.servo_map import ServoMap
 
 AMBIENT_C = 25.0  # [°C]
@@ -41,6 +42,8 @@ SATURATED_RATIO = 0.999  # |force| / stall torque at or above this counts as sat
 #: Thermal and saturation bookkeeping period [s of sim time]: 2 % of OVERLOAD_AFTER_S.
 ACCOUNT_PERIOD_S = 0.02
 _TIME_EPS = 1e-9  # [s]
+_OVERLOAD = frozenset({"overload"})
+_NO_ERRORS: frozenset[str] = frozenset()
 
 Floats = npt.NDArray[np.float64]
 
@@ -81,6 +84,10 @@ class SimServos:
 
     def to_rad(self, goals: Mapping[int, int], idx: npt.NDArray[np.intp]) -> Floats:
         """Goal ticks (values of ``goals``, for joints ``idx``) → radians in the limits."""
+        return self._rad(np.fromiter(goals.values(), float, len(idx)), idx)
+
+    def _rad(self, q: Floats, idx: npt.NDArray[np.intp]) -> Floats:
+        """Ticks ``q`` of joints ``idx`` → radians in the limits, in place."""
         sm = self.map
         if idx is self._all:
             zero, per_rad, lo, hi = sm.zero, self._signed_tpr, sm.q_min, sm.q_max
@@ -88,11 +95,15 @@ class SimServos:
             zero, per_rad = sm.zero[idx], self._signed_tpr[idx]
             lo, hi = sm.q_min[idx], sm.q_max[idx]
         # (t - zero) / (sign * ticks_per_rad): bit-identical to * sign / ticks_per_rad.
-        q = np.fromiter(goals.values(), float, len(idx))
         q -= zero
         q /= per_rad
         np.maximum(q, lo, out=q)
         return np.minimum(q, hi, out=q)
+
+    def write_ticks(self, ticks: Floats, now: float) -> None:
+        """Goal ticks of every joint in joint order (whole numbers as floats; the array is
+        used up), written at sim time ``now`` [s]: ``write`` of their radians."""
+        self.write(self._all, self._rad(ticks, self._all), now)
 
     def index_all(self, goals: Mapping[int, int]) -> npt.NDArray[np.intp] | None:
         """All joints' indices if ``goals`` names every servo in joint order, else None."""
@@ -191,6 +202,20 @@ class SimServos:
         ratio += AMBIENT_C * decay
         self.temperature *= 1.0 - decay
         self.temperature += ratio
+
+    def states(self, idx: list[int], ticks: list[int], force: Floats, volts: float
+               ) -> dict[int, ServoState]:
+        """The read-back of joints ``idx`` (the bookkeeping flushed first) at present
+        positions ``ticks`` (all joints) [ticks], actuator ``force`` [N m], supply [V]."""
+        self.flush(force)
+        load = self.load_percent(force).tolist()
+        temperature = self.temperature.tolist()
+        overloaded = self.overloaded().tolist()
+        sids = self._ids
+        return {sids[i]: ServoState(id=sids[i], position=ticks[i], load=load[i],
+                                    temperature=temperature[i], voltage=volts,
+                                    errors=_OVERLOAD if overloaded[i] else _NO_ERRORS)
+                for i in idx}
 
     def load_percent(self, force: Floats) -> Floats:
         """Load [%] of stall torque, signed in each servo's direction."""

@@ -89,10 +89,10 @@ class ServoMap:
         floats (numpy's rint rounds half to even, as ``round``); NaN raises BipedError
         naming the joint."""
         t = self.zero + self._gain * q
-        nan = t != t
-        if nan.any():
-            self._nan(int(np.flatnonzero(nan)[0]))
         ticks: npt.NDArray[np.float64] = np.rint(t.clip(self._tick_lo, self._tick_hi))
+        total = np.add.reduce(ticks)     # finite unless a tick is NaN (the rest are clamped)
+        if total != total:
+            self._nan(int(np.flatnonzero(t != t)[0]))
         return ticks
 
     def from_positions(self, positions: Mapping[int, int]) -> npt.NDArray[np.float64]:

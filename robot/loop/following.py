@@ -73,7 +73,7 @@ class FollowCheck:
         r_goal = np.ptp(self._goal, axis=0)
         r_present = np.ptp(self._present, axis=0)
         stuck = (r_goal >= self.travel) & (r_present <= FROZEN_SHARE * r_goal)
-        if not stuck.any():
+        if not np.logical_or.reduce(stuck):
             return None
         i = int(np.argmax(stuck))
         return i, float(r_goal[i]), float(r_present[i])

@@ -242,7 +242,7 @@ class Streamer(Generic[SourceT]):
         limited = self.map.clamp(q)
         own = limited != q
         clamped = (tuple(self.map.names[i] for i in sorted({*held, *np.flatnonzero(own).tolist()}))
-                   if held or own.any() else ())
+                   if held or np.logical_or.reduce(own) else ())
         q = limited.clip(self._q_last - self._step, self._q_last + self._step)
         q_list = q.tolist()
         self._wait_deadline()

@@ -148,7 +148,7 @@ class SimServos:
         vmax = self._vmax
         distance = self.goal - self.setpoint
         np.abs(distance, out=distance)
-        if np.less_equal(distance, vmax).all():  # the usual tick: every setpoint reaches its goal
+        if np.logical_and.reduce(distance <= vmax):  # the usual tick: all reach their goals
             self.setpoint = self.goal.copy()
             self.settled = True
             return self.setpoint
@@ -186,12 +186,12 @@ class SimServos:
             return
         ratio = np.abs(force)
         ratio /= self.stall
-        if ratio.max() >= SATURATED_RATIO:
+        if np.maximum.reduce(ratio) >= SATURATED_RATIO:
             saturated = self.enabled & (ratio >= SATURATED_RATIO)
             self.saturated_s = np.where(saturated, self.saturated_s + span, 0.0)
         elif self._any_saturated:
             self.saturated_s.fill(0.0)
-        self._any_saturated = bool(self.saturated_s.any())
+        self._any_saturated = bool(np.logical_or.reduce(self.saturated_s != 0.0))
         if span != self._decay_span:
             self._decay_span, self._decay = span, -math.expm1(-span / THERMAL_TAU_S)
         decay = self._decay

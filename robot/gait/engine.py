@@ -74,6 +74,7 @@ class GaitEngine:
         self.phase = gait.Phase(0.0, 0.0, 0.0, 0.0, 0.0)
         self.time = 0.0
         self._ramp = 0.0          # linear ramp variable in [0, 1]
+        self._amplitude = 0.0     # _smoothstep(_ramp), set with it
         self._running = False
         self.unreachable_ticks = 0
         #: The heading change [rad] the gait's ``turn`` asked for so far: ``turn`` per step,
@@ -155,7 +156,7 @@ class GaitEngine:
     @property
     def amplitude(self) -> float:
         """Current envelope value in [0, 1]."""
-        return _smoothstep(self._ramp)
+        return self._amplitude
 
     @property
     def stopped(self) -> bool:
@@ -263,6 +264,7 @@ class GaitEngine:
             self._ramp = min(1.0, self._ramp + step)
         else:
             self._ramp = max(0.0, self._ramp - step)
+        self._amplitude = _smoothstep(self._ramp)
         if self._ramp > 0.0:
             theta = self.phase.theta
             rate = 1.0 if self.stairs is None else self.stairs.rate   # x 1.0: same bits

@@ -189,9 +189,10 @@ class SimServos:
         if np.maximum.reduce(ratio) >= SATURATED_RATIO:
             saturated = self.enabled & (ratio >= SATURATED_RATIO)
             self.saturated_s = np.where(saturated, self.saturated_s + span, 0.0)
+            self._any_saturated = bool(np.logical_or.reduce(self.saturated_s != 0.0))
         elif self._any_saturated:
             self.saturated_s.fill(0.0)
-        self._any_saturated = bool(np.logical_or.reduce(self.saturated_s != 0.0))
+            self._any_saturated = False
         if span != self._decay_span:
             self._decay_span, self._decay = span, -math.expm1(-span / THERMAL_TAU_S)
         decay = self._decay

@@ -12,7 +12,8 @@ its goals at the present positions.
 
 Time is simulation time: ``bus.clock.sleep_until(t)`` steps the physics to exactly ``t``
 (whole ``timestep`` steps, batched into one ``mj_step`` call once the setpoints are
-constant, then one shorter step to land on ``t``).
+constant, then one shorter step to land on ``t``; the sensors computed in the last step
+only: sim.mujoco.stepping).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from sim.mujoco.observation import BodyObservation
 from sim.mujoco.run_watch import SimRunWatch
 from sim.mujoco.servo_law import ChainLaw, robot_servos
 from sim.mujoco.servos import AMBIENT_C, SimServos
+from sim.mujoco.stepping import physics_to
 from sim.mujoco.view import OffscreenRenderer, SimClock, WallPacer, check_display, launch_viewer
 from sim.mujoco.world import PUSH_WINDOW_S, TimedForces, heading_force
 from sim.mujoco.world_scene import apply_world_to_model, place_on_floor
@@ -102,7 +104,6 @@ class MujocoBus(BodyObservation, Bus):
         names = self.robot.joint_names
         self._qadr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names])
         self._act = np.array([model.actuator(n).id for n in names])
-        self._ctrl = data.ctrl   # a view of the actuators' controls
         dof = np.array([model.jnt_dofadr[model.joint(n).id] for n in names])
         law = robot_servos(self.robot)
         self._law = ChainLaw(model, data, law, self._act, dof, self._qadr)
@@ -110,8 +111,6 @@ class MujocoBus(BodyObservation, Bus):
                                       & ((model.geom_contype | model.geom_conaffinity) != 0))
         self._feet = foot_geoms(model)
         self._torso = model.body("torso").id
-        self._dt = float(model.opt.timestep)
-        self._opt = model.opt
         self._servos = SimServos(self.servo_map, law.force, data.qpos[self._qadr],
                                  latency_s=world.latency_s if world is not None else 0.0,
                                  max_speed=np.minimum(self.servo_map.max_speed,
@@ -244,10 +243,10 @@ class MujocoBus(BodyObservation, Bus):
         self._law.tick(servos.setpoint, deadline - t0)
         while (event := self._next_event()) < deadline - _TIME_EPS:
             if event > d.time:
-                self._physics_to(event)
+                physics_to(self.model, d, servos, self._law, event, sensed=False)
                 d.time = event
             self._events_due(event)
-        self._physics_to(deadline)
+        physics_to(self.model, d, servos, self._law, deadline, sensed=True)
         d.time = deadline
         if servos.pending or self._forces.active:   # delayed goals, pushes in progress
             self._events_due(deadline)
@@ -275,19 +274,3 @@ class MujocoBus(BodyObservation, Bus):
         d = self.data
         force = heading_force(d.qpos[3:7].tolist(), jx, jy) / window_s
         self._forces.start(d.time + window_s, force, d.xfrc_applied[self._torso])
-
-    def _physics_to(self, stop: float) -> None:
-        """Physics steps up to ``stop`` [s]: the setpoints slew before each step until they
-        are settled, then the remaining whole steps run in one call, then one short step."""
-        m, d, opt, servos, dt, law = self.model, self.data, self._opt, self._servos, self._dt, self._law
-        while (remaining := stop - d.time) > _TIME_EPS:
-            if not servos.settled:
-                self._ctrl[self._act] = law.ctrl(servos.slew(dt if dt < remaining else remaining))
-            if remaining < dt:
-                opt.timestep = remaining
-                try:
-                    mujoco.mj_step(m, d)
-                finally:
-                    opt.timestep = dt
-            else:
-                mujoco.mj_step(m, d, int(remaining / dt + 1e-6) if servos.settled else 1)

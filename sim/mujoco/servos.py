@@ -146,16 +146,14 @@ class SimServos:
         if dt != self._vmax_dt:
             self._vmax_dt, self._vmax = dt, self.max_speed * dt
         vmax = self._vmax
-        distance = self.goal - self.setpoint
-        np.abs(distance, out=distance)
-        if np.logical_and.reduce(distance <= vmax):  # the usual tick: all reach their goals
+        error = self.goal - self.setpoint
+        within = np.abs(error) <= vmax
+        if np.logical_and.reduce(within):    # the usual tick: every setpoint reaches its goal
             self.setpoint = self.goal.copy()
             self.settled = True
             return self.setpoint
-        error = self.goal - self.setpoint
-        within = np.abs(error) <= vmax
         self.setpoint = np.where(within, self.goal, self.setpoint + np.sign(error) * vmax)
-        self.settled = bool(np.all((self.setpoint == self.goal) | ~self.enabled))
+        self.settled = bool(np.logical_and.reduce((self.setpoint == self.goal) | ~self.enabled))
         return self.setpoint
 
     def set_torque(self, idx: list[int], enabled: bool, present: Floats) -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -30,14 +31,26 @@ assert sorted(n for g in CHANNEL_GROUPS.values() for n in g) == sorted(CHANNELS)
 
 def write_csv(path: str | Path, times: npt.NDArray[np.float64],
               channels: dict[str, npt.NDArray[np.float64]], joint_names: tuple[str, ...],
-              q: npt.NDArray[np.float64]) -> None:
-    """Columns: ``t`` [s], every channel of equations.md, ``q_<joint>`` [rad]."""
+              q: npt.NDArray[np.float64], *,
+              extra: Mapping[str, npt.NDArray[np.float64]] | None = None) -> None:
+    """Columns: ``t`` [s], every channel of equations.md, ``q_<joint>`` [rad], then the
+    ``extra`` columns by name (ValueError if one is named as a column before it)."""
+    more = dict(extra or {})
     header = ["t", *CHANNELS, *(f"q_{n}" for n in joint_names)]
-    data = np.column_stack([times, *(channels[c] for c in CHANNELS), *q])
-    with Path(path).open("w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(header)
-        w.writerows(data.tolist())  # repr precision: the channels round-trip exactly
+    taken = set(header) & set(more)
+    if taken:
+        raise ValueError(f"column {sorted(taken)[0]!r} twice")
+    data = np.column_stack([times, *(channels[c] for c in CHANNELS), *q, *more.values()])
+    out = Path(path)
+    tmp = out.with_name(f".{out.name}.part")  # written whole, then renamed into place
+    try:
+        with tmp.open("w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow([*header, *more])
+            w.writerows(data.tolist())  # repr precision: the channels round-trip exactly
+        tmp.replace(out)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 def palette(n: int) -> list[tuple[float, float, float, float]]:

@@ -1,12 +1,13 @@
 """Previs on an imported robot (issue 31): `biped export` builds the skeleton from the
 robot's own model, judged by independent readers: bvhio reads the BVH back, MuJoCo
 compiles the vendor's original file (tests/kit_models.py). Every joint's offset is the
-model's (MuJoCo's joint anchors at the zero pose) within 1e-6 m, and at every frame the
+model's (MuJoCo's joint anchors at the zero pose) within 1e-6 m; at every frame the
 joints stand where MuJoCo puts the anchors at that frame's angles (`biped curves
---model-angles`), and at random angles every joint and chain end where MuJoCo has
-it (composed from bvhio's parse: each channel's sign); export → import gives back the gait's angles as the box robot's round
-trip does (tests/test_import.py: 1e-4 rad); the panel's stick figure draws each hinge on
-MuJoCo's axis and the sole where MuJoCo's foot has it; `biped render` films the model."""
+--model-angles`), and at random angles every joint and chain end where MuJoCo has it
+(composed from bvhio's parse: each channel's sign counts); export → import gives back
+the gait's angles as the box robot's round trip does (tests/test_import.py: 1e-4 rad);
+the panel's stick figure draws each hinge on MuJoCo's axis and the sole where MuJoCo's
+foot has it; `biped render` films the model."""
 
 from __future__ import annotations
 

@@ -3,9 +3,10 @@ centre of mass, inertia, collision shapes and named frames.
 
 One description, two sources: the box model built from a robot file's dozen lengths
 (robot/body/boxes.py) and a builder's own URDF or MJCF (robot/body/urdf_read.py,
-mjcf_read.py, through ``biped robots import``). The simulation (sim/mujoco/mjcf_robot.py),
-the leg IK's chains (robot/body/legs.py), the previs skeleton and ``biped mjcf`` all read
-this.
+mjcf_read.py, through ``biped robots import``); robot/config/body_tree.py gives either
+in the robot's terms. The simulation and ``biped mjcf`` build MuJoCo from it
+(sim/mujoco/mjcf_body.py), and an imported robot's leg IK chains are measured on it
+(robot/body/legs.py).
 
 Frames: each link's frame is given relative to its parent's at the zero pose of every
 joint (all hinge angles 0, in the model's own convention); the root link's frame is the
@@ -83,7 +84,9 @@ class Hinge:
 
     name: the model's joint name; axis: unit vector in the link frame; pos: a point of the
     axis in the link frame [m]; range: limits [rad] (None: the model gives none);
-    effort [N m] and velocity [rad/s]: the model's limits, None where it gives none."""
+    effort [N m] and velocity [rad/s]: the model's limits, None where it gives none;
+    ref: the angle at which the link stands as the tree draws it [rad] (0 in a model's
+    own terms; a tree in the robot's terms, robot/body/model.py, moves the zero)."""
 
     name: str
     axis: Vec3
@@ -91,6 +94,7 @@ class Hinge:
     range: tuple[float, float] | None = None
     effort: float | None = None
     velocity: float | None = None
+    ref: float = 0.0
 
 
 @dataclass(frozen=True)

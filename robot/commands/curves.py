@@ -20,6 +20,7 @@ from robot.commands.common import (
     gait_from,
     one_line_errors,
     output_file,
+    plot_output,
     rate_hz,
     robot_from,
     seconds,
@@ -46,7 +47,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--rate", type=rate_hz, default=100.0, help="samples per second [Hz]")
     p.add_argument("--out", required=True, type=output_file, metavar="FILE.csv",
                    help="CSV to write")
-    p.add_argument("--plot", type=output_file, metavar="FILE.png", help="also write a plot")
+    p.add_argument("--plot", type=plot_output, metavar="FILE.png", help="also write a plot")
     p.add_argument("--model-angles", action="store_true",
                    help="an imported robot: add each joint under its model's name, in the "
                         "model's convention [rad]")

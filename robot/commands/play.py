@@ -31,11 +31,13 @@ from robot.commands.chase_args import (
 )
 from robot.commands.common import (
     add_bus_args,
+    audio_offset,
     bus_from,
     checked,
     input_file,
     output_file,
     params_from,
+    plot_output,
     rate_hz,
     seconds,
 )
@@ -89,12 +91,12 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--audio", default=None, type=input_file, metavar="SOUND",
                    help="play this soundtrack in sync (default: the file's own show.audio); "
                         "the sim then runs in real time")
-    p.add_argument("--audio-offset", type=float, default=None, metavar="SECONDS",
+    p.add_argument("--audio-offset", type=audio_offset, default=None, metavar="SECONDS",
                    help="show time [s] at which the audio starts (default: the file's, or 0)")
     p.add_argument("--player", default=None, metavar="CMD",
                    help="audio player reading a WAV on stdin (default: aplay, paplay, else "
                         "ffplay)")
-    p.add_argument("--check-plot", default=None, type=output_file, metavar="FILE.png",
+    p.add_argument("--check-plot", default=None, type=plot_output, metavar="FILE.png",
                    help="sim bus: plot the physics check (support margin, torque by limb, "
                         "headroom per joint)")
     p.add_argument("--no-root-travel", action="store_true",
@@ -241,14 +243,12 @@ def run(args: argparse.Namespace) -> int:
               "record_error": record_error, "exit_code": code}
     if soundtrack is not None:
         result["audio"] = {"file": str(soundtrack.show.audio_path()),
-                           "started_at_show_s": soundtrack.started_at,
-                           "warning": soundtrack.warning}
+                           "started_at_show_s": soundtrack.started_at, "warning": soundtrack.warning}
     if chase is not None:
         result["chase"] = {**summary(chase), "stopped": chase.ended or stats.stop_reason}
     metrics = done.metrics or {}
     if "distance_m" in metrics:      # the sim: where the robot went (a show that walks)
-        result["walked"] = {k: metrics[k] for k in ("distance_m", "lateral_drift_m",
-                                                      "heading_change_deg")}
+        result["walked"] = {k: metrics[k] for k in ("distance_m", "lateral_drift_m", "heading_change_deg")}
     check = physics_check(watch, robot, done.metrics)
     if check is not None and check.fell_at is not None:
         code = result["exit_code"] = max(code, 1)   # the show did not hold up: incomplete

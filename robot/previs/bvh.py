@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from robot.config.robot import RobotConfig
+from robot.files.atomic import write_text
 from robot.previs.body_bones import body_skeleton, body_soles
 from robot.previs.bones import Array, Bone, box_skeleton, box_soles
 
@@ -102,7 +103,7 @@ def write_bvh(path: str | Path, robot: RobotConfig, q: Array, frame_s: float, *,
     lines += ["MOTION", f"Frames: {len(q)}", f"Frame Time: {frame_s:.6f}"]
     data = np.column_stack(cols)
     lines += [" ".join(num(v) for v in row) for row in data.tolist()]
-    Path(path).write_text("\n".join(lines) + "\n")
+    write_text(path, "\n".join(lines) + "\n")
     return len(q)
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import io
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -11,7 +12,9 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.config.joint_names import limb_groups
+from robot.files.atomic import write_text
 from robot.gait.expressions import CHANNELS
+from robot.previs.figure_file import save_figure
 
 # Channels grouped by body part, as the paper groups its expressions.
 CHANNEL_GROUPS: dict[str, tuple[str, ...]] = {
@@ -41,16 +44,11 @@ def write_csv(path: str | Path, times: npt.NDArray[np.float64],
     if taken:
         raise ValueError(f"column {sorted(taken)[0]!r} twice")
     data = np.column_stack([times, *(channels[c] for c in CHANNELS), *q, *more.values()])
-    out = Path(path)
-    tmp = out.with_name(f".{out.name}.part")  # written whole, then renamed into place
-    try:
-        with tmp.open("w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow([*header, *more])
-            w.writerows(data.tolist())  # repr precision: the channels round-trip exactly
-        tmp.replace(out)
-    finally:
-        tmp.unlink(missing_ok=True)
+    text = io.StringIO()
+    w = csv.writer(text)
+    w.writerow([*header, *more])
+    w.writerows(data.tolist())  # repr precision: the channels round-trip exactly
+    write_text(path, text.getvalue())
 
 
 def palette(n: int) -> list[tuple[float, float, float, float]]:
@@ -121,5 +119,5 @@ def plot_curves(path: str | Path, times: npt.NDArray[np.float64],
     import matplotlib.pyplot as plt
 
     fig = curves_figure(times, channels, joint_names, q, title=title)
-    fig.savefig(path, dpi=90)
+    save_figure(fig, path)
     plt.close(fig)

@@ -23,6 +23,7 @@ import numpy.typing as npt
 import pygltflib as gl
 
 from robot.config.robot import RobotConfig
+from robot.files.atomic import replacing
 from robot.previs.bones import Bone
 from robot.previs.bvh import root_motion, skeleton, to_bvh
 
@@ -140,9 +141,10 @@ def write_gltf(path: str | Path, robot: RobotConfig, q: Array, frame_s: float, *
     returns the number of frames."""
     path = Path(path)
     doc = build_gltf(robot, q, frame_s, name=name)
-    if path.suffix == ".glb":
-        doc.save_binary(str(path))
-    else:
-        doc.convert_buffers(gl.BufferFormat.DATAURI)
-        doc.save_json(str(path))
+    with replacing(path) as temp:
+        if path.suffix == ".glb":
+            doc.save_binary(str(temp))
+        else:
+            doc.convert_buffers(gl.BufferFormat.DATAURI)
+            doc.save_json(str(temp))
     return len(q)

@@ -15,7 +15,8 @@ from pathlib import Path
 
 from robot.body.mjcf_read import read_mjcf
 from robot.body.tree import BodyTree
-from robot.config.model_import import build, check_servo, read_map, summary
+from robot.config.model_import import build, check_servo, summary
+from robot.config.model_recipe import read_map
 from robot.config.model_text import robot_file_text
 from robot.config.robot_file import parse_robot
 from robot.errors import ConfigError

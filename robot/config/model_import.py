@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -31,6 +32,8 @@ from robot.config.joint_names import ARM_NAMES, LEG_NAMES
 from robot.errors import ConfigError
 from robot.servo.models import MODELS, ServoModel
 
+#: A frame on the torso whose name says it is the IMU's (onshape-to-robot's "imu" frame).
+IMU_FRAME = re.compile(r"imu|bno0?55", re.IGNORECASE)
 #: The rest pose of a straight-legged robot [rad]: knees bent as the bundled robots rest.
 REST = {"hip_pitch": -0.55, "knee": 1.1, "ankle_pitch": -0.55}
 #: What ``--map`` may say of a model joint: its name (an extra joint's), its servo's id,
@@ -83,7 +86,8 @@ class Imported:
 
 def _sole_frames(tree: BodyTree, roles: Roles, m: Measured) -> BodyTree:
     """The tree with a ``r_sole`` / ``l_sole`` frame on each foot (the sole point) and an
-    ``imu`` frame on the root at the torso's centre of mass."""
+    ``imu`` frame on the root, in the robot's axes: where a torso frame named for an IMU
+    is (IMU_FRAME), else at the torso's centre of mass."""
     by = roles.by_name()
     pose_angles = {j.model_joint: j.offset for j in roles.joints}
     pos, rot = tree.poses(pose_angles)
@@ -102,10 +106,16 @@ def _sole_frames(tree: BodyTree, roles: Roles, m: Measured) -> BodyTree:
     weighed = [(link.inertial.mass, pos[i] + rot[i] @ np.asarray(link.inertial.com))
                for i in torso if (link := tree.links[i]).inertial is not None]
     mass = sum(w for w, _ in weighed)
-    com = sum((w * c for w, c in weighed), np.zeros(3)) / max(mass, 1e-12)
+    mount = sum((w * c for w, c in weighed), np.zeros(3)) / max(mass, 1e-12)
+    marked = [pos[i] + rot[i] @ np.asarray(f.pos) for i in torso for f in links[i].frames
+              if IMU_FRAME.search(f.name)]
+    if marked:      # the model's own IMU frame: the sensor sits there
+        mount = marked[0]
+    links = [dataclasses.replace(link, frames=tuple(f for f in link.frames if f.name != "imu"))
+             for link in links]
     root = links[0]
     links[0] = Link(root.name, -1, root.pos, root.quat, root.inertial, None, root.shapes,
-                    (*root.frames, Frame("imu", (float(com[0]), float(com[1]), float(com[2])),
+                    (*root.frames, Frame("imu", (float(mount[0]), float(mount[1]), float(mount[2])),
                                          matrix_to_quat(axes.T))))
     del by
     return BodyTree(tuple(links), source=tree.source, excludes=tree.excludes)
@@ -235,60 +245,3 @@ def _yaw_off(leg: object) -> float:
     if leg.yaw_axis is None:
         return 0.0
     return math.hypot(leg.yaw_axis[0] - leg.hip[0], leg.yaw_axis[1] - leg.hip[1])
-
-
-@dataclass(frozen=True)
-class Recipe:
-    """An import's ``--map`` file: per model joint what MAP_KEYS allow; the bus (kind,
-    model, baud), the gain registers and balance gains the robot file gets; where the
-    model comes from, its licence, and notes for the file's opening comment."""
-
-    joints: dict[str, dict[str, object]] = field(default_factory=dict)
-    bus: dict[str, object] = field(default_factory=dict)
-    gains: dict[str, int] = field(default_factory=dict)
-    balance: dict[str, float] = field(default_factory=dict)
-    source: str = ""
-    licence: str = ""
-    notes: tuple[str, ...] = ()
-
-
-RECIPE_KEYS = ("joints", "bus", "balance", "source", "licence", "notes")
-
-
-def read_map(path: str | None) -> Recipe:
-    """The ``--map`` file at ``path`` (None: an empty one); one-line ConfigError."""
-    if path is None:
-        return Recipe()
-    from robot.config.toml_io import read_toml
-
-    data = read_toml(Path(path))
-    where = f"--map {path}"
-    bad = sorted(set(data) - set(RECIPE_KEYS))
-    if bad:
-        raise ConfigError(f"{where}: {bad[0]}: unknown key; valid: {', '.join(RECIPE_KEYS)}")
-    joints = data.get("joints", {})
-    if not isinstance(joints, dict):
-        raise ConfigError(f"{where}: joints: expected [joints.MODEL_JOINT] tables")
-    out: dict[str, dict[str, object]] = {}
-    for name, tab in joints.items():
-        if not isinstance(tab, dict):
-            raise ConfigError(f"{where}: joints.{name}: expected a table")
-        unknown = sorted(set(tab) - MAP_KEYS)
-        if unknown:
-            raise ConfigError(f"{where}: joints.{name}.{unknown[0]}: unknown key; valid: "
-                              f"{', '.join(sorted(MAP_KEYS))}")
-        out[name] = dict(tab)
-    bus = data.get("bus", {})
-    balance = data.get("balance", {})
-    notes = data.get("notes", [])
-    if not isinstance(bus, dict) or not isinstance(balance, dict) or not isinstance(notes, list):
-        raise ConfigError(f"{where}: bus and balance must be tables, notes a list of strings")
-    gains = bus.pop("gains", {}) if isinstance(bus.get("gains", {}), dict) else None
-    if gains is None:
-        raise ConfigError(f"{where}: bus.gains: expected a table of register values")
-    unknown = sorted(set(bus) - {"kind", "model", "baud"})
-    if unknown:
-        raise ConfigError(f"{where}: bus.{unknown[0]}: unknown key; valid: kind, model, baud, gains")
-    return Recipe(out, dict(bus), dict(gains), dict(balance),  # type: ignore[arg-type]
-                  str(data.get("source", "")), str(data.get("licence", "")),
-                  tuple(str(n) for n in notes))

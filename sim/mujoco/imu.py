@@ -74,6 +74,7 @@ class SimImu(Imu):
         self.bus = bus
         self.config = config
         self._mount = Mount.from_rpy_deg(config.mount_rpy_deg)
+        self._level = self._mount.is_identity   # the chip's axes are the torso's
         self._adr: dict[str, int] | None = None
         self._buffer: deque[ImuSample] = deque()
         self._rng = np.random.default_rng(config.seed)
@@ -134,12 +135,12 @@ class SimImu(Imu):
         due = now.t - self.config.latency_ms / 1000.0 + _TIME_EPS
         while len(buf) > 1 and buf[1].t <= due:
             buf.popleft()
-        return self._mount.to_torso(buf[0])
+        return buf[0] if self._level else self._mount.to_torso(buf[0])
 
     def _measure(self, exact: ImuSample) -> ImuSample:
         """What the chip reports for ``exact`` (torso frame): in its own frame, with bias
         and a fresh draw of noise."""
-        dev = self._mount.to_imu(exact)
+        dev = exact if self._level else self._mount.to_imu(exact)
         c = self.config
         if c.noise == 0.0 and c.bias == 0.0:
             return dev

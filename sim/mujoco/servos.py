@@ -211,9 +211,9 @@ class SimServos:
         temperature = self.temperature.tolist()
         overloaded = self.overloaded().tolist()
         sids = self._ids
-        return {sids[i]: ServoState(id=sids[i], position=ticks[i], load=load[i],
-                                    temperature=temperature[i], voltage=volts,
-                                    errors=_OVERLOAD if overloaded[i] else _NO_ERRORS)
+        # positional: id, position, load, temperature, voltage, errors
+        return {sids[i]: ServoState(sids[i], ticks[i], load[i], temperature[i], volts,
+                                    _OVERLOAD if overloaded[i] else _NO_ERRORS)
                 for i in idx}
 
     def load_percent(self, force: Floats) -> Floats:

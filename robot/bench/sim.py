@@ -37,7 +37,7 @@ def _walk(robot_name: str, seconds: float, *, balance: bool) -> tuple[float, flo
     robot = load_robot(robot_name)
     bus: Any = make_bus("sim", robot=robot)
     with bus:
-        engine = GaitEngine(robot, load_gait("walk").params)
+        engine = GaitEngine(robot, load_gait("walk").for_robot(robot))
         feedback = None
         imu = None
         if balance and robot.imu is not None:

@@ -48,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
     gait = gait_from(args)
     times = np.arange(n) / args.rate
-    engine = GaitEngine(robot, gait.params)
+    engine = GaitEngine(robot, gait.for_robot(robot))
     channels, q = engine.curves(times)
     with writing("--out", args.out):
         write_csv(args.out, times, channels, robot.joint_names, q)

@@ -106,7 +106,9 @@ def run_import(args: argparse.Namespace) -> int:
               "The body ([model]) is the model's own numbers; docs/robots.md, \"From CAD\"."]
     text = robot_file_text(imp, name=name, kind=kind, servo=servo, baud=baud, header=header,
                            gains=recipe.gains, balance=recipe.balance, gait=recipe.gait)
-    parse_robot(tomllib.loads(text), source=str(out))   # what is written loads
+    # What is written loads; a fault there comes from the map (a gain register, a value).
+    parse_robot(tomllib.loads(text), source=f"{out} (from --map {args.map})" if args.map
+                else str(out))
     for line in summary(imp, path=path):
         print(line)
     tmp = out.with_name(f".{out.name}.tmp")

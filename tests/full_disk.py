@@ -18,11 +18,12 @@ import pytest
 SIZE = "64k"
 
 
-@pytest.fixture
-def full_dir(tmp_path: Path) -> Iterator[Path]:
-    """An empty-looking directory on a disk with no block left (files can be created,
-    nothing can be written into them)."""
-    d = tmp_path / "full"
+#: Bytes left free by ``nearly_full_dir``: a few lines fit, a take or a picture does not.
+LEFT = 8192
+
+
+def _filled(d: Path, *, leave: int) -> Iterator[Path]:
+    """A tmpfs mounted on ``d`` and filled to ``leave`` bytes of free space."""
     d.mkdir()
     mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={SIZE},mode=0777",
                               "tmpfs", str(d)], capture_output=True, text=True)
@@ -37,8 +38,25 @@ def full_dir(tmp_path: Path) -> Iterator[Path]:
         except OSError as e:
             assert e.errno == errno.ENOSPC, e
         finally:
+            if leave:
+                os.ftruncate(fd, max(0, os.fstat(fd).st_size - leave))
             os.close(fd)
-        assert os.statvfs(d).f_bavail == 0
+        free = os.statvfs(d).f_bavail * os.statvfs(d).f_frsize
+        assert free == leave, (free, leave)
         yield d
     finally:
         subprocess.run(["umount", "-l", str(d)], check=False)
+
+
+@pytest.fixture
+def full_dir(tmp_path: Path) -> Iterator[Path]:
+    """An empty-looking directory on a disk with no block left (files can be created,
+    nothing can be written into them)."""
+    yield from _filled(tmp_path / "full", leave=0)
+
+
+@pytest.fixture
+def nearly_full_dir(tmp_path: Path) -> Iterator[Path]:
+    """A directory on a disk with ``LEFT`` bytes free: a command's output check passes
+    (there is space), and a file larger than that fails part-way (ENOSPC)."""
+    yield from _filled(tmp_path / "nearly", leave=LEFT)

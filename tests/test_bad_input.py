@@ -65,7 +65,7 @@ def run_cli(argv: list[str], capsys: pytest.CaptureFixture[str],
             monkeypatch: pytest.MonkeyPatch) -> tuple[int, str, str]:
     """(exit code, stdout, stderr) of ``biped <argv>`` in-process. Only the command under test
     is built (others may be mid-edit); argparse's own exit counts like a returned code."""
-    monkeypatch.setattr(cli, "COMMANDS", (argv[0],))
+    monkeypatch.setattr(cli, "COMMANDS", (cli.command_of(argv) or argv[0],))  # import_
     try:
         code = cli.main(argv)
     except SystemExit as e:

@@ -74,7 +74,9 @@ def joint_field(joint: str, field: str, value: str) -> Callable[[str], str]:
 def test_bundled_robots_load() -> None:
     for path in sorted(ROBOTS_DIR.glob("*.toml")):
         r = load_robot(path)
-        n = (12 if r.has_hip_yaw else 10) + (6 if r.has_arms else 0)   # 5-DoF legs: no yaw
+        legs = 2 * (4 + r.has_hip_yaw + r.has_ankle_roll)   # 5-DoF legs: no yaw or ankle roll
+        extras = sum(j.fixed_rad is not None for j in r.joints)   # a kit's neck and head
+        n = legs + (6 if r.has_arms else 0) + extras
         assert len(r.joints) == n and len(set(r.ids)) == n
         assert r.source == str(path)
     assert len(load_robot(ROBOTS_DIR / "robotis-mini.toml").ids) == 16   # its 16 XL-320s
@@ -117,7 +119,7 @@ def test_bundled_robots_load() -> None:
      "bus.model: XL430-W250 is not a feetech servo"),
     (sub('kind = "dynamixel"', 'kind = "can"'), "bus.kind: expected one of dynamixel, dynamixel1, feetech"),
     (drop_joint("l_elbow"), "joints.l_elbow: missing (arms need all of"),
-    (drop_joint("r_ankle_roll"), "joints.r_ankle_roll: missing (every leg joint is required; only hip yaw"),
+    (drop_joint("r_ankle_roll"), "joints.r_ankle_roll: missing (ankle roll on both legs, or neither"),
     (sub("r_knee = 1.1", "r_knee = 2.9"), "rest.r_knee: 2.9 is outside the joint limits"),
     (sub("r_knee = 1.1", "r_toe = 1.1"), "rest.r_toe: unknown joint"),
     (sub('name = "biped18-dynamixel"', "name = 42"), "name: expected a non-empty string, got 42"),

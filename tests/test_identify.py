@@ -1,5 +1,6 @@
 """`biped identify fit` and `check`: the bundled servo models predict real recordings they
-were not fitted on (Rhoban/bam's pendulum logs, tests/data/bam/), and the fit recovers the
+were not fitted on (Rhoban/bam's pendulum logs, ../shared/servo_logs/bam/ beside the
+repository), and the fit recovers the
 parameters of a servo model that made the logs.
 
 The goals (issue 20): held-out mean error <= 0.05 rad on the XL330-M288 logs and <= 0.02
@@ -25,7 +26,7 @@ from robot.servo.physics import ServoPhysics, from_datasheet
 from sim.mujoco.fit import fit_physics
 from sim.mujoco.pendulum import PendulumBench
 
-DATA = Path(__file__).parent / "data" / "bam"
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "servo_logs" / "bam"
 GOALS = {"xl330": ("XL330-M288", 0.05), "sts3250": ("STS3250", 0.02)}
 
 

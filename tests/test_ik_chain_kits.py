@@ -9,33 +9,19 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import xml.etree.ElementTree as ET
-from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
+from kit_models import DUCK, OP3, without_meshes
 
 from robot.body.measure import measure
 from robot.body.mjcf_read import read_mjcf
 from robot.body.roles import find_roles
 from robot.gait.ik_chain import chain_leg_ik, check_layout
 
-ROBOTS = Path(__file__).resolve().parents[1].parent / "shared" / "robots"
-KITS = {"op3": ROBOTS / "robotis_op3" / "op3.xml",
-        "open-duck-mini-v2": ROBOTS / "open_duck_mini_v2" / "robot.xml"}
+KITS = {"op3": OP3, "open-duck-mini-v2": DUCK}
 JOINTS = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
-
-
-def without_meshes(path: Path) -> mujoco.MjModel:
-    """The model with its mesh assets and mesh geoms left out (the kinematics stay)."""
-    root = ET.parse(path).getroot()
-    for parent in list(root.iter()):
-        for child in list(parent):
-            if child.tag == "mesh" or (child.tag == "geom" and (child.get("mesh") or
-                                                                child.get("type") == "mesh")):
-                parent.remove(child)
-    return mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
 
 
 @pytest.mark.parametrize(("kit", "back"), [("op3", False), ("open-duck-mini-v2", False),

@@ -164,6 +164,29 @@ def test_full_disk_under_record_and_save(emu: Emulator, robot: RobotConfig, robo
     assert os.path.islink(takes / "full.take.jsonl")
 
 
+def test_a_refused_record_keeps_the_take_of_that_name(emu: Emulator, robot: RobotConfig,
+                                                     robot_toml: Path, tmp_path: Path) -> None:
+    """Issue 36: a recording that never starts (a joint outside its limits) leaves the take
+    already under that name as it was; the panel says why and serves on."""
+    takes = tmp_path / "studio" / "takes"
+    takes.mkdir(parents=True)
+    old = takes / "keep.take.jsonl"
+    old.write_text('{"take": 1}\n{"tick": 1}\n')
+    knee = robot.joint("r_knee")
+    beyond = knee.max_rad + 0.3
+    emu.set_register(knee.servo_id, "present_position", round(
+        knee.zero_ticks + knee.sign * beyond * RESOLUTION / (2 * math.pi)))
+    with launched(emu, robot_toml, tmp_path, rate=RATE) as panel:
+        panel.request("POST", "/api/record", {"name": "keep"})
+        assert wait_for(lambda: not panel.state()["running"]
+                        and "refusing to start" in str(panel.state())), panel.state()
+        panel.proc.send_signal(TERM)
+        code, out = end(panel)
+    assert code == 128 + TERM, out
+    assert old.read_text() == '{"take": 1}\n{"tick": 1}\n'
+    assert sorted(p.name for p in takes.iterdir()) == ["keep.take.jsonl"]
+
+
 def test_web_side_killed_the_loop_stops_the_robot(emu: Emulator, robot: RobotConfig,
                                                   robot_toml: Path, tmp_path: Path) -> None:
     """SIGKILL on `biped panel` (nothing of it runs any more): its loop process sees the

@@ -152,7 +152,8 @@ def test_the_cad_urdf_is_measured_as_it_was_written(tmp_path: Path) -> None:
     assert "mass" not in data and data["model"]["links"][0]["name"] == "base_link"
 
 
-@pytest.mark.parametrize("case", ["xacro", "prismatic", "mesh", "inertia", "layout", "format"])
+@pytest.mark.parametrize("case", ["xacro", "prismatic", "mesh", "inertia", "layout", "two roles",
+                                  "format"])
 def test_a_model_it_cannot_take_is_one_line_and_nothing_written(
         case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     urdf, meshes = cad_robot.write(tmp_path)
@@ -178,6 +179,10 @@ def test_a_model_it_cannot_take_is_one_line_and_nothing_written(
         path.write_text(re.sub(r'(name="left_knee".*?<axis xyz=")0 -1 0', r"\g<1>1 0 0", text,
                                flags=re.S))
         want = "axes"
+    elif case == "two roles":   # the ankle roll turned into a fourth pitch joint
+        path.write_text(re.sub(r'(name="left_ankle_roll".*?<axis xyz=")1 0 0', r"\g<1>0 1 0",
+                               text, flags=re.S))
+        want = "4 joints turn about y (left_hip_pitch, left_knee, left_ankle_pitch, left_ankle_roll)"
     else:
         path = tmp_path / "robot.dae"
         path.write_text("<COLLADA/>")

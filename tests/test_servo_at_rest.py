@@ -1,10 +1,10 @@
 """A servo at rest stops short of its goal, and the model's friction is what holds it
 (issue 34; docs/servos.md, "At rest"). Oracle: the real XL330-M288 recordings
-(tests/data/bam/xl330, Rhoban/bam): each opens with the servo at rest on goal 0, torque
-on, the arm hanging, several pulses off the goal while the firmware keeps pushing (Present
-PWM); the bundled model's friction at rest must hold what the recording shows held:
-the motor's torque (PWM of 885, times the stall torque at the log's supply) plus gravity
-on the arm pushing the same way.
+(../shared/servo_logs/bam/xl330 beside the repository, Rhoban/bam): each opens with the
+servo at rest on goal 0, torque on, the arm hanging, several pulses off the goal while
+the firmware keeps pushing (Present PWM); the bundled model's friction at rest must hold
+what the recording shows held: the motor's torque (PWM of 885, times the stall torque at
+the log's supply) plus gravity on the arm pushing the same way.
 """
 
 from __future__ import annotations
@@ -17,7 +17,8 @@ import numpy as np
 from robot.config.servo_file import physics_for
 from robot.servo.pendulum_log import read_log
 
-LOGS = sorted((Path(__file__).parent / "data" / "bam" / "xl330").glob("*.json.gz"))
+BAM = Path(__file__).resolve().parents[1].parent / "shared" / "servo_logs" / "bam"
+LOGS = sorted((BAM / "xl330").glob("*.json.gz"))
 PULSE = 2 * math.pi / 4096          # XL330-M288: 4096 pulses a turn
 PWM_FULL = 885.0                    # e-Manual: PWM Limit 885 = 100 % duty
 G = 9.81

@@ -25,7 +25,8 @@ from robot.servo.physics import ServoPhysics
 from robot.servo.physics_table import PHYSICS
 from sim.mujoco.servo_law import ServoArrays
 
-DATA = Path(__file__).parent / "data" / "bam"
+#: Rhoban/bam's recordings, published data kept beside the repository (not in it).
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "servo_logs" / "bam"
 
 
 def _one_servo(physics: ServoPhysics, gains: dict[str, int], voltage: float,

@@ -135,3 +135,44 @@ def test_a_chased_jump_restarts_the_player_there_and_the_cues_from_there(
     track(Telemetry(t=1.2, state="walking", tick=101))
     track.close()
     assert seen == ["a", "b", "a"]
+
+
+def _refused(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
+    try:
+        code = cli.main(argv)
+    except SystemExit as e:
+        code = int(e.code or 0)
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "", out + err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+    return err.strip()
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-1e400", "1e7"])
+@pytest.mark.parametrize("command", ["import", "play"])
+def test_an_audio_offset_that_is_no_time_is_refused_at_the_flag(
+        command: str, value: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 36: import wrote "audio_offset_s": NaN, which play then refused."""
+    keys = tmp_path / "wave.keys.toml"
+    _keys(keys, "song.wav", 0.0, [])
+    _wav(tmp_path / "song.wav", 0.5)
+    argv = (["import", str(tmp_path / "none.bvh"), "--out", str(tmp_path / "o.take.jsonl")]
+            if command == "import" else ["play", str(keys)])
+    err = _refused([*argv, f"--audio-offset={value}"], capsys)
+    assert "argument --audio-offset" in err and "[-1e+06, 1e+06] s" in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["song.wav", "wave.keys.toml"]
+
+
+@pytest.mark.parametrize(("data", "why"), [
+    (b"", "it ends before its header is whole"),
+    (b"not a sound\n" * 20, "file does not start with RIFF id"),
+])
+def test_a_wav_that_does_not_read_is_refused_with_its_reason(
+        data: bytes, why: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 36: "not a readable WAV file: ;" with no reason, a silent show, exit 0."""
+    keys = tmp_path / "wave.keys.toml"
+    _keys(keys, "song.wav", 0.0, [])
+    bad = tmp_path / "text.wav"
+    bad.write_bytes(data)
+    err = _refused(["play", str(keys), "--audio", str(bad)], capsys)
+    assert f"audio {bad}: not a readable WAV file: {why}" in err, err

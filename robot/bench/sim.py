@@ -101,7 +101,8 @@ def run_presets(*, quick: bool = False) -> dict[str, Any]:
 def run_sim_bench(*, quick: bool = False) -> dict[str, Any]:
     seconds, repeats = (1.0, 1) if quick else (20.0, 5)
     out: dict[str, Any] = {"walk_seconds": seconds, "repeats": repeats}
-    for robot in ("biped18-dynamixel", "biped18-feetech"):
+    # the box models, and the imported kits (their own bodies: hull and box collisions)
+    for robot in ("biped18-dynamixel", "biped18-feetech", "robotis-op3", "open-duck-mini-v2"):
         for balance in (False, True):
             runs = [_walk(robot, seconds, balance=balance) for _ in range(repeats)]
             factors = sorted(r[0] for r in runs)

@@ -128,6 +128,15 @@ def _leg_roles(pose: Pose, limb: Limb, side: str, feet: list[int]) -> tuple[list
         elif letter == "x":                              # ankle roll: sole level in roll
             pose.turn(link, X, _angle_to(sole_normal(pose, feet), X, -Z))
     roles = LEG_PATTERNS.get(pattern)
+    most = {"z": 1, "x": 2, "y": 3}
+    for letter, n in most.items():
+        found = [name for name, a in zip(names, pattern, strict=True) if a == letter]
+        if roles is None and len(found) > n:
+            what = {"z": "hip yaw", "x": "roll (hip and ankle)", "y": "pitch (hip, knee, ankle)"}
+            raise ConfigError(f"{tree.source}: leg {names[0]}..{names[-1]}: {len(found)} joints "
+                              f"turn about {letter} ({', '.join(found)}): more than the "
+                              f"{n} {what[letter]} a leg has, so two would take one role; "
+                              "name the joints with --map")
     if roles is None:
         raise ConfigError(f"{tree.source}: leg {names[0]}..{names[-1]}: axes {pattern} (torso "
                           f"outward, at the zero pose); the importer takes "

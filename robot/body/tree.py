@@ -3,9 +3,10 @@ centre of mass, inertia, collision shapes and named frames.
 
 One description, two sources: the box model built from a robot file's dozen lengths
 (robot/body/boxes.py) and a builder's own URDF or MJCF (robot/body/urdf_read.py,
-mjcf_read.py, through ``biped robots import``). The simulation (sim/mujoco/mjcf_robot.py),
-the leg IK's chains (robot/body/legs.py), the previs skeleton and ``biped mjcf`` all read
-this.
+mjcf_read.py, through ``biped robots import``); robot/config/body_tree.py gives either
+in the robot's terms. The simulation and ``biped mjcf`` build MuJoCo from it
+(sim/mujoco/mjcf_body.py), and an imported robot's leg IK chains are measured on it
+(robot/body/legs.py).
 
 Frames: each link's frame is given relative to its parent's at the zero pose of every
 joint (all hinge angles 0, in the model's own convention); the root link's frame is the
@@ -83,7 +84,9 @@ class Hinge:
 
     name: the model's joint name; axis: unit vector in the link frame; pos: a point of the
     axis in the link frame [m]; range: limits [rad] (None: the model gives none);
-    effort [N m] and velocity [rad/s]: the model's limits, None where it gives none."""
+    effort [N m] and velocity [rad/s]: the model's limits, None where it gives none;
+    ref: the angle at which the link stands as the tree draws it [rad] (0 in a model's
+    own terms; a tree in the robot's terms, robot/body/model.py, moves the zero)."""
 
     name: str
     axis: Vec3
@@ -91,6 +94,7 @@ class Hinge:
     range: tuple[float, float] | None = None
     effort: float | None = None
     velocity: float | None = None
+    ref: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -162,6 +166,30 @@ class BodyTree:
                 pos[i], rot[i] = p_local, r_local
             else:
                 pos[i] = pos[link.parent] + rot[link.parent] @ p_local
+                rot[i] = rot[link.parent] @ r_local
+        return pos, rot
+
+    def poses_many(self, q: Mapping[str, Array], n: int) -> tuple[Array, Array]:
+        """``poses`` over ``n`` frames at once: hinge angles ``q`` [rad] (n,) each, by
+        hinge name (missing ones 0) → positions (L, n, 3) [m] and rotations (L, n, 3, 3)."""
+        pos, rot = np.zeros((len(self.links), n, 3)), np.zeros((len(self.links), n, 3, 3))
+        for i, link in enumerate(self.links):
+            r_local = np.broadcast_to(quat_to_matrix(link.quat), (n, 3, 3))
+            p_local = np.broadcast_to(np.asarray(link.pos, float), (n, 3))
+            if link.joint is not None:
+                a = np.asarray(link.joint.axis, float)
+                a = a / np.linalg.norm(a)
+                k = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+                angle = np.broadcast_to(np.asarray(q.get(link.joint.name, 0.0), float), (n,))
+                turn = (np.eye(3) + np.sin(angle)[:, None, None] * k
+                        + (1.0 - np.cos(angle))[:, None, None] * (k @ k))
+                anchor = np.asarray(link.joint.pos, float)
+                p_local = p_local + np.einsum("nij,nj->ni", r_local, anchor - turn @ anchor)
+                r_local = r_local @ turn
+            if link.parent < 0:
+                pos[i], rot[i] = p_local, r_local
+            else:
+                pos[i] = pos[link.parent] + np.einsum("nij,nj->ni", rot[link.parent], p_local)
                 rot[i] = rot[link.parent] @ r_local
         return pos, rot
 

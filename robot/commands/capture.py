@@ -27,6 +27,7 @@ from robot.commands.common import (
 )
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
 from robot.motion.keyframes import SUFFIXES, load_sequence, sequence_to_toml
 from robot.motion.posing import Capture, limb_joints
 from robot.run.release import release
@@ -66,7 +67,7 @@ def run(args: argparse.Namespace, *, ask: Ask = input) -> int:
         raise ConfigError("no keyframe captured; nothing was written")
     seq = capture.sequence(args.name or out.stem)
     with writing("--out", out):
-        out.write_text(sequence_to_toml(seq))
+        write_text(out, sequence_to_toml(seq))
     try:
         load_sequence(out, robot)  # as `biped play` and `walk --keyframes` will read it
     except ConfigError as e:

@@ -24,6 +24,7 @@ from robot.config.params import GaitParams
 from robot.config.robot import SERVO_ID, SPEED, RobotConfig
 from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
+from robot.previs.figure_file import figure_format
 
 T = TypeVar("T")
 
@@ -102,6 +103,8 @@ def _short(text: str) -> str:
 rate_hz = bounded_float(1.0, 2000.0, "Hz", what="a rate")
 #: --seconds: up to 1e6 s (11.6 days; an animatronics show runs all day, not for weeks).
 seconds = bounded_float(0.0, 1e6, "s", what="a duration", lo_open=True)
+#: --audio-offset: the show time the audio starts at, in the range of --seconds either way.
+audio_offset = bounded_float(-1e6, 1e6, "s", what="a show time")
 #: --speed: the joints' max_speed_rad_s range (robot.config.SPEED).
 joint_speed = bounded_float(SPEED.lo, SPEED.hi, SPEED.unit, what="a joint speed")
 
@@ -169,6 +172,17 @@ def output_file(text: str) -> str:
             else None))
     if why:
         raise argparse.ArgumentTypeError(f"{why}; expected a writable file path")
+    return text
+
+
+def plot_output(text: str) -> str:
+    """An argparse type: an ``output_file`` whose suffix is a picture format a plot is
+    written in (robot.previs.figure_file.FORMATS; none: PNG)."""
+    output_file(text)
+    try:
+        figure_format(text)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
     return text
 
 

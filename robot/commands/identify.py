@@ -22,10 +22,18 @@ import argparse
 import json
 from pathlib import Path
 
-from robot.commands.common import bounded_float, checked, input_file, one_line_errors, output_file
+from robot.commands.common import (
+    bounded_float,
+    checked,
+    input_file,
+    one_line_errors,
+    output_file,
+    plot_output,
+)
 from robot.commands.identify_record_cli import add_record_parser, run_record_command
 from robot.config.servo_file import load_servo_file, physics_for, servo_file_text
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
 from robot.servo.models import MODELS
 from robot.servo.pendulum_log import PendulumLog, read_log, split_logs
 from robot.servo.physics import FITTED, ServoPhysics
@@ -97,7 +105,7 @@ def _errors(logs: list[PendulumLog], physics: ServoPhysics, offset: float,
 
 def _check(args: argparse.Namespace) -> int:
     if args.plot is not None:
-        checked("--plot", output_file, args.plot)
+        checked("--plot", plot_output, args.plot)
     physics = _model(args.model)
     logs = _logs(args.logs, physics.law)
     errors = _errors(logs, physics, args.offset, args.plot)
@@ -145,10 +153,8 @@ def _fit(args: argparse.Namespace) -> int:
            "train_logs": [p.name for p in train_paths], "held_out_logs": [p.name for p in held_paths]}
     if held_err:
         fit["held_out_error_rad"] = sum(held_err) / len(held_err)
-    tmp = out.with_name(f".{out.name}.tmp")          # whole or not at all
-    tmp.write_text(servo_file_text(result.physics, fit=fit, comment=(
+    write_text(out, servo_file_text(result.physics, fit=fit, comment=(
         f"{args.motor} servo model fitted by `biped identify fit` (docs/servos.md).")))
-    tmp.replace(out)
     for path, e in zip([*train_paths, *held_paths], [*train_err, *held_err], strict=True):
         print(f"  {'held out' if path in held_paths else 'train   '} {path.name}: {e:.4f} rad")
     print(f"train error {fit['train_error_rad']:.4f} rad over {len(train)} logs")

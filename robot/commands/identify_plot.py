@@ -9,6 +9,7 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
+from robot.previs.figure_file import save_figure
 from robot.servo.pendulum_log import PendulumLog
 
 
@@ -42,5 +43,5 @@ def plot_replays(logs: Sequence[PendulumLog], simulated: npt.NDArray[np.float64]
     axes.flat[0].legend(fontsize=7, loc="best")
     fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
+    save_figure(fig, path)
     plt.close(fig)

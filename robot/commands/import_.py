@@ -21,6 +21,7 @@ import numpy as np
 
 from robot.commands.common import (
     add_robot_args,
+    audio_offset,
     bounded_float,
     checked,
     input_file,
@@ -78,7 +79,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                         "(docs/animatronics.md)")
     p.add_argument("--audio", default=None, metavar="SOUND",
                    help="soundtrack of the show (a path relative to the take)")
-    p.add_argument("--audio-offset", type=float, default=0.0, metavar="SECONDS",
+    p.add_argument("--audio-offset", type=audio_offset, default=0.0, metavar="SECONDS",
                    help="show time [s] at which the audio starts (default: 0)")
     p.set_defaults(set=[])
     return p

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from robot.commands.common import checked, input_file, one_line_errors, output_file, writing
+from robot.commands.common import checked, input_file, one_line_errors, plot_output, writing
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
@@ -23,7 +23,7 @@ def run(args: argparse.Namespace) -> int:
 
     # Checked here rather than as argparse types so that main() returns 2 like for a bad file.
     checked("FILE", input_file, args.file)
-    checked("--out", output_file, args.out)
+    checked("--out", plot_output, args.out)
     with writing("--out", args.out):
         kind = plot_file(args.file, args.out)
     print(f"wrote {args.out} ({kind} plot of {args.file})")

@@ -16,6 +16,7 @@ from robot.commands.common import (
     params_from,
     rate_hz,
     robot_from,
+    writing,
 )
 from robot.errors import ConfigError
 
@@ -63,7 +64,8 @@ def run(args: argparse.Namespace) -> int:
                           "smaller, or .mp4)")
     robot = robot_from(args)
     gait, params = params_from(args)
-    result = render_walk(robot, params, args.out, spec=spec, progress=not args.quiet)
+    with writing("--out", args.out):
+        result = render_walk(robot, params, args.out, spec=spec, progress=not args.quiet)
     fell = ", the robot FELL" if result.fell else ""
     print(f"wrote {result.path}: {result.frames} frames, {result.seconds:.2f} s at "
           f"{args.fps:g} fps, {args.width}x{args.height}, gait {gait.name}{fell}")

@@ -22,6 +22,7 @@ from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot, parse_robot
 from robot.config.toml_edit import edit_joints
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -107,17 +108,11 @@ def copy(name: str, dest: Path) -> Path:
                        name=target.stem)
     parse_robot(tomllib.loads(text), source=str(target))    # the copy loads as it is
     try:
-        f = target.open("x", encoding="utf-8")
+        write_text(target, text, exclusive=True)
     except FileExistsError:
         raise ConfigError(f"copy DEST {target}: exists; not overwritten: choose another "
                           "name, or delete it first") from None
-    except OSError as e:
-        raise ConfigError(f"copy DEST {target}: cannot create it: {e.strerror or e}") from e
-    try:
-        with f:
-            f.write(text)
     except OSError as e:             # e.g. a full disk: no half-written robot file is left
-        target.unlink(missing_ok=True)
         raise ConfigError(f"copy DEST {target}: cannot write it: {e.strerror or e}; "
                           "nothing was left there") from e
     return target

@@ -15,11 +15,12 @@ from pathlib import Path
 
 from robot.body.mjcf_read import read_mjcf
 from robot.body.tree import BodyTree
-from robot.config.import_recipe import read_map
 from robot.config.model_import import build, check_servo, summary
+from robot.config.model_recipe import read_map
 from robot.config.model_text import robot_file_text
 from robot.config.robot_file import parse_robot
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
 from robot.gait.ik_chain import check_layout
 from robot.servo.models import BUS_FAMILIES, MODELS, factory_baud
 
@@ -111,12 +112,9 @@ def run_import(args: argparse.Namespace) -> int:
                 else str(out))
     for line in summary(imp, path=path):
         print(line)
-    tmp = out.with_name(f".{out.name}.tmp")
     try:
-        tmp.write_text(text, encoding="utf-8")
-        tmp.replace(out)
+        write_text(out, text)
     except OSError as e:
-        tmp.unlink(missing_ok=True)
         raise ConfigError(f"--out {out}: cannot write it: {e.strerror or e}") from e
     print(f"wrote {out}: `biped walk --robot {out}` walks it in the sim")
     return 0

@@ -13,12 +13,13 @@ from pathlib import Path
 from robot.commands.common import (
     add_robot_args,
     add_set_arg,
-    output_file,
     params_from,
+    plot_output,
     positive_int,
     robot_from,
     seconds,
 )
+from robot.previs.figure_file import save_figure
 from robot.tuning.robustness import (
     STRAIGHT_DEG,
     STRAIGHT_DRIFT,
@@ -50,7 +51,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                    help="skip the open-loop runs (--no-balance)")
     p.add_argument("--jobs", type=positive_int, default=None,
                    help="parallel runs (default: the number of cores)")
-    p.add_argument("--out", type=output_file, default=None, metavar="PNG",
+    p.add_argument("--out", type=plot_output, default=None, metavar="PNG",
                    help="write the survival picture here")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     return p
@@ -161,5 +162,5 @@ def plot_survival(table: Sequence[tuple[str, dict[bool, tuple[int, int]]]], out:
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     ax.grid(axis="x", alpha=0.3)
     fig.tight_layout()
-    fig.savefig(out, dpi=90)
+    save_figure(fig, out)
     plt.close(fig)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -21,14 +22,17 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-from robot.commands.common import checked, input_file, output_file
+from robot.commands.common import checked, input_file, plot_output
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot
 from robot.errors import ConfigError
 from robot.loop.mcap_recorder import is_mcap
 from robot.motion.takes import Take, read_take
+from robot.previs.figure_file import save_figure
 from robot.previs.mcap_read import mcap_take
 from robot.servo.bench_load import BenchLoad, parse_load
+
+log = logging.getLogger(__name__)
 
 Floats = npt.NDArray[np.float64]
 PAIRS = ("real_cmd", "sim_cmd", "real_sim")
@@ -141,17 +145,22 @@ def plot(robot: RobotConfig, take: Take, sim: Floats, path: str) -> None:
         ax.set_xlabel("t [s]")
     fig.suptitle(f"sim-gap: {Path(take.source).name} [deg]")
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
+    save_figure(fig, path)
     plt.close(fig)
 
 
 def run(args: argparse.Namespace) -> int:
     from sim.mujoco.take_replay import replay
 
+    plot_path = None if args.plot is None else checked("--plot", plot_output, args.plot)
     path = checked("TAKE", input_file, args.take)
     take = mcap_take(path) if is_mcap(path) else read_take(path)
-    plot_path = None if args.plot is None else checked("--plot", output_file, args.plot)
     robot = robot_for(take, args.robot)
+    recorded_on = take.header.robot
+    if recorded_on and recorded_on != robot.name:
+        log.warning("%s was recorded on robot %r; simulating %r (--robot): the gap "
+                    "includes how the two robots differ (without --robot: the one the "
+                    "take names)", take.source, recorded_on, robot.name)
     loads = loads_from(args.load)
     if loads and args.world != "bench":
         raise ConfigError("--load: only with --world bench (the robot world has its body)")
@@ -162,10 +171,13 @@ def run(args: argparse.Namespace) -> int:
     if plot_path is not None:
         plot(robot, take, sim, plot_path)
     if args.json:
-        print(json.dumps({"take": take.source, "robot": robot.name, "world": args.world,
+        print(json.dumps({"take": take.source, "robot": robot.name,
+                          "recorded_on": recorded_on, "world": args.world,
                           "read_backs": reads,
                           "joints": [asdict(r) for r in rows]}))
     else:
-        print(f"{take.source}: {robot.name}, {args.world} world, {reads} read-back ticks")
+        other = f" (recorded on {recorded_on})" if recorded_on != robot.name else ""
+        print(f"{take.source}: {robot.name}{other}, {args.world} world, {reads} read-back "
+              "ticks")
         print(table(rows))
     return 0

@@ -1,6 +1,7 @@
 """Where a robot's extra joints (beyond the legs and arms: a head pan and tilt, a jaw, a
 tail) sit and which way they turn, from their names: one layout that the BVH and glTF
-skeletons (robot/previs/bvh.py) and the simulation (sim/mujoco/mjcf_robot.py) share.
+skeletons (robot/previs/bvh.py) and the box model (robot/body/boxes.py, through
+robot/config/body_tree.py) share.
 
 Axis (robot frame, right-hand rule): a name with ``tilt``, ``pitch``, ``nod`` or ``jaw``
 turns about y (nodding); with ``roll``, about x; anything else (``pan``, ``yaw``,

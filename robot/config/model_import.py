@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,11 +33,13 @@ from robot.body.measure import Measured, measure
 from robot.body.model import BodyModel
 from robot.body.roles import Roles, find_roles
 from robot.body.tree import BodyTree, Frame, Link, matrix_to_quat
-from robot.config.import_recipe import KNEES
+from robot.config.model_recipe import KNEES
 from robot.config.joint_names import ARM_NAMES, LEG_NAMES
 from robot.errors import ConfigError
 from robot.servo.models import MODELS, ServoModel
 
+#: A frame on the torso whose name says it is the IMU's (onshape-to-robot's "imu" frame).
+IMU_FRAME = re.compile(r"imu|bno0?55", re.IGNORECASE)
 #: The rest pose of a straight-legged robot [rad]: knees bent as the bundled robots rest
 #: (a knee that bends backward: each angle negated).
 REST = {"hip_pitch": -0.55, "knee": 1.1, "ankle_pitch": -0.55}
@@ -105,7 +108,8 @@ def knee_back(joints: list[JointEntry], knee: str | None) -> tuple[bool, str]:
 
 def _sole_frames(tree: BodyTree, roles: Roles, m: Measured) -> BodyTree:
     """The tree with a ``r_sole`` / ``l_sole`` frame on each foot (the sole point) and an
-    ``imu`` frame on the root at the torso's centre of mass."""
+    ``imu`` frame on the root, in the robot's axes: where a torso frame named for an IMU
+    is (IMU_FRAME), else at the torso's centre of mass."""
     by = roles.by_name()
     pose_angles = {j.model_joint: j.offset for j in roles.joints}
     pos, rot = tree.poses(pose_angles)
@@ -124,10 +128,16 @@ def _sole_frames(tree: BodyTree, roles: Roles, m: Measured) -> BodyTree:
     weighed = [(link.inertial.mass, pos[i] + rot[i] @ np.asarray(link.inertial.com))
                for i in torso if (link := tree.links[i]).inertial is not None]
     mass = sum(w for w, _ in weighed)
-    com = sum((w * c for w, c in weighed), np.zeros(3)) / max(mass, 1e-12)
+    mount = sum((w * c for w, c in weighed), np.zeros(3)) / max(mass, 1e-12)
+    marked = [pos[i] + rot[i] @ np.asarray(f.pos) for i in torso for f in links[i].frames
+              if IMU_FRAME.search(f.name)]
+    if marked:      # the model's own IMU frame: the sensor sits there
+        mount = marked[0]
+    links = [dataclasses.replace(link, frames=tuple(f for f in link.frames if f.name != "imu"))
+             for link in links]
     root = links[0]
     links[0] = Link(root.name, -1, root.pos, root.quat, root.inertial, None, root.shapes,
-                    (*root.frames, Frame("imu", (float(com[0]), float(com[1]), float(com[2])),
+                    (*root.frames, Frame("imu", (float(mount[0]), float(mount[1]), float(mount[2])),
                                          matrix_to_quat(axes.T))))
     del by
     return BodyTree(tuple(links), source=tree.source, excludes=tree.excludes)

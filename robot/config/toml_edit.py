@@ -9,7 +9,6 @@ nothing is written unless the result loads.
 from __future__ import annotations
 
 import os
-import tempfile
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
@@ -20,6 +19,7 @@ from tomlkit.exceptions import TOMLKitError
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import parse_robot
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
 
 EDITABLE = ("sign", "zero_ticks", "min_rad", "max_rad", "fixed_rad")
 
@@ -68,13 +68,5 @@ def write_validated(source: Path, out: Path,
     text = edit_joints(source.read_text(encoding="utf-8"), changes, source=str(source),
                        name=name, rest=rest)
     robot = parse_robot(tomllib.loads(text), source=str(out))
-    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", dir=out.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, out)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_text(out, text)
     return robot

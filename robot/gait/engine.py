@@ -288,3 +288,7 @@ class GaitEngine:
         ``with_channels=False`` returns an empty channel dict and only the joint angles."""
         return vectorised.curves(self.robot, self._target, times, chunk=chunk,
                                  with_channels=with_channels)
+
+    def sole_targets(self, times: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """The sole targets (2, n, 3) [m, pelvis frame] that ``curves`` solves for."""
+        return vectorised.sole_targets(self.robot, self._target, times)

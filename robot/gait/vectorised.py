@@ -112,3 +112,13 @@ def curves(robot: RobotConfig, p: GaitParams, times: npt.NDArray[np.float64], *,
             for _ in pool.map(one, starts):  # re-raises a chunk's exception
                 pass
     return out_ch, out_q
+
+
+def sole_targets(robot: RobotConfig, p: GaitParams, times: npt.NDArray[np.float64]
+                 ) -> npt.NDArray[np.float64]:
+    """The right and left sole targets (2, n, 3) [m, pelvis frame] the IK of ``curves``
+    solves for over ``times`` [s] (before the joint limits clamp the angles)."""
+    times = np.asarray(times, dtype=float)
+    t = body_targets(gait.curves(times, p), p, robot.geometry, leg_yaw=robot.has_hip_yaw)
+    return np.stack([np.stack([np.broadcast_to(np.asarray(v, float), times.shape)
+                               for v in sole], axis=1) for sole in (t.r_sole, t.l_sole)])

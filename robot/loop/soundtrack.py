@@ -40,6 +40,22 @@ SEEK_S = 0.25
 STDIN_PLAYERS = (("aplay", "-q", "-"), ("paplay",))
 
 
+def _unreadable(path: Path, e: Exception) -> ConfigError:
+    why = (str(e) if str(e) else "it ends before its header is whole" if isinstance(
+        e, EOFError) else type(e).__name__)
+    return ConfigError(f"audio {path}: not a readable WAV file: {why}")
+
+
+def check_wav(path: Path) -> None:
+    """ConfigError naming ``path`` and why, unless its header reads as a PCM WAV file's
+    (read before the show starts: a WAV that cannot play is refused, not a silent show)."""
+    try:
+        with wave.open(str(path), "rb") as w:
+            w.getparams()
+    except (OSError, EOFError, wave.Error) as e:
+        raise _unreadable(path, e) from None
+
+
 def wav_from(path: Path, skip_s: float) -> bytes:
     """The WAV file at ``path`` from ``skip_s`` [s] on, as a WAV (header and frames)."""
     try:
@@ -48,7 +64,7 @@ def wav_from(path: Path, skip_s: float) -> bytes:
             w.setpos(min(params.nframes, int(round(max(0.0, skip_s) * params.framerate))))
             frames = w.readframes(params.nframes)
     except (OSError, EOFError, wave.Error) as e:
-        raise ConfigError(f"audio {path}: not a readable WAV file: {e}") from None
+        raise _unreadable(path, e) from None
     out = io.BytesIO()
     with wave.open(out, "wb") as w:
         w.setparams(params)
@@ -94,6 +110,8 @@ class Soundtrack:
         if path is not None and not path.is_file():
             raise ConfigError(f"audio {path}: file not found (relative to the file that "
                               "names it)")
+        if path is not None and (player is not None or path.suffix.lower() == ".wav"):
+            check_wav(path)             # fed to the player as a WAV: it must read as one
 
     def __call__(self, tel: Telemetry) -> None:
         if self.clock is not None:               # a chased show: its own show time

@@ -258,8 +258,8 @@ class Streamer(Generic[SourceT]):
         tel.tick, tel.state, tel.q_cmd = self._ticks, state, q_list
         tel.amplitude = self.source.amplitude
         tel.fresh, tel.clamped = False, clamped
-        if self._ticks % self.read_every == 0 and not read_state(self.bus, self.map,
-                                                                  self.watchdog, tel, q):
+        if self._ticks % self.read_every == 0 and not read_state(
+                self.bus, self.map, self.watchdog, tel, q, clock=self.clock):
             self._bus_errors += 1
         self._notify()
 

@@ -1,15 +1,17 @@
 """Recording a take as the run goes (the file format: robot.motion.takes): a tick observer
-of the loop, like the CSV/JSONL recorder (robot.loop.recorder)."""
+of the loop, like the CSV/JSONL recorder (robot.loop.recorder), written the same way
+(robot.files.atomic.OutputFile): renamed into place when the run has closed if it
+ticked, else removed (an older take of that name stays as it was)."""
 
 from __future__ import annotations
 
 import json
-import time
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
 from robot.errors import ConfigError
+from robot.files.atomic import OutputFile
 from robot.loop.telemetry import Telemetry
 from robot.motion.takes import SUFFIX, TakeHeader, is_take
 
@@ -29,7 +31,7 @@ class TakeWriter:
         if not is_take(self.path):
             raise ConfigError(f"{path}: a take file name ends in {SUFFIX}")
         self.header = header
-        self._file: IO[str] | None = None
+        self._file: OutputFile | None = None
         self._last_tick = -1
         self._t0: float | None = None
         self.error: str | None = None
@@ -37,7 +39,7 @@ class TakeWriter:
 
     def open(self) -> TakeWriter:
         try:
-            self._file = self.path.open("w")
+            self._file = OutputFile(self.path).open()
         except OSError as e:
             raise ConfigError(f"--record {self.path}: cannot write it: "
                               f"{e.strerror or e}") from None
@@ -76,16 +78,20 @@ class TakeWriter:
         line: dict[str, Any] = {"tick": tel.tick, "t": tel.t - self._t0, "state": tel.state,
                                 "q": tel.q_cmd}
         if tel.fresh and tel.q_present:         # read back this tick (biped sim-gap), and
-            line["present"] = tel.q_present     # when: the reply is in [s, the t clock]
-            line["present_t"] = time.monotonic() - self._t0
+            line["present"] = tel.q_present     # when: the reply was in [s, the t clock:
+            line["present_t"] = tel.t_read - self._t0   # the sim's on the sim bus]
         self._line(line)
 
     def close_quietly(self) -> str | None:
-        """Close; the first failed write as one line, or None."""
+        """Rename the take into place if a tick was recorded, else remove it; the first
+        failed write as one line, or None."""
         if self._file is not None:
             file, self._file = self._file, None
             try:
-                file.close()
+                if self.ticks:
+                    file.commit()
+                else:
+                    file.discard()
             except OSError as e:
                 self.error = self.error or f"{self.path}: {e.strerror or e}"
         return self.error

@@ -20,7 +20,9 @@ class Telemetry:
     lateness of the last tick start [ms]; clamped: the joints (names, joint order) held at
     a limit in this tick's command: by the source (the gait engine clamps what its IK asks
     beyond a limit) or by the loop (a feedback correction beyond one); empty when none
-    was; imu: the balance stage's last IMU sample (None: no IMU in the run).
+    was; imu: the balance stage's last IMU sample (None: no IMU in the run). t and t_read [s]
+    are on the loop's clock (the wall clock on servos, the simulation's on the sim bus):
+    t the tick's start, t_read when the last read-back's reply was in.
     """
 
     t: float = 0.0
@@ -34,6 +36,7 @@ class Telemetry:
     amplitude: float = 0.0
     stop_reason: str | None = None
     fresh: bool = False  # True on ticks that read the servos back
+    t_read: float = 0.0
     clamped: tuple[str, ...] = ()
     imu: ImuSample | None = None
 

@@ -20,6 +20,7 @@ from robot.config.bundled import GAITS_DIR, gait_names, user_gaits_dir
 from robot.config.gait_file import Gait, gait_to_toml, load_gait, parse_gait
 from robot.config.params import GaitParams
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
 
 log = logging.getLogger(__name__)
 
@@ -78,11 +79,9 @@ class PresetStore:
                                     "another name or set overwrite")
         text = gait_to_toml(Gait(name=name, params=params))
         parse_gait(tomllib.loads(text), source=str(target))  # validate what we write
-        tmp = target.with_suffix(".toml.tmp")
         try:
             self.presets_dir.mkdir(parents=True, exist_ok=True)
-            tmp.write_text(text)
-            tmp.replace(target)
+            write_text(target, text)
         except OSError as e:
             raise ConfigError(f"preset {name!r}: cannot write {target}: {e.strerror or e}") \
                 from e

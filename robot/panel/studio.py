@@ -22,6 +22,7 @@ import platformdirs
 
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
 from robot.motion.keyframes import Sequence, load_sequence, parse_sequence, sequence_to_toml
 from robot.motion.layered import LayeredEngine
 from robot.motion.posing import limb_joints, limbs
@@ -163,7 +164,7 @@ class Studio:
         parse_sequence(tomllib.loads(text), self.robot, source=str(path))  # as it will load
         _writable(self.keys_dir, "keyframes")
         try:
-            path.write_text(text)
+            write_text(path, text)
         except OSError as e:
             raise ConfigError(f"sequence {seq_name!r}: cannot write {path}: "
                               f"{e.strerror or e}") from None

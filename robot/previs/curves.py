@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import csv
+import io
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -10,7 +12,9 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.config.joint_names import limb_groups
+from robot.files.atomic import write_text
 from robot.gait.expressions import CHANNELS
+from robot.previs.figure_file import save_figure
 
 # Channels grouped by body part, as the paper groups its expressions.
 CHANNEL_GROUPS: dict[str, tuple[str, ...]] = {
@@ -30,14 +34,21 @@ assert sorted(n for g in CHANNEL_GROUPS.values() for n in g) == sorted(CHANNELS)
 
 def write_csv(path: str | Path, times: npt.NDArray[np.float64],
               channels: dict[str, npt.NDArray[np.float64]], joint_names: tuple[str, ...],
-              q: npt.NDArray[np.float64]) -> None:
-    """Columns: ``t`` [s], every channel of equations.md, ``q_<joint>`` [rad]."""
+              q: npt.NDArray[np.float64], *,
+              extra: Mapping[str, npt.NDArray[np.float64]] | None = None) -> None:
+    """Columns: ``t`` [s], every channel of equations.md, ``q_<joint>`` [rad], then the
+    ``extra`` columns by name (ValueError if one is named as a column before it)."""
+    more = dict(extra or {})
     header = ["t", *CHANNELS, *(f"q_{n}" for n in joint_names)]
-    data = np.column_stack([times, *(channels[c] for c in CHANNELS), *q])
-    with Path(path).open("w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(header)
-        w.writerows(data.tolist())  # repr precision: the channels round-trip exactly
+    taken = set(header) & set(more)
+    if taken:
+        raise ValueError(f"column {sorted(taken)[0]!r} twice")
+    data = np.column_stack([times, *(channels[c] for c in CHANNELS), *q, *more.values()])
+    text = io.StringIO()
+    w = csv.writer(text)
+    w.writerow([*header, *more])
+    w.writerows(data.tolist())  # repr precision: the channels round-trip exactly
+    write_text(path, text.getvalue())
 
 
 def palette(n: int) -> list[tuple[float, float, float, float]]:
@@ -108,5 +119,5 @@ def plot_curves(path: str | Path, times: npt.NDArray[np.float64],
     import matplotlib.pyplot as plt
 
     fig = curves_figure(times, channels, joint_names, q, title=title)
-    fig.savefig(path, dpi=90)
+    save_figure(fig, path)
     plt.close(fig)

@@ -15,7 +15,11 @@ spec allows for rotations).
 
 from __future__ import annotations
 
+import os
+import struct
+import warnings
 from pathlib import Path
+from urllib.parse import unquote, urlsplit
 
 import numpy as np
 import pygltflib as gl
@@ -28,6 +32,8 @@ from robot.previs.rotations import quat_matrix
 COMPONENTS = {5126: ("<f4", 0.0), 5120: ("<i1", 127.0), 5121: ("<u1", 255.0),
               5122: ("<i2", 32767.0), 5123: ("<u2", 65535.0)}
 WIDTH = {"SCALAR": 1, "VEC3": 3, "VEC4": 4, "MAT4": 16}
+#: Bytes of a .glb's header (magic, version, total length).
+GLB_HEADER = 12
 #: Most frames resampled (an hour at 60 fps).
 MAX_FRAMES = 216_000
 
@@ -99,9 +105,61 @@ def _sample(kind: str, t: Array, times: Array, values: Array, rotation: bool) ->
     return np.column_stack([np.interp(t, times, values[:, c]) for c in range(values.shape[1])])
 
 
+def check_glb(p: Path) -> None:
+    """ConfigError unless the .glb's lengths (the header's total, each chunk's) fit the
+    file: read before pygltflib, which reads as many bytes as a chunk says it holds."""
+    try:
+        size = p.stat().st_size
+        with p.open("rb") as f:
+            head = f.read(GLB_HEADER)
+            if len(head) < GLB_HEADER or head[:4] != b"glTF":
+                return                                  # pygltflib says what is wrong
+            total = struct.unpack_from("<I", head, 8)[0]
+            if total != size:
+                raise ConfigError(f"{p}: its header says {total} bytes; the file has {size}")
+            at = GLB_HEADER
+            while at < size:
+                f.seek(at)
+                chunk = f.read(8)
+                if len(chunk) < 8:
+                    raise ConfigError(f"{p}: the chunk at byte {at} is cut short")
+                n, kind = struct.unpack("<I4s", chunk)
+                if n > size - at - 8:
+                    name = kind.rstrip(b"\0").decode("ascii", "replace")
+                    raise ConfigError(f"{p}: its {name} chunk at byte {at} says {n} bytes; "
+                                      f"{size - at - 8} follow in the file")
+                at += 8 + n
+    except OSError as e:
+        raise ConfigError(f"{p}: cannot read it: {e.strerror or e}") from None
+
+
+def check_uris(doc: gl.GLTF2, p: Path) -> None:
+    """ConfigError unless every buffer and image uri is a data: URI or a file inside the
+    glTF's folder (a relative path that stays there, links resolved): nothing is read
+    from anywhere else (an absolute path, another scheme, ``..`` out of the folder)."""
+    folder = os.path.realpath(p.parent)
+    for kind, items in (("buffers", doc.buffers), ("images", doc.images)):
+        for i, item in enumerate(items or []):
+            uri = item.uri
+            if uri is None or uri.startswith("data:"):
+                continue
+            where = f"{p}: {kind}[{i}].uri {uri[:60]!r}"
+            path = unquote(uri)
+            why = ("has a scheme other than data:" if urlsplit(uri).scheme else
+                   "is an absolute path" if os.path.isabs(path) or path.startswith("\\") else
+                   "leaves the glTF's folder" if os.path.commonpath(
+                       [folder, os.path.realpath(os.path.join(folder, path))]) != folder
+                   else None)
+            if why:
+                raise ConfigError(f"{where}: {why}; expected a data: URI or a file in "
+                                  f"{p.parent} (a relative path)")
+
+
 def read_gltf(path: str | Path) -> Rig:
     p = Path(path)
     src = str(p)
+    if p.suffix.lower() == ".glb":
+        check_glb(p)
     try:
         doc = gl.GLTF2().load(src)
     except FileNotFoundError:
@@ -111,9 +169,12 @@ def read_gltf(path: str | Path) -> Rig:
     if doc is None or not doc.skins or not doc.animations:
         raise ConfigError(f"{p}: no skin or no animation; expected a skinned, animated "
                           "glTF (Blender: File > Export > glTF 2.0 with the armature)")
+    check_uris(doc, p)
     blob = doc.binary_blob()
     if blob is None:
-        doc.convert_buffers(gl.BufferFormat.BINARYBLOB)
+        with warnings.catch_warnings():     # "will leave x.bin orphaned": we write nothing
+            warnings.simplefilter("ignore", UserWarning)
+            doc.convert_buffers(gl.BufferFormat.BINARYBLOB)
         blob = doc.binary_blob() or b""
     joints = list(doc.skins[0].joints)
     up: dict[int, int] = {c: i for i, n in enumerate(doc.nodes) for c in n.children}

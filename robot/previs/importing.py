@@ -17,8 +17,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -28,6 +26,7 @@ from tqdm import tqdm
 from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
+from robot.files.atomic import OutputFile
 from robot.motion.interp import smooth
 from robot.motion.kinks import sampled
 from robot.motion.show import Show
@@ -56,7 +55,12 @@ def read_rig(path: str | Path, *, progress: bool = False) -> Rig:
     suffix = Path(path).suffix.lower()
     if suffix not in SUFFIXES:
         raise ConfigError(f"{path}: expected a {', '.join(SUFFIXES)} animation")
-    return read_bvh(path, progress=progress) if suffix == ".bvh" else read_gltf(path)
+    rig = read_bvh(path, progress=progress) if suffix == ".bvh" else read_gltf(path)
+    if rig.frames < 2:
+        raise ConfigError(f"{path}: {rig.frames} frame: a pose, not an animation; a take "
+                          "needs at least 2 frames (a pose: biped capture, or a keyframe "
+                          "file for biped play)")
+    return rig
 
 
 @dataclass(frozen=True)
@@ -97,8 +101,7 @@ def import_animation(path: str | Path, robot: RobotConfig, bone_map: BoneMap, ho
         raise ConfigError(f"{path}: {frames.t[-1]:.0f} s at {rate:g} Hz is {n} ticks, more "
                           f"than a take holds ({MAX_TICKS}); lower --rate or cut the animation")
     t = np.arange(n) / rate
-    raw = (frames.q[:1].copy() if len(frames.t) < 2 else
-           sampled(frames.t, frames.q, t, lo=np.array([j.min_rad for j in robot.joints]),
+    raw = (sampled(frames.t, frames.q, t, lo=np.array([j.min_rad for j in robot.joints]),
                   hi=np.array([j.max_rad for j in robot.joints]))
            if rig.sampled else smooth(frames.t, frames.q, t))
     found = check(robot, t, raw, max_accel=max_accel, joints=frames.animated)
@@ -122,32 +125,27 @@ def write_stream_take(path: str | Path, robot: RobotConfig, params: GaitParams,
     header = TakeHeader(robot=robot.name, robot_file=robot.source,
                         joints=robot.joint_names, rate_hz=imported.rate_hz, read_every=10,
                         gait="import", params=params, note=note, show=show.as_json())
-    out = Path(path)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", dir=out.parent or ".")
-    except OSError as e:
-        raise ConfigError(f"--out {path}: cannot write it: {e.strerror or e}") from None
+    out = OutputFile(path, buffer_bytes=1 << 20)
     n = len(imported.t)
     try:
-        with os.fdopen(fd, "w") as f, tqdm(total=n, unit="tick", leave=False,
-                                           desc=f"writing {out.name}",
-                                           disable=not progress or n < PROGRESS_TICKS) as bar:
-            f.write(json.dumps(header.as_json()) + "\n")
+        out.open()
+        with tqdm(total=n, unit="tick", leave=False, desc=f"writing {Path(path).name}",
+                  disable=not progress or n < PROGRESS_TICKS) as bar:
+            out.write(json.dumps(header.as_json()) + "\n")
             for event in travel(imported.walks).timeline(imported.rate_hz):
-                f.write(json.dumps(event) + "\n")
+                out.write(json.dumps(event) + "\n")
             for start in range(0, n, WRITE_ROWS):
                 ts = imported.t[start:start + WRITE_ROWS].tolist()
                 qs = imported.q[start:start + WRITE_ROWS].tolist()
-                f.writelines(_tick_line(start + k, t, row)
-                             for k, (t, row) in enumerate(zip(ts, qs, strict=True)))
+                out.write("".join(_tick_line(start + k, t, row)
+                                  for k, (t, row) in enumerate(zip(ts, qs, strict=True))))
                 bar.update(len(ts))
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, out)
+        out.commit(partial=False)                 # a take is whole or absent
     except OSError as e:
-        Path(tmp).unlink(missing_ok=True)
+        out.discard()
         raise ConfigError(f"--out {path}: cannot write it: {e.strerror or e}") from None
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        out.discard()
         raise
 
 

@@ -17,6 +17,7 @@ from robot.config.toml_io import parse_json
 from robot.errors import ConfigError
 from robot.gait.expressions import CHANNELS
 from robot.previs.curves import outside_legend, palette, plot_curves
+from robot.previs.figure_file import save_figure
 from robot.previs.mcap_read import mcap_rows
 
 Array = npt.NDArray[np.float64]
@@ -223,5 +224,5 @@ def plot_record(table: Table, out: str | Path) -> None:
     import matplotlib.pyplot as plt
 
     fig = record_figure(table)
-    fig.savefig(out, dpi=90)
+    save_figure(fig, out)
     plt.close(fig)

@@ -24,6 +24,7 @@ from robot.config.joint_names import limb_groups
 from robot.config.robot import RobotConfig
 from robot.loop.watchdog import WatchdogConfig
 from robot.previs.curves import outside_legend, palette
+from robot.previs.figure_file import save_figure
 
 Array = npt.NDArray[np.float64]
 #: Torque headroom below this [%] is flagged.
@@ -167,5 +168,5 @@ def plot_check(check: ShowCheck, out: str | Path, *, title: str) -> None:
                    loc="left", fontsize=10)
     bars.grid(alpha=0.3, axis="y")
     fig.suptitle(title)
-    fig.savefig(out, dpi=90)
+    save_figure(fig, out)
     plt.close(fig)

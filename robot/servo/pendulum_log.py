@@ -25,6 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.errors import ConfigError
+from robot.files.atomic import write_bytes
 from robot.servo import log_rules as rules
 
 Floats = npt.NDArray[np.float64]
@@ -172,9 +173,7 @@ def write_log(log: PendulumLog, path: str | Path) -> Path:
     before anything is written, so every log written can be read."""
     p = Path(path)
     text = json.dumps(checked_log(log).to_json(), separators=(",", ":")).encode()
-    tmp = p.with_name(f".{p.name}.tmp")
-    tmp.write_bytes(gzip.compress(text, mtime=0) if p.suffix == ".gz" else text)
-    tmp.replace(p)
+    write_bytes(p, gzip.compress(text, mtime=0) if p.suffix == ".gz" else text)
     return p
 
 

@@ -3,9 +3,9 @@
 Three kinds of entry, best first:
 
 1. identified from real recordings by this project (``biped identify fit`` on the public
-   pendulum logs of Rhoban/bam, tests/data/bam/): XL330-M288, STS3250. Their fitted files
-   ship as ``robot/configs/servos/<model>.toml``; ``robot.config.servo_file.physics_for``
-   prefers those files to this table.
+   pendulum logs of Rhoban/bam, kept beside the repository in ../shared/servo_logs/bam/):
+   XL330-M288, STS3250. Their fitted files ship as ``robot/configs/servos/<model>.toml``;
+   ``robot.config.servo_file.physics_for`` prefers those files to this table.
 2. identified by Rhoban/bam on their own recordings, numbers carried over as facts:
    STS3215 at 7.4 V (``bam/params/feetech_sts3215_7_4V/m1.json``).
 3. datasheet stall torque and no-load speed at the nominal voltage (kt and R follow), the

@@ -29,8 +29,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import os
-import tempfile
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -39,6 +37,7 @@ from pathlib import Path
 from robot.config.params import SPECS, canonical_name
 from robot.config.toml_io import Range, number, read_toml, show
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
 from robot.showctl.actions import Command, Named
 from robot.showctl.entry import KEYS, entry_action
 
@@ -216,11 +215,4 @@ def save_map(m: MidiMap, path: Path) -> None:
             m, source=str(path)):
         raise ConfigError(f"{path}: the mapping would not read back as it is; not written")
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_text(path, text)                # whole (robot/files/atomic.py)

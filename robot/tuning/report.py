@@ -16,6 +16,8 @@ import optuna
 from robot.config.gait_file import Gait, gait_to_toml, load_gait
 from robot.config.params import SPECS, GaitParams
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
+from robot.previs.figure_file import save_figure
 from robot.tuning.objective import WALK_SHARE
 from robot.tuning.space import Knob
 
@@ -27,7 +29,7 @@ def write_preset(path: str | Path, params: GaitParams, *, name: str,
     path = Path(path)
     gait = Gait(name=name, params=params, source=str(path))
     text = f"# {description}\n" + gait_to_toml(gait)
-    path.write_text(text)
+    write_text(path, text)
     back = load_gait(str(path))
     if back.params != params:
         raise ConfigError(f"{path}: the written preset does not load back unchanged")
@@ -118,7 +120,7 @@ def plot_study(study: optuna.Study, prefix: str | Path, *,
         ax.figure.set_size_inches(8, 4.5)
         ax.figure.tight_layout()
         path = Path(f"{prefix}.{suffix}.png")
-        ax.figure.savefig(path, dpi=90)
+        save_figure(ax.figure, path)
         plt.close(ax.figure)
         out.append(path)
     with warnings.catch_warnings():

@@ -1,5 +1,6 @@
 """The simulated IMU (``[imu] kind = "sim"``): MuJoCo's gyro, accelerometer and framequat
-sensors at the ``imu`` site on the torso (``sim.mujoco.mjcf_robot``; the site's axes are the
+sensors at the ``imu`` site on the torso (the body tree's ``imu`` frame, robot/body/boxes.py
+for the box model; the sensors: ``sim.mujoco.mjcf_robot``; the site's axes are the
 torso's), made to look like a BNO055: white noise, a constant bias and latency.
 
 Measurement model, per axis, in the IMU (device) frame (the torso frame rotated by

@@ -1,12 +1,13 @@
 """RobotConfig → MJCF (MuJoCo Menagerie conventions): ``robot.xml`` plus ``scene.xml``.
 
-robot.xml: compiler/option, ``<default>`` classes (one per servo model, nested one per
-joint group carrying axis, joint range and actuator ctrlrange; ``visual`` / ``collision``
-geom classes), the body tree (free joint ``root`` on the ``torso`` body, whose frame is the
-pelvis frame), position actuators named after their joints, IMU sensors, sole and hand
-sites, and a ``home`` keyframe: the robot's rest pose standing with the lowest sole point
-at z = 0. scene.xml includes robot.xml and adds floor, light, skybox and the tracking
-camera ``track``.
+robot.xml: compiler/option, ``<default>`` classes (the robot's; ``visual``, ``collision``
+and the contact classes), the body tree (robot/config/body_tree.py: the box model or the
+imported body, in the robot's terms, written by sim/mujoco/mjcf_body.py; free joint
+``root`` on the ``torso`` body, whose frame is the pelvis frame), position actuators named
+after their joints, IMU sensors, sole and hand sites, and a ``home`` keyframe: the robot's
+rest pose standing with the lowest sole point at z = 0. scene.xml includes robot.xml and
+adds floor, light, skybox and the tracking camera ``track``. Every robot, box model or
+imported, is written the same way, and what ``biped mjcf`` writes is what is simulated.
 
 Servo model (``sim.mujoco.servo_law``, written per joint by
 ``sim.mujoco.mjcf_robot.servo_attributes``): each actuator is the firmware's position law at
@@ -27,11 +28,13 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 
+from robot.config.body_tree import robot_tree, stand_height
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
+from robot.files.atomic import write_text
 from sim.mujoco.geoms import foot_geoms, geom_points
-from sim.mujoco.mjcf_body import add_body_actuators, add_body_defaults, add_body_worldbody
-from sim.mujoco.mjcf_robot import add_actuators_and_sensors, add_assets, add_defaults, add_worldbody, fmt
+from sim.mujoco.mjcf_body import add_worldbody, has_visuals
+from sim.mujoco.mjcf_robot import add_actuators_and_sensors, add_assets, add_defaults, fmt
 
 if TYPE_CHECKING:
     from sim.mujoco.world import World
@@ -54,8 +57,8 @@ class Mjcf:
         try:
             out.mkdir(parents=True, exist_ok=True)
             robot_path, scene_path = out / ROBOT_FILE, out / SCENE_FILE
-            robot_path.write_text(self.robot)
-            scene_path.write_text(self.scene)
+            write_text(robot_path, self.robot)
+            write_text(scene_path, self.scene)
         except OSError as e:
             raise ConfigError(f"--out {out}: cannot write MJCF files: {e.strerror}") from e
         return robot_path, scene_path
@@ -82,23 +85,15 @@ def robot_xml(robot: RobotConfig, *, timestep: float = DEFAULT_TIMESTEP,
               ctrl: npt.NDArray[np.float64] | None = None) -> str:
     """The robot MJCF; ``home`` (qpos) adds the ``home`` keyframe with ``ctrl`` (default:
     its joints, in actuator order)."""
+    tree = robot_tree(robot)
     root = ET.Element("mujoco", model=robot.name)
-    if robot.body is None:
-        ET.SubElement(root, "compiler", angle="radian", autolimits="true")
-    else:   # every link's mass is its own inertial (none from the shapes)
-        ET.SubElement(root, "compiler", angle="radian", autolimits="true",
-                      inertiafromgeom="false")
+    # every link's mass is its own inertial (none from the shapes)
+    ET.SubElement(root, "compiler", angle="radian", autolimits="true", inertiafromgeom="false")
     ET.SubElement(root, "option", timestep=fmt(timestep), integrator="implicitfast")
-    if robot.body is None:
-        add_defaults(root, robot)
-        add_assets(root)
-        add_worldbody(root, robot)
-        add_actuators_and_sensors(root, robot)
-    else:
-        add_body_defaults(root, robot)
-        add_assets(root)
-        add_body_worldbody(root, robot, -min(leg.zero_sole()[2] for leg in robot.body.legs))
-        add_body_actuators(root, robot)
+    add_defaults(root, robot, drawn=not has_visuals(tree))
+    add_assets(root)
+    add_worldbody(root, tree, childclass=robot.name, height0=stand_height(robot))
+    add_actuators_and_sensors(root, robot)
     if home is not None:
         keyframe = ET.SubElement(root, "keyframe")
         ET.SubElement(keyframe, "key", name="home", qpos=fmt(*home),

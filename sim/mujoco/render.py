@@ -8,8 +8,10 @@ Frames are written with imageio: .mp4 through imageio-ffmpeg's bundled ffmpeg (H
 
 from __future__ import annotations
 
+import errno
 import logging
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -21,6 +23,7 @@ from robot.bus.servo_map import ServoMap
 from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
+from robot.files.atomic import replacing
 from robot.gait.engine import GaitEngine
 from robot.loop.streamer import Streamer, Telemetry
 from sim.mujoco.bus import MujocoBus
@@ -76,23 +79,54 @@ def _writer(path: Path, fps: float) -> Any:
 
     if path.suffix.lower() == ".mp4":
         return imageio.get_writer(path, format="FFMPEG", mode="I", fps=fps, codec="libx264",
-                                  quality=7, macro_block_size=2, pixelformat="yuv420p")
+                                  quality=7, macro_block_size=2, pixelformat="yuv420p",
+                                  ffmpeg_log_level="quiet")   # its failures: _check_clip
     return None
+
+
+def _check_clip(path: Path, frames: int) -> None:
+    """OSError unless ffmpeg reads ``frames`` frames back from the clip it wrote: imageio
+    does not look at how ffmpeg exited (a full disk as it wrote the trailer: a clip that
+    does not play, and no error)."""
+    import imageio_ffmpeg
+
+    try:
+        got = imageio_ffmpeg.count_frames_and_secs(str(path))[0]
+    except RuntimeError:                     # ffmpeg cannot read it at all
+        got = 0
+    if got != frames:
+        full = os.statvfs(path.parent).f_bavail == 0
+        raise OSError(errno.ENOSPC if full else errno.EIO,
+                      os.strerror(errno.ENOSPC) if full
+                      else f"ffmpeg wrote a clip of {got} frames, not {frames}", str(path))
 
 
 def render_walk(robot: RobotConfig, params: GaitParams, out: str | Path, *,
                 spec: ClipSpec = ClipSpec(), progress: bool = True) -> ClipResult:
-    """Walk ``params`` on a fresh MujocoBus and write ``spec.frames`` frames to ``out``."""
+    """Walk ``params`` on a fresh MujocoBus and write ``spec.frames`` frames to ``out``
+    (whole, robot.files.atomic; OSError if it cannot be written)."""
+    path = check_output(out, spec)
+    with replacing(path) as temp:    # whole or not at all (a device: copied at the end)
+        count, fell = _render(robot, params, temp, spec=spec, progress=progress,
+                              label=path.name)
+    log.info("wrote %s: %d frames at %g fps", path, count, spec.fps)
+    return ClipResult(path=path, frames=count, seconds=count / spec.fps, fell=fell)
+
+
+def _render(robot: RobotConfig, params: GaitParams, path: Path, *, spec: ClipSpec,
+            progress: bool, label: str) -> tuple[int, bool]:
+    """Walk and write the clip to ``path``; (frames written, whether the robot fell).
+    OSError if the clip cannot be written."""
     from tqdm import tqdm
 
     from sim.mujoco.metrics import WalkMonitor
 
-    path = check_output(out, spec)
     n = spec.frames
     frames: list[Frame] = []
     writer = _writer(path, spec.fps)
     bus = MujocoBus(robot)
-    bar = tqdm(total=n, unit="frame", desc=f"render {path.name}", disable=not progress)
+    bar = tqdm(total=n, unit="frame", desc=f"render {label}", disable=not progress)
+    failed: list[OSError] = []
     try:
         with bus:
             monitor = WalkMonitor(standing_height=bus.standing_height)
@@ -105,7 +139,12 @@ def render_walk(robot: RobotConfig, params: GaitParams, out: str | Path, *,
                     return
                 frame = bus.render(spec.width, spec.height, camera=spec.camera)
                 if writer is not None:
-                    writer.append_data(frame)
+                    try:
+                        writer.append_data(frame)
+                    except OSError as e:       # ffmpeg could not write: end the clip
+                        failed.append(e)
+                        streamer.request_stop("clip cannot be written")
+                        return
                 else:
                     frames.append(frame.copy())
                 box["count"] += 1
@@ -121,11 +160,13 @@ def render_walk(robot: RobotConfig, params: GaitParams, out: str | Path, *,
         bar.close()
         if writer is not None:
             writer.close()
+    if failed:
+        raise failed[0]
     if writer is None:
         _write_gif(path, frames, spec.fps)
-    count = int(box["count"])
-    log.info("wrote %s: %d frames at %g fps", path, count, spec.fps)
-    return ClipResult(path=path, frames=count, seconds=count / spec.fps, fell=monitor.fell)
+    else:
+        _check_clip(path, int(box["count"]))
+    return int(box["count"]), monitor.fell
 
 
 def _write_gif(path: Path, frames: list[Frame], fps: float) -> None:

@@ -33,8 +33,8 @@ from robot.body.measure import Measured, measure
 from robot.body.model import BodyModel
 from robot.body.roles import Roles, find_roles
 from robot.body.tree import BodyTree, Frame, Link, matrix_to_quat
-from robot.config.model_recipe import KNEES
 from robot.config.joint_names import ARM_NAMES, LEG_NAMES
+from robot.config.model_recipe import KNEES
 from robot.errors import ConfigError
 from robot.servo.models import MODELS, ServoModel
 

@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
     gait = gait_from(args)
     times = np.arange(n) / args.rate
-    engine = GaitEngine(robot, gait.params)
+    engine = GaitEngine(robot, gait.for_robot(robot))
     channels, q = engine.curves(times)
     extra = model_columns(robot, engine, times, q, angles=args.model_angles,
                           targets=args.targets)

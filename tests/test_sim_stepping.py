@@ -31,13 +31,14 @@ def test_each_tick_ends_with_the_sensors_of_every_step_on(robot: str, timestep: 
     bus = MujocoBus(load_robot(robot), timestep=timestep)
     with bus:
         bus.set_torque(bus.robot.ids, enabled=True)
-        bus.advance(bus.data.time + tick)       # the setpoints settle: ctrl now constant
+        bus.advance(bus.data.time + tick)       # the setpoints settle: a tick's ctrl is constant
         m, d = bus.model, bus.data
         flags, dt = m.opt.disableflags, m.opt.timestep
         ref = copy.copy(d)    # MuJoCo alone, one step at a time, sensors on in every step
         for k in range(1, 8):
             deadline = ref.time + tick
             bus.advance(deadline)
+            ref.ctrl[:] = d.ctrl   # the tick's ctrl (the firmware's I term sets it per tick)
             for _ in range(int((deadline - ref.time) / dt + 1e-6)):   # the bus's whole steps
                 mujoco.mj_step(m, ref)
             if deadline - ref.time > 1e-9:                            # and its short one

@@ -4,14 +4,15 @@ Each robot of `biped bench --only sim` (the two box models and the two imported 
 walks the ``walk`` preset (with the robot's own ``[gait]``) for 10 s on the sim bus, open
 loop and with balance (the sim IMU and robot.balance), exactly as the bench runs it
 (robot.bench.sim); the final state of the physics (qpos, qvel, sim time) and the last
-commanded joint angles are compared bit for bit with tests/data/sim_walk_golden.json. A 10 s walk is chaotic enough that any
-change to what is computed (an operation reordered, a contact dropped or added, one
-step more or less) shows in the last bits of qpos, so this is the check that a speed-up
-of the loop changed no result.
+commanded joint angles are compared bit for bit with tests/data/sim_walk_golden.json. A 10
+s walk is chaotic enough that any change to what is computed (an operation reordered, a
+contact dropped or added, one step more or less) shows in the last bits of qpos, so this
+is the check that a speed-up of the loop changed no result.
 
 The fixture was written by ``python tests/test_sim_walk_golden.py --write`` from main's
-code before the change (run with main's tree first on PYTHONPATH). Bit-for-bit equality is a property of one platform (MuJoCo's build,
-numpy, libm, the CPU): the fixture records where it was made and a mismatch says so.
+code before the change (run with main's tree first on PYTHONPATH). Bit-for-bit equality is
+a property of one platform (MuJoCo's build, numpy, libm, the CPU): the fixture records
+where it was made and a mismatch says so.
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ convention, robot.balance.law). Units: m, m/s, rad.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import NamedTuple
 
 from robot.config.joint_names import LEG_JOINTS
@@ -60,16 +60,56 @@ def level(v: tuple[float, float, float], roll: float, pitch: float
     return cp * x + sp * z, y, -sp * x + cp * z
 
 
+Legs = tuple[Sequence[float], Sequence[float]]
+#: The right and left sole points [m] in the pelvis frame for (right, left) leg angles.
+SolesOf = Callable[[Legs], tuple[Point, Point]]
+
+
+def leg_soles(g: Geometry, legs: Legs) -> tuple[Point, Point]:
+    """The right and left sole points [m] in the pelvis frame (the legs' forward
+    kinematics) for the (right, left) leg angles [rad]."""
+    right, _ = leg_fk_full(g, "r", tuple(legs[0]))
+    left, _ = leg_fk_full(g, "l", tuple(legs[1]))
+    return right, left
+
+
+class SoleMemo:
+    """``leg_soles`` of one geometry, remembered for one tick: the estimate asks for each
+    pose of the legs twice, at its tick and as the tick before at the next (the same
+    numbers: the kinematics is a function of the angles). ``tick()`` starts a tick."""
+
+    def __init__(self, g: Geometry) -> None:
+        self.g = g
+        self._now: dict[Legs, tuple[Point, Point]] = {}
+        self._last: dict[Legs, tuple[Point, Point]] = {}
+
+    def tick(self) -> None:
+        self._last, self._now = self._now, {}
+
+    def __call__(self, legs: Legs) -> tuple[Point, Point]:
+        got = self._now.get(legs) or self._last.get(legs)
+        if got is None:
+            got = leg_soles(self.g, legs)
+        self._now[legs] = got
+        return got
+
+
+def over_soles(soles: tuple[Point, Point], roll: float, pitch: float
+               ) -> tuple[Point, Point]:
+    """The pelvis's position (forward, left, up) [m] relative to the right and to the
+    left sole point (pelvis frame), level frame, for the torso tilt [rad]."""
+    out = []
+    for sole in soles:
+        x, y, z = level((float(sole[0]), float(sole[1]), float(sole[2])), roll, pitch)
+        out.append((-x, -y, -z))
+    return out[0], out[1]
+
+
 def body_over_soles(g: Geometry, q_right: Sequence[float], q_left: Sequence[float],
                     roll: float, pitch: float) -> tuple[Point, Point]:
     """The pelvis's position (forward, left, up) [m] relative to the right and to the
     left sole point, level frame, for leg angles [rad] and torso tilt [rad]."""
-    out = []
-    for side, q in (("r", q_right), ("l", q_left)):
-        sole, _ = leg_fk_full(g, side, tuple(q))
-        x, y, z = level((float(sole[0]), float(sole[1]), float(sole[2])), roll, pitch)
-        out.append((-x, -y, -z))
-    return out[0], out[1]
+    return over_soles(leg_soles(g, (q_right, q_left)), roll, pitch)
 
 
 def support_weight(standing: tuple[bool, bool]) -> float:
@@ -79,9 +119,8 @@ def support_weight(standing: tuple[bool, bool]) -> float:
     return 1.0 if r and not l_ else 0.0 if l_ and not r else 0.5
 
 
-def over_support(g: Geometry, legs: tuple[Sequence[float], Sequence[float]],
-                 before: tuple[Sequence[float], Sequence[float]] | None,
-                 tilt: Quad, weight: float, dt: float) -> Quad:
+def over_support(g: Geometry, legs: Legs, before: Legs | None, tilt: Quad, weight: float,
+                 dt: float, *, soles_of: SolesOf | None = None) -> Quad:
     """(x, y, vx, vy): the pelvis over its support [m] and its velocity there [m/s].
 
     legs: (right, left) leg angles [rad] now; before: the same one tick ``dt`` [s] ago
@@ -89,11 +128,13 @@ def over_support(g: Geometry, legs: tuple[Sequence[float], Sequence[float]],
     rate [rad/s]); weight: the right sole's share of the support (``support_weight``).
     The velocity has two parts: the legs' motion (the change of the position over the
     same support at the same tilt) and the tilt's rate turning the pelvis about the sole
-    (omega x c: pitch rate x height forward, -roll rate x height to the left)."""
+    (omega x c: pitch rate x height forward, -roll rate x height to the left).
+    soles_of: ``leg_soles`` of ``g`` (a ``SoleMemo``), by default computed afresh."""
     roll, pitch, roll_rate, pitch_rate = tilt
+    fk = soles_of if soles_of is not None else (lambda q: leg_soles(g, q))
 
-    def at(q: tuple[Sequence[float], Sequence[float]]) -> Point:
-        a, b = body_over_soles(g, q[0], q[1], roll, pitch)
+    def at(q: Legs) -> Point:
+        a, b = over_soles(fk(q), roll, pitch)
         return (weight * a[0] + (1.0 - weight) * b[0], weight * a[1] + (1.0 - weight) * b[1],
                 weight * a[2] + (1.0 - weight) * b[2])
     x, y, z = at(legs)

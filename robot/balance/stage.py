@@ -16,6 +16,7 @@ import numpy as np
 
 from robot.balance.kinematic import (
     LegSlots,
+    SoleMemo,
     leg_angles,
     over_support,
     support_weight,
@@ -102,6 +103,7 @@ class Balance:
         self._present = present
         self.slots = JointSlots.of(engine.robot.joint_names)
         self.legs = LegSlots.of(engine.robot.joint_names)
+        self._soles = SoleMemo(engine.robot.geometry)
         self._sent: np.ndarray | None = None
         self._lag: np.ndarray | None = None
         self._lag_seen: np.ndarray | None = None
@@ -173,10 +175,13 @@ class Balance:
         want = support_weight((not gait.swinging[0], not gait.swinging[1]))
         w = self._w = (want if self._w is None
                        else self._w + min(1.0, dt / SUPPORT_TAU_S) * (want - self._w))
-        g = self.engine.robot.geometry
+        g, soles = self.engine.robot.geometry, self._soles
+        soles.tick()
         measured = over_support(g, legs, self._before,
-                                (tilt.roll, tilt.pitch, tilt.roll_rate, tilt.pitch_rate), w, dt)
-        planned = over_support(g, plan, self._plan_before, (0.0, 0.0, 0.0, 0.0), w, dt)
+                                (tilt.roll, tilt.pitch, tilt.roll_rate, tilt.pitch_rate), w, dt,
+                                soles_of=soles)
+        planned = over_support(g, plan, self._plan_before, (0.0, 0.0, 0.0, 0.0), w, dt,
+                               soles_of=soles)
         t = self.engine.trim
         shift = (w * t.r_dx + (1.0 - w) * t.l_dx, w * t.r_dy + (1.0 - w) * t.l_dy)
         b = self._trim_before

@@ -132,10 +132,10 @@ def disturbance(rhythm: Rhythm, values: Quad, p: GaitParams, g: GaitPhase, movin
         return rhythm, (0.0, 0.0, 0.0, 0.0)
     a = g.amplitude * moving
     learned = rhythm.at(g.theta)
-    e_roll, e_pitch, r_roll, r_pitch = (v - a * m for v, m in zip(values, learned, strict=True))
+    e_roll, e_pitch, r_roll, r_pitch = [v - a * m for v, m in zip(values, learned, strict=True)]
     if a >= 0.999 and p.bal_learn_cycles > 0.0:
-        target = tuple(m + _clip(v - m, c)
-                       for v, m, c in zip(values, learned, clip, strict=True))
+        target = tuple([m + _clip(v - m, c)
+                        for v, m, c in zip(values, learned, clip, strict=True)])
         rhythm = rhythm.learn(g.theta, target, g.dtheta, p.bal_learn_cycles)
     if p.bal_learn_cycles > 0.0 and rhythm.cycles < LEARNED:
         return rhythm, (0.0, 0.0, 0.0, 0.0)

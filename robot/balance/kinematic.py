@@ -48,7 +48,7 @@ class LegSlots(NamedTuple):
 
 def leg_angles(q: Sequence[float], slots: tuple[int | None, ...]) -> tuple[float, ...]:
     """The six angles [rad] of one leg from the joint vector ``q``; 0 where it has none."""
-    return tuple(0.0 if i is None else float(q[i]) for i in slots)
+    return tuple([0.0 if i is None else float(q[i]) for i in slots])
 
 
 def level(v: tuple[float, float, float], roll: float, pitch: float

@@ -168,7 +168,8 @@ class Balance:
         feedback put under the support (robot.balance.kinematic.unplanned)."""
         held = self.held(q, dt).tolist()
         legs = (leg_angles(held, self.legs.right), leg_angles(held, self.legs.left))
-        plan = (leg_angles(q.tolist(), self.legs.right), leg_angles(q.tolist(), self.legs.left))
+        q_list = q.tolist()
+        plan = (leg_angles(q_list, self.legs.right), leg_angles(q_list, self.legs.left))
         # The support moves from foot to foot over SUPPORT_TAU_S, not in one tick: the two
         # feet's unplanned offsets differ by a few mm, and a jump by half of that at a
         # lift that the learned rhythm places a bin early or late reads as a push.

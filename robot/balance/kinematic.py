@@ -54,8 +54,13 @@ def leg_angles(q: Sequence[float], slots: tuple[int | None, ...]) -> tuple[float
 def level(v: tuple[float, float, float], roll: float, pitch: float
           ) -> tuple[float, float, float]:
     """Vector ``v`` [m] of the pelvis frame in the level frame: R_y(pitch) R_x(roll) v."""
+    return _level(v, math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch))
+
+
+def _level(v: tuple[float, float, float], cr: float, sr: float, cp: float, sp: float
+           ) -> tuple[float, float, float]:
+    """``level`` with the cosines and sines of roll and pitch given."""
     x, y, z = v
-    cr, sr, cp, sp = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch)
     y, z = cr * y - sr * z, sr * y + cr * z
     return cp * x + sp * z, y, -sp * x + cp * z
 
@@ -98,9 +103,10 @@ def over_soles(soles: tuple[Point, Point], roll: float, pitch: float
                ) -> tuple[Point, Point]:
     """The pelvis's position (forward, left, up) [m] relative to the right and to the
     left sole point (pelvis frame), level frame, for the torso tilt [rad]."""
+    cs = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch)
     out = []
     for sole in soles:
-        x, y, z = level((float(sole[0]), float(sole[1]), float(sole[2])), roll, pitch)
+        x, y, z = _level((float(sole[0]), float(sole[1]), float(sole[2])), *cs)
         out.append((-x, -y, -z))
     return out[0], out[1]
 

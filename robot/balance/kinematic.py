@@ -21,11 +21,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from math import cos, sin
 from typing import NamedTuple
 
 from robot.config.joint_names import LEG_JOINTS
 from robot.config.robot import Geometry
-from robot.gait.ik import leg_fk_full
+from robot.gait.ik import hip_centre
 
 Point = tuple[float, float, float]
 Quad = tuple[float, float, float, float]
@@ -70,12 +71,36 @@ Legs = tuple[Sequence[float], Sequence[float]]
 SolesOf = Callable[[Legs], tuple[Point, Point]]
 
 
+def sole_point(g: Geometry, side: str, q: Sequence[float]) -> Point:
+    """The sole point [m] of ``robot.gait.ik.leg_fk_full`` for six leg angles [rad] on
+    Python floats: its operations written out, those of the foot's rotation that the
+    point does not use left out (the same bits: tests/test_kinematic_sole.py)."""
+    hx, hy, hz = hip_centre(g, side)
+    q0, q1, q2, q3, q4, q5 = q
+    c, s = cos(q0), sin(q0)                                       # rot_z
+    r0, r1, r2, r3, r4, r5, r6, r7, r8 = c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0
+    c, s = cos(q1), sin(q1)                                       # post_rx
+    r1, r2, r4, r5, r7, r8 = (c * r1 + s * r2, c * r2 - s * r1, c * r4 + s * r5,
+                              c * r5 - s * r4, c * r7 + s * r8, c * r8 - s * r7)
+    c, s = cos(q2), sin(q2)                                       # post_ry: the hip
+    h0, h2, h3, h5, h6, h8 = (c * r0 - s * r2, s * r0 + c * r2, c * r3 - s * r5,
+                              s * r3 + c * r5, c * r6 - s * r8, s * r6 + c * r8)
+    c, s = cos(q3), sin(q3)                                       # post_ry: the knee
+    k0, k2, k3, k5, k6, k8 = (c * h0 - s * h2, s * h0 + c * h2, c * h3 - s * h5,
+                              s * h3 + c * h5, c * h6 - s * h8, s * h6 + c * h8)
+    c, s = cos(q4), sin(q4)                                       # post_ry, column 2
+    a2, a5, a8 = s * k0 + c * k2, s * k3 + c * k5, s * k6 + c * k8
+    c, s = cos(q5), sin(q5)                                       # post_rx, column 2
+    f2, f5, f8 = c * a2 - s * r1, c * a5 - s * r4, c * a8 - s * r7
+    ah = g.ankle_height
+    return (hx - h2 * g.thigh - k2 * g.shin - f2 * ah, hy - h5 * g.thigh - k5 * g.shin - f5 * ah,
+            hz - h8 * g.thigh - k8 * g.shin - f8 * ah)
+
+
 def leg_soles(g: Geometry, legs: Legs) -> tuple[Point, Point]:
     """The right and left sole points [m] in the pelvis frame (the legs' forward
-    kinematics) for the (right, left) leg angles [rad]."""
-    right, _ = leg_fk_full(g, "r", tuple(legs[0]))
-    left, _ = leg_fk_full(g, "l", tuple(legs[1]))
-    return right, left
+    kinematics, ``sole_point``) for the (right, left) leg angles [rad]."""
+    return sole_point(g, "r", legs[0]), sole_point(g, "l", legs[1])
 
 
 class SoleMemo:

@@ -13,7 +13,7 @@ from types import FrameType
 import pytest
 
 from robot.bus.factory import make_bus
-from robot.bus.sdk_bus import SdkBus
+from robot.bus.sdk.bus import SdkBus
 from robot.config.bundled import ROBOTS_DIR
 from robot.config.robot import RobotConfig
 from robot.config.robot_file import load_robot

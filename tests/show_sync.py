@@ -107,7 +107,10 @@ def measure(controller: PanelController, base: str, browser: Browser, seconds: f
         if b is None:
             break
         w = clock["at"] / 1000.0
-        take = a[0] + (w - a[1]) * (b[0] - a[0]) / (b[1] - a[1]) if b[1] > a[1] else -1.0
+        # between the ticks stamped before and after the read; on a loaded machine both
+        # asks may find the same tick: then from it at the take's rate (1 s per s)
+        take = (a[0] + (w - a[1]) * (b[0] - a[0]) / (b[1] - a[1]) if b[1] > a[1]
+                else b[0] + (w - b[1]))
         if clock["playing"] and take >= OFFSET:   # the soundtrack has begun
             audio.append(1000 * (clock["audio"] + OFFSET - take))
             estimate.append(1000 * (clock["show"] - take))

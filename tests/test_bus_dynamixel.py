@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from robot.bus.sdk_bus import SdkBus
+from robot.bus.sdk.bus import SdkBus
 from robot.bus.tables import DYNAMIXEL_X
 from robot.errors import BusError
 from sim.emulator.chain import Emulator

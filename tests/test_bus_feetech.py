@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 import scservo_sdk
 
-from robot.bus.sdk_bus import SdkBus
+from robot.bus.sdk.bus import SdkBus
 from robot.servo.models import MODELS
 from sim.emulator.chain import Emulator
 

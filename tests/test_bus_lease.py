@@ -12,7 +12,7 @@ import pytest
 from panel_wire import assert_estop_held
 
 from robot.bus.lease import BusBusy, BusLease, Preempted, holding
-from robot.bus.sdk_bus import SdkBus
+from robot.bus.sdk.bus import SdkBus
 from robot.config.robot import RobotConfig
 from sim.emulator.chain import Emulator
 

@@ -9,7 +9,7 @@ from bus_harness import PATIENT_TIMEOUT_MS
 from waiting import wait_for
 
 from robot.bus import health
-from robot.bus.sdk_bus import SdkBus
+from robot.bus.sdk.bus import SdkBus
 from robot.bus.servo_map import ServoMap
 from robot.bus.tables import TABLES
 from robot.config.robot import RobotConfig

@@ -91,7 +91,7 @@ def test_bundled_robots_load() -> None:
     (joint_field("r_knee", "servo_id", "4.5"), "joints.r_knee.servo_id: expected an integer"),
     (sub("thigh = 0.11", "thigh = -0.11"),
      "geometry.thigh: expected a number in [0.001, 2] m, got -0.11"),
-    (lambda t: "colour = 'red'\n" + t, "colour: unknown key; valid: balance, bus, geometry"),
+    (lambda t: "colour = 'red'\n" + t, "colour: unknown key; valid: balance, bus, gait, geometry"),
     (sub("[bus]\n", "[bus]\nparity = 'N'\n"), "bus.parity: unknown key; valid: kind, model"),
     (sub("[joints.r_knee]\n", "[joints.r_knee]\noffset = 3\n"),
      "joints.r_knee.offset: unknown key; valid: servo_id, sign"),

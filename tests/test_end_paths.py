@@ -21,7 +21,7 @@ from waiting import wait_for
 
 import robot.cli as cli
 from robot.bus.base import Bus
-from robot.bus.dynamixel import DynamixelBus
+from robot.bus.dynamixel.protocol2 import DynamixelBus
 from robot.bus.servo_map import ServoMap
 from robot.config.gait_file import load_gait
 from robot.config.robot import RobotConfig

@@ -23,7 +23,7 @@ import pytest
 from waiting import sleep_until, wait_for
 
 from robot.bus.base import Bus
-from robot.bus.sdk_bus import SdkBus
+from robot.bus.sdk.bus import SdkBus
 from robot.bus.servo_map import ServoMap
 from robot.bus.tables import TABLES
 from robot.config.gait_file import load_gait

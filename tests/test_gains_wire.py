@@ -160,7 +160,7 @@ def test_sts_eeprom_gains_are_written_once_over_two_runs(emulate: Any, bus_facto
     robot = robot_with("feetech", joints={"r_knee": {"gains": {"p_coefficient": 16}}})
     emu = emulate("feetech", robot)
     knee = robot.joint("r_knee").servo_id
-    with caplog.at_level(logging.INFO, logger="robot.bus.gain_writer"):
+    with caplog.at_level(logging.INFO, logger="robot.bus.sdk.gain_writer"):
         sts_run(bus_factory, emu, robot)
     assert any("EEPROM gains changed (p_coefficient 32 -> 16)" in r.getMessage()
                for r in caplog.records)

@@ -2,45 +2,35 @@
 Duck Mini v2): the legs measured by the importer (robot.body.measure), solved by
 robot.gait.ik_chain, checked by MuJoCo's forward kinematics of the vendor's own file (its
 meshes left out: they move nothing) at the model angles the roles give (robot.body.roles):
-each sole point and foot rotation where the IK aimed, within 1e-6 m and 1e-6 rad."""
+each sole point and foot rotation where the IK aimed, within 1e-6 m and 1e-6 rad; the Duck
+also with its knees bent backward, as it walks (LegChain.knee_back: the other branch)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
-import xml.etree.ElementTree as ET
-from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
+from kit_models import DUCK, OP3, without_meshes
 
 from robot.body.measure import measure
 from robot.body.mjcf_read import read_mjcf
 from robot.body.roles import find_roles
 from robot.gait.ik_chain import chain_leg_ik, check_layout
 
-ROBOTS = Path(__file__).resolve().parents[1].parent / "shared" / "robots"
-KITS = {"op3": ROBOTS / "robotis_op3" / "op3.xml",
-        "open-duck-mini-v2": ROBOTS / "open_duck_mini_v2" / "robot.xml"}
+KITS = {"op3": OP3, "open-duck-mini-v2": DUCK}
 JOINTS = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
 
 
-def without_meshes(path: Path) -> mujoco.MjModel:
-    """The model with its mesh assets and mesh geoms left out (the kinematics stay)."""
-    root = ET.parse(path).getroot()
-    for parent in list(root.iter()):
-        for child in list(parent):
-            if child.tag == "mesh" or (child.tag == "geom" and (child.get("mesh") or
-                                                                child.get("type") == "mesh")):
-                parent.remove(child)
-    return mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
-
-
-@pytest.mark.parametrize("kit", KITS)
-def test_mujoco_puts_the_kits_soles_where_the_ik_aimed(kit: str) -> None:
+@pytest.mark.parametrize(("kit", "back"), [("op3", False), ("open-duck-mini-v2", False),
+                                           ("open-duck-mini-v2", True)])
+def test_mujoco_puts_the_kits_soles_where_the_ik_aimed(kit: str, back: bool) -> None:
     tree, _ = read_mjcf(KITS[kit], missing_mesh="box")
     roles = find_roles(tree)
-    legs = measure(tree, roles).legs
+    legs = tuple(dataclasses.replace(leg, knee_back=back)
+                 for leg in measure(tree, roles).legs)
     origin = measure(tree, roles).origin
     model = without_meshes(KITS[kit])
     data = mujoco.MjData(model)
@@ -68,16 +58,17 @@ def test_mujoco_puts_the_kits_soles_where_the_ik_aimed(kit: str) -> None:
         offset = rot0.T @ (np.array(leg.zero_sole()) - at0)   # the sole in the foot's frame
         worst = [0.0, 0.0]
         for _ in range(200):
-            knee = rng.uniform(0.1, 1.4)
+            knee = rng.uniform(0.1, 1.4) * (-1.0 if back else 1.0)
             lean = math.atan2(leg.thigh * math.sin(knee), leg.shin + leg.thigh * math.cos(knee))
             q = (rng.uniform(-0.4, 0.4) if leg.has_yaw else 0.0, rng.uniform(-0.3, 0.3),
-                 rng.uniform(-0.8, 0.4), knee, rng.uniform(-0.6, 0.6) - lean,
+                 rng.uniform(-0.8, 0.4) * (-1.0 if back else 1.0), knee,
+                 rng.uniform(-0.6, 0.6) - lean,
                  rng.uniform(-0.3, 0.3) if leg.has_ankle_roll else 0.0)
             at, rot = foot(side, q)
             sole, want = at + rot @ offset, rot @ rot0.T
             sol = chain_leg_ik(leg, tuple(sole), tuple(want.ravel()))  # type: ignore[arg-type]
-            assert sol.reachable
+            assert sol.reachable and (sol.q[3] < 0.0) == back
             at, rot = foot(side, sol.q)
             worst = [max(worst[0], float(np.abs(at + rot @ offset - sole).max())),
                      max(worst[1], float(np.abs(rot @ rot0.T - want).max()))]
-        assert worst[0] < 1e-6 and worst[1] < 1e-6, (kit, side, worst)
+        assert worst[0] < 1e-6 and worst[1] < 1e-6, (kit, back, side, worst)

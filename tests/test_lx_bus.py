@@ -1,4 +1,4 @@
-"""The LX bus (robot/bus/lx.py) at the wire, against the emulated LX chain: what the
+"""The LX bus (robot/bus/lx/bus.py) at the wire, against the emulated LX chain: what the
 emulator's servos were told (goal, move time, load state per servo) after each call, and
 faults: dropped answers, a silent servo, overheating, a wrong baud."""
 
@@ -11,7 +11,7 @@ import pytest
 from waiting import wait_for
 
 from robot.bus.factory import make_bus
-from robot.bus.lx import LxBus
+from robot.bus.lx.bus import LxBus
 from robot.bus.servo_map import ServoMap
 from robot.config.robot import RobotConfig
 from robot.errors import BusError, ConfigError

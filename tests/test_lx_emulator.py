@@ -10,7 +10,7 @@ from collections.abc import Iterator
 import pytest
 from waiting import wait_for
 
-from robot.bus.lx import LxBus
+from robot.bus.lx.bus import LxBus
 from robot.errors import BusError
 from sim.emulator.chain import Emulator
 

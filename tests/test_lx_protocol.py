@@ -9,8 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from robot.bus import lx_packet, lx_wire
-from robot.bus.lx_tables import LX_ALARM_BITS, LX_BROADCAST_ID, LX_COMMANDS
+from robot.bus.lx import packet as lx_packet
+from robot.bus.lx import wire as lx_wire
+from robot.bus.lx.tables import LX_ALARM_BITS, LX_BROADCAST_ID, LX_COMMANDS
 from robot.bus.tables import ERROR_BITS
 from robot.config.bundled import ROBOTS_DIR
 from robot.config.robot_file import load_robot

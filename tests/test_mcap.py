@@ -113,11 +113,11 @@ def test_sim_gap_and_plot_read_it(recorded: tuple[Path, Path], tmp_path: Path,
         capsys.readouterr()
         assert cli.main(["sim-gap", str(path), "--json"]) == 0
         out.append(json.loads(capsys.readouterr().out)["joints"])
-    # real - command needs no replay: the same; the replay's (sim) follows each record's
-    # reply times, which are the host's clock of its own run
+    # real - command needs no replay: the same; the replay follows each record's reply
+    # times, on the loop's clock (the sim's here): the sim replays its own run, gap ~0
     assert [(r["joint"], r["rms_real_cmd"], r["max_real_cmd"]) for r in out[0]] == \
         [(r["joint"], r["rms_real_cmd"], r["max_real_cmd"]) for r in out[1]]
-    assert all(np.isfinite(r["rms_sim_cmd"]) and np.isfinite(r["rms_real_sim"]) for r in out[0])
+    assert all(np.isfinite(r["rms_sim_cmd"]) and r["max_real_sim"] < 0.02 for r in out[0]), out[0]
     png = tmp_path / "run.png"
     assert cli.main(["plot", str(run), "--out", str(png)]) == 0
     assert png.stat().st_size > 10_000

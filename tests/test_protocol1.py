@@ -47,7 +47,7 @@ def test_ax_ticks_span_300_degrees() -> None:
 
 
 def test_the_protocol1_bus_uses_packet_handler_1_0() -> None:
-    from robot.bus.dynamixel1 import Dynamixel1Bus
+    from robot.bus.dynamixel.protocol1 import Dynamixel1Bus
 
     bus = Dynamixel1Bus("/dev/null", baud=1_000_000)
     assert (bus.kind, bus.family) == ("dynamixel1", "dynamixel_p1")

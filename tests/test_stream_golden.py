@@ -49,7 +49,13 @@ from robot.gait.targets import NO_TRIM, BodyTrim
 FIXTURE = Path(__file__).parent / "data" / "stream_golden.npz"
 DT = 1.0 / 200.0
 SAMPLE = 32  # every SAMPLE-th row is stored in full
-ROBOTS = tuple(sorted(p.stem for p in ROBOTS_DIR.glob("*.toml")))
+#: Not in the fixture: the Open Duck Mini's knees bend backward since issue 31 item 5 (its
+#: stream changed by design; robot.body.legs.LegChain.knee_back): its tick path is checked
+#: against the vectorised one in tests/test_tick_kernel.py, its IK against MuJoCo in
+#: tests/test_ik_chain_kits.py. The ROBOTIS OP3's streams were added from the code of
+#: b510622 (main before that change), so they hold it to its stream bit for bit too.
+NOT_STORED = frozenset({"open-duck-mini-v2"})
+ROBOTS = tuple(sorted(p.stem for p in ROBOTS_DIR.glob("*.toml") if p.stem not in NOT_STORED))
 TICK_GAITS = ("walk", "paper")
 CURVE_SETS = ("walk", "paper", "steer")
 #: The live change: steering beyond STEER_BUDGET (scaled down), rhythm, foot, sway.

@@ -17,7 +17,7 @@ from bus_harness import TEST_TIMEOUT_MS
 from waiting import sleep_until, wait_for
 
 import robot.cli as cli
-from robot.bus.dynamixel import DynamixelBus
+from robot.bus.dynamixel.protocol2 import DynamixelBus
 from robot.bus.factory import make_bus
 from robot.bus.servo_map import ServoMap
 from robot.config.bundled import ROBOTS_DIR

@@ -18,7 +18,7 @@ import scservo_sdk
 from bus_harness import TEST_TIMEOUT_MS
 from sdk_timeouts import allow_slow_replies
 
-from robot.bus.feetech import FeetechBus
+from robot.bus.feetech.bus import FeetechBus
 from sim.emulator.chain import Emulator
 
 pytest_plugins = ("bus_harness",)

@@ -136,7 +136,8 @@ def _heading(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float,
     # with turn, so a trim that changed within a step would yaw the body one way in one
     # step and the other way in the next.
     want = _clip(p.bal_heading_p * error + p.bal_heading_i * heading_i, p.bal_turn_max)
-    step_s = 0.5 * p.cycle_s if math.isfinite(p.cycle_s) else 0.0
+    cycle = p.cycle_s
+    step_s = 0.5 * cycle if math.isfinite(cycle) else 0.0
     turn = want if step_s <= dt else state.turn + (want - state.turn) * dt / step_s
     sign = state.sign
     if gait.by_stride and amplitude >= 0.999:
@@ -167,14 +168,13 @@ def balance_step(state: BalanceState, tilt: Attitude, p: GaitParams, dt: float,
     values = (tilt.roll, tilt.pitch, tilt.roll_rate, tilt.pitch_rate)
     stepping, capture = step(state.stepping, values, p, gait, dt, kin)
     feet, level = stepping.feet, stepping.level
-    corr = Correction(
-        ankle_pitch=p.bal_ankle_pd * tilt.pitch_rate + p.bal_ankle_pp * e_pitch,
-        ankle_roll=p.bal_ankle_pd * tilt.roll_rate + p.bal_ankle_pp * e_roll,
-        hip_pitch=p.bal_hip_pd * tilt.pitch_rate,
-        hip_roll=p.bal_hip_pd * tilt.roll_rate,
-        turn=a * sign.sign * turn, pelvis_roll=lean_roll, pelvis_pitch=lean_pitch,
-        feet=(a * feet[0], a * feet[1], a * feet[2], a * feet[3]),
-        tempo=phase_rate(stepping, a) - 1.0, land=stepping.brace, capture=capture,
-        level=(a * level[0], a * level[1], a * level[2], a * level[3]))
+    corr = Correction(  # positional, in the order of the fields
+        p.bal_ankle_pd * tilt.pitch_rate + p.bal_ankle_pp * e_pitch,       # ankle_pitch
+        p.bal_ankle_pd * tilt.roll_rate + p.bal_ankle_pp * e_roll,         # ankle_roll
+        p.bal_hip_pd * tilt.pitch_rate, p.bal_hip_pd * tilt.roll_rate,     # hip pitch, roll
+        a * sign.sign * turn, lean_roll, lean_pitch,                # turn, pelvis roll, pitch
+        (a * feet[0], a * feet[1], a * feet[2], a * feet[3]),       # feet
+        phase_rate(stepping, a) - 1.0, stepping.brace, capture,     # tempo, land, capture
+        (a * level[0], a * level[1], a * level[2], a * level[3]))   # level
     return BalanceState(lean_pitch, lean_roll, heading, heading_ref, heading_i, turn,
                         stepping, True, sign), corr

@@ -22,6 +22,7 @@ BINS = 64
 #: Signals kept: torso roll, pitch [rad] and roll, pitch rate [rad/s].
 SIGNALS = 4
 _TWO_PI = 2.0 * math.pi
+_ROWS = range(0, SIGNALS * BINS, BINS)  # where each signal's bins start in the table
 
 
 def _bins(theta: float) -> tuple[int, int, float]:
@@ -43,8 +44,8 @@ class Rhythm(NamedTuple):
     def at(self, theta: float) -> tuple[float, ...]:
         """The learned value of every signal at phase ``theta`` [rad]."""
         i, j, w = _bins(theta)
-        t = self.table
-        return tuple((1.0 - w) * t[k * BINS + i] + w * t[k * BINS + j] for k in range(SIGNALS))
+        t, u = self.table, 1.0 - w
+        return tuple([u * t[k + i] + w * t[k + j] for k in _ROWS])
 
     def residual(self, theta: float, values: tuple[float, ...]) -> tuple[float, ...]:
         """``values`` minus the learned rhythm at ``theta``."""
@@ -70,7 +71,6 @@ class Rhythm(NamedTuple):
                 continue
             weight[b] = min(weight[b] + wb, tau_cycles)
             rate = min(1.0, wb / weight[b])
-            for k, v in enumerate(values):
-                a = k * BINS + b
+            for a, v in zip(range(b, SIGNALS * BINS, BINS), values, strict=True):
                 t[a] += rate * (v - t[a])
         return Rhythm(tuple(t), tuple(weight), self.cycles + dtheta / _TWO_PI)

@@ -16,6 +16,7 @@ import numpy as np
 
 from robot.balance.kinematic import (
     LegSlots,
+    SoleMemo,
     leg_angles,
     over_support,
     support_weight,
@@ -29,6 +30,7 @@ from robot.balance.law import (
     balance_step,
     commanded_yaw_rate,
 )
+from robot.config.params import GaitParams
 from robot.gait.targets import NO_TRIM, BodyTrim
 from robot.imu.base import Imu
 from robot.imu.tilt import TiltEstimator, tilt_from_quat, wrap
@@ -101,6 +103,7 @@ class Balance:
         self._present = present
         self.slots = JointSlots.of(engine.robot.joint_names)
         self.legs = LegSlots.of(engine.robot.joint_names)
+        self._soles = SoleMemo(engine.robot.geometry)
         self._sent: np.ndarray | None = None
         self._lag: np.ndarray | None = None
         self._lag_seen: np.ndarray | None = None
@@ -108,6 +111,9 @@ class Balance:
         self._plan_before: tuple[tuple[float, ...], tuple[float, ...]] | None = None
         self._trim_before: BodyTrim | None = None
         self._w: float | None = None
+        self._phase_p: GaitParams | None = None    # the parameters _height, _inward are for
+        self._height = self._inward = 0.0
+        self._by_stride = False
         self.state = BalanceState()
         self.last = Correction()
         self._theta = 0.0
@@ -127,17 +133,20 @@ class Balance:
     def gait_phase(self) -> GaitPhase:
         """What the law needs from the engine at this tick."""
         e = self.engine
-        p, g = e.live_params, e.robot.geometry
+        p = e.live_params
+        if p is not self._phase_p:    # the pendulum's height and the feet's room, per set
+            g = e.robot.geometry
+            gap = g.hip_width + 2.0 * p.foot_spread - g.foot_width
+            self._phase_p, self._height = p, p.stance * g.leg_length + g.ankle_height
+            self._inward = max(0.0, 0.5 * (gap - FOOT_GAP_M))
+            self._by_stride = not e.robot.has_hip_yaw and p.bal_stride_turn != 0.0
         theta = float(e.phase.theta)
         dtheta = theta - self._theta
         self._theta = theta
-        gap = g.hip_width + 2.0 * p.foot_spread - g.foot_width
-        return GaitPhase(theta=theta, dtheta=dtheta if math.isfinite(dtheta) else 0.0,
-                         amplitude=e.amplitude, stopping=not e.running,
-                         by_stride=not e.robot.has_hip_yaw and p.bal_stride_turn != 0.0,
-                         swinging=(e.lift[0] > 0.0, e.lift[1] > 0.0),
-                         height=p.stance * g.leg_length + g.ankle_height,
-                         inward=max(0.0, 0.5 * (gap - FOOT_GAP_M)))
+        lift = e.lift
+        return GaitPhase(theta, dtheta if math.isfinite(dtheta) else 0.0, e.amplitude,
+                         (lift[0] > 0.0, lift[1] > 0.0), self._height, self._inward,
+                         not e.running, self._by_stride)
 
     def held(self, q: np.ndarray, dt: float) -> np.ndarray:
         """The joint angles [rad] the servos hold now, as known: the last command plus
@@ -162,17 +171,21 @@ class Balance:
         feedback put under the support (robot.balance.kinematic.unplanned)."""
         held = self.held(q, dt).tolist()
         legs = (leg_angles(held, self.legs.right), leg_angles(held, self.legs.left))
-        plan = (leg_angles(q.tolist(), self.legs.right), leg_angles(q.tolist(), self.legs.left))
+        q_list = q.tolist()
+        plan = (leg_angles(q_list, self.legs.right), leg_angles(q_list, self.legs.left))
         # The support moves from foot to foot over SUPPORT_TAU_S, not in one tick: the two
         # feet's unplanned offsets differ by a few mm, and a jump by half of that at a
         # lift that the learned rhythm places a bin early or late reads as a push.
         want = support_weight((not gait.swinging[0], not gait.swinging[1]))
         w = self._w = (want if self._w is None
                        else self._w + min(1.0, dt / SUPPORT_TAU_S) * (want - self._w))
-        g = self.engine.robot.geometry
+        g, soles = self.engine.robot.geometry, self._soles
+        soles.tick()
         measured = over_support(g, legs, self._before,
-                                (tilt.roll, tilt.pitch, tilt.roll_rate, tilt.pitch_rate), w, dt)
-        planned = over_support(g, plan, self._plan_before, (0.0, 0.0, 0.0, 0.0), w, dt)
+                                (tilt.roll, tilt.pitch, tilt.roll_rate, tilt.pitch_rate), w, dt,
+                                soles_of=soles)
+        planned = over_support(g, plan, self._plan_before, (0.0, 0.0, 0.0, 0.0), w, dt,
+                               soles_of=soles)
         t = self.engine.trim
         shift = (w * t.r_dx + (1.0 - w) * t.l_dx, w * t.r_dy + (1.0 - w) * t.l_dy)
         b = self._trim_before
@@ -191,11 +204,11 @@ class Balance:
         else:       # switched on later (the panel), it starts afresh: no stale last tick
             self._before = self._plan_before = self._trim_before = self._w = None
         self.state, corr = balance_step(self.state, tilt, p, dt, gait, kin)
+        r_dx, r_dy, l_dx, l_dy = corr.feet
         r_roll, r_pitch, l_roll, l_pitch = corr.level
-        self.engine.trim = BodyTrim(corr.pelvis_roll, corr.pelvis_pitch, *corr.feet,
-                                    turn=corr.turn, tempo=corr.tempo, land=corr.land,
-                                    r_roll=r_roll, r_pitch=r_pitch, l_roll=l_roll,
-                                    l_pitch=l_pitch, close=p.bal_stop_close)
+        self.engine.trim = BodyTrim(corr.pelvis_roll, corr.pelvis_pitch, r_dx, r_dy, l_dx, l_dy,
+                                    corr.turn, corr.tempo, corr.land, r_roll, r_pitch, l_roll,
+                                    l_pitch, p.bal_stop_close)
         self.last = corr
         out = apply(q, corr, self.slots)
         self._sent = out
@@ -220,6 +233,5 @@ def attitude_reader(imu: Imu, *, tau_s: float | None = None) -> Callable[[], Att
         else:
             roll, pitch = estimator.update(s)
             heading = None
-        return Attitude(roll=roll, pitch=pitch, roll_rate=gx, pitch_rate=gy, yaw_rate=gz,
-                        heading=heading)
+        return Attitude(roll, pitch, gx, gy, gz, heading)
     return read

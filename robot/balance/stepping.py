@@ -138,10 +138,10 @@ def disturbance(rhythm: Rhythm, values: Quad, p: GaitParams, g: GaitPhase, movin
         return rhythm, (0.0, 0.0, 0.0, 0.0)
     a = g.amplitude * moving
     learned = rhythm.at(g.theta)
-    e_roll, e_pitch, r_roll, r_pitch = (v - a * m for v, m in zip(values, learned, strict=True))
+    e_roll, e_pitch, r_roll, r_pitch = [v - a * m for v, m in zip(values, learned, strict=True)]
     if a >= 0.999 and p.bal_learn_cycles > 0.0:
-        target = tuple(m + _clip(v - m, c)
-                       for v, m, c in zip(values, learned, clip, strict=True))
+        target = tuple([m + _clip(v - m, c)
+                        for v, m, c in zip(values, learned, clip, strict=True)])
         rhythm = rhythm.learn(g.theta, target, g.dtheta, p.bal_learn_cycles)
     if p.bal_learn_cycles > 0.0 and rhythm.cycles < LEARNED:
         return rhythm, (0.0, 0.0, 0.0, 0.0)
@@ -214,14 +214,18 @@ def _level(level: Quad, tilt: tuple[float, float], p: GaitParams, g: GaitPhase,
            dt: float) -> Quad:
     """A swinging foot's pelvis turn follows the residual tilt x ``bal_swing_level``; a
     standing foot's returns to 0."""
-    want = (p.bal_swing_level * tilt[0], p.bal_swing_level * tilt[1])
-    out = list(level)
-    for foot in (0, 1):
-        swinging = g.swinging[foot] and not g.swinging[1 - foot]
-        for k in (0, 1):
-            i = 2 * foot + k
-            out[i] = want[k] if swinging else _follow(out[i], 0.0, dt, LEVEL_OUT_S)
-    return out[0], out[1], out[2], out[3]
+    want_roll, want_pitch = p.bal_swing_level * tilt[0], p.bal_swing_level * tilt[1]
+    right, left = g.swinging
+    r_roll, r_pitch, l_roll, l_pitch = level
+    if right and not left:
+        r_roll, r_pitch = want_roll, want_pitch
+    else:
+        r_roll, r_pitch = _follow(r_roll, 0.0, dt, LEVEL_OUT_S), _follow(r_pitch, 0.0, dt, LEVEL_OUT_S)
+    if left and not right:
+        l_roll, l_pitch = want_roll, want_pitch
+    else:
+        l_roll, l_pitch = _follow(l_roll, 0.0, dt, LEVEL_OUT_S), _follow(l_pitch, 0.0, dt, LEVEL_OUT_S)
+    return r_roll, r_pitch, l_roll, l_pitch
 
 
 def step(state: StepState, values: tuple[float, float, float, float], p: GaitParams,
@@ -256,7 +260,7 @@ def step(state: StepState, values: tuple[float, float, float, float], p: GaitPar
     latch = (0.0, 0.0) if next_lift != state.next_lift else state.latch
     if any(g.swinging) and not all(g.swinging):
         latch = (_further(latch[0], plan.dx), _further(latch[1], plan.dy))
-        plan = plan._replace(dx=latch[0], dy=latch[1])
+        plan = StepPlan(plan.t_s, latch[0], latch[1])
     feet = _feet(state.feet, plan, p, g, dt)
     tempo = _follow(state.tempo, want_tempo, dt, TEMPO_TAU_S)
     size = math.hypot(*xi)

@@ -30,7 +30,7 @@ def percentiles_us(samples_s: list[float] | np.ndarray) -> dict[str, float]:
 
 def _ticker(robot: RobotConfig, gait: str, dt: float) -> Callable[[], object]:
     """One tick of ``robot``'s gait engine and servo map, warmed up to full amplitude."""
-    engine = GaitEngine(robot, load_gait(gait).params)
+    engine = GaitEngine(robot, load_gait(gait).for_robot(robot))
     smap = ServoMap(robot)
     engine.start()
     for _ in range(500):  # warm up, and ramp in to full amplitude
@@ -98,7 +98,7 @@ def bench_vectorised(*, frames: int = 1_000_000, repeats: int = 3,
     """Joint angles for ``frames`` samples at once (best of ``repeats``): as
     ``GaitEngine.curves`` runs them (one thread per CPU), and on one thread."""
     robot = load_robot(robot_path)
-    params = load_gait(gait).params
+    params = load_gait(gait).for_robot(robot)
     engine = GaitEngine(robot, params)
     times = np.linspace(0.0, frames / 100.0, frames)
     best = _best_s(lambda: engine.curves(times, with_channels=False), repeats)

@@ -26,7 +26,7 @@ from robot.balance.stage import Balance, attitude_reader
 from robot.bench.stops import run_stops
 from robot.bus.factory import make_bus
 from robot.bus.servo_map import ServoMap
-from robot.config.bundled import gait_names, robot_names
+from robot.config.bundled import gait_names, made_for, robot_names
 from robot.config.gait_file import load_gait
 from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
@@ -44,7 +44,7 @@ def _walk(robot_name: str, seconds: float, *, balance: bool) -> tuple[float, flo
     robot = load_robot(robot_name)
     bus: Any = make_bus("sim", robot=robot)
     with bus:
-        engine = GaitEngine(robot, load_gait("walk").params)
+        engine = GaitEngine(robot, load_gait("walk").for_robot(robot))
         feedback = None
         imu = None
         if balance and robot.imu is not None:
@@ -133,9 +133,6 @@ def flags(row: dict[str, Any], gait: str) -> list[str]:
 #: Presets for previs only, not for a robot to walk (their files say so: "paper" is the
 #: paper's equations verbatim, with no weight shift): walked and reported, not counted.
 PREVIS_ONLY = frozenset({"paper", "run"})
-#: Presets not made for some bundled robots: walked and reported there, not counted
-#: (`jog` falls 13.7 s into a 60 s walk on the 12 cm-legged ROBOTIS MINI; docs/gait.md).
-NOT_FOR: dict[str, frozenset[str]] = {"jog": frozenset({"robotis-mini"})}
 #: Presets planned for a world the flat is not: walked and reported, not counted. `climb`
 #: plans footsteps for the staircase its `stairs_*` parameters describe (3 x 1.5 cm), and
 #: on the flat the steps it shortens and closes for risers that are not there tip the
@@ -155,7 +152,7 @@ def run_presets(*, quick: bool = False) -> dict[str, Any]:
         for gait in gait_names():
             row = out[f"{robot} {gait}"] = _preset(robot, gait, seconds)
             counted = not (gait in PREVIS_ONLY or gait in NEEDS_ITS_WORLD
-                           or robot in NOT_FOR.get(gait, ()))
+                           or not made_for(robot, gait))
             walked = walked and (not counted or not row["fell"])
             if counted and not quick:
                 row["flags"] = flags(row, gait)

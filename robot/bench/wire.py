@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from robot.bus.factory import make_bus
-from robot.bus.sdk_bus import SdkBus
+from robot.bus.sdk.bus import SdkBus
 from robot.config.bundled import ROBOTS_DIR
 from robot.config.robot_file import load_robot
 

@@ -19,7 +19,11 @@ the axes of a leg are, with the right-hand rule and REP-103 axes (x forward, y l
   in the foot frame (the box model's: (0, 0, -ankle_height)).
 
 ``order`` says which hip joint the pelvis carries: "yaw_roll" (yaw first, the usual),
-or "roll_yaw" (roll first, then yaw: some 5-DoF legs). ``fk`` below is the definition the
+or "roll_yaw" (roll first, then yaw: some 5-DoF legs). ``knee_back`` says which way the
+knee bends: False (the usual) forward, knee angles >= 0 (the shin swings back, the knee
+points forward); True backward, knee angles <= 0 (the thigh swings back and the shin
+forward as the leg crouches: a bird's, or the Open Duck Mini's, whose hip pitch lets the
+thigh swing 0.52 rad forward but 1.22 rad back). The IK takes that branch. ``fk`` below is the definition the
 IK inverts (robot/gait/ik_chain.py); the test oracle is MuJoCo on the model's own file.
 """
 
@@ -51,6 +55,7 @@ class LegChain:
     ankle_drop: float = 0.0
     has_ankle_roll: bool = True
     order: str = "yaw_roll"
+    knee_back: bool = False
 
     @property
     def has_yaw(self) -> bool:
@@ -60,14 +65,15 @@ class LegChain:
     def simple(self) -> bool:
         """True when every axis meets where the box model says: the hip's three axes in
         one point, the ankle's two in one, the sole straight below it, no sideways
-        offset, the ankle roll there, yaw (if any) first: robot/gait/ik.py's closed form of
-        the box model, bit for bit (without hip yaw it solves as if there were one and the
-        yaw is dropped, as for the box model's 5-DoF legs)."""
+        offset, the ankle roll there, yaw (if any) first, the knee bending forward:
+        robot/gait/ik.py's closed form of the box model, bit for bit (without hip yaw it
+        solves as if there were one and the yaw is dropped, as for the box model's 5-DoF
+        legs)."""
         hx, hy, _ = self.hip
         yaw_on_hip = self.yaw_axis is None or self.yaw_axis == (hx, hy)
         return (yaw_on_hip and self.roll_drop == 0.0 and self.lateral == 0.0
                 and self.ankle_drop == 0.0 and self.sole[0] == 0.0 and self.sole[1] == 0.0
-                and self.has_ankle_roll and self.order == "yaw_roll")
+                and self.has_ankle_roll and self.order == "yaw_roll" and not self.knee_back)
 
     @property
     def pitch_point(self) -> Vec3:

@@ -169,6 +169,30 @@ class BodyTree:
                 rot[i] = rot[link.parent] @ r_local
         return pos, rot
 
+    def poses_many(self, q: Mapping[str, Array], n: int) -> tuple[Array, Array]:
+        """``poses`` over ``n`` frames at once: hinge angles ``q`` [rad] (n,) each, by
+        hinge name (missing ones 0) → positions (L, n, 3) [m] and rotations (L, n, 3, 3)."""
+        pos, rot = np.zeros((len(self.links), n, 3)), np.zeros((len(self.links), n, 3, 3))
+        for i, link in enumerate(self.links):
+            r_local = np.broadcast_to(quat_to_matrix(link.quat), (n, 3, 3))
+            p_local = np.broadcast_to(np.asarray(link.pos, float), (n, 3))
+            if link.joint is not None:
+                a = np.asarray(link.joint.axis, float)
+                a = a / np.linalg.norm(a)
+                k = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+                angle = np.broadcast_to(np.asarray(q.get(link.joint.name, 0.0), float), (n,))
+                turn = (np.eye(3) + np.sin(angle)[:, None, None] * k
+                        + (1.0 - np.cos(angle))[:, None, None] * (k @ k))
+                anchor = np.asarray(link.joint.pos, float)
+                p_local = p_local + np.einsum("nij,nj->ni", r_local, anchor - turn @ anchor)
+                r_local = r_local @ turn
+            if link.parent < 0:
+                pos[i], rot[i] = p_local, r_local
+            else:
+                pos[i] = pos[link.parent] + np.einsum("nij,nj->ni", rot[link.parent], p_local)
+                rot[i] = rot[link.parent] @ r_local
+        return pos, rot
+
 
 def quat_to_matrix(q: Quat | Array) -> Array:
     """Rotation matrix of the quaternion (w, x, y, z) (normalised first)."""

@@ -13,6 +13,10 @@ from types import TracebackType
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    import numpy as np
+    import numpy.typing as npt
+
+    from robot.bus.servo_map import ServoMap
     from robot.bus.wire_time import TickWire
 
 
@@ -89,6 +93,12 @@ class Bus(ABC):
     @abstractmethod
     def write_goals(self, goals: Mapping[int, int]) -> None:
         """Goal positions [ticks] for many servos as ONE sync-write packet."""
+
+    def write_joint_goals(self, servo_map: ServoMap, q: npt.NDArray[np.float64]) -> None:
+        """Every servo of ``servo_map`` to the joint angles ``q`` [rad] (its joint order):
+        ``write_goals(servo_map.goals(q))``, what the loop sends each tick. The sim bus
+        takes the vector whole (``ServoMap.tick_vector``: the same ticks, no dict)."""
+        self.write_goals(servo_map.goals(q.tolist()))
 
     @abstractmethod
     def read_state(self, ids: Iterable[int]) -> dict[int, ServoState]:

@@ -71,18 +71,18 @@ def make_bus(kind: str | None, *, robot: RobotConfig, port: str | None = None,
         port = port or robot.bus.port
         baud = baud or robot.bus.baud
         if kind == "dynamixel":
-            from robot.bus.dynamixel import DynamixelBus
+            from robot.bus.dynamixel.protocol2 import DynamixelBus
 
             return DynamixelBus(port, baud=baud, robot=robot, **options)  # type: ignore[arg-type]
         if kind == "dynamixel1":
-            from robot.bus.dynamixel1 import Dynamixel1Bus
+            from robot.bus.dynamixel.protocol1 import Dynamixel1Bus
 
             return Dynamixel1Bus(port, baud=baud, robot=robot, **options)  # type: ignore[arg-type]
         if kind == "lx":
-            from robot.bus.lx import LxBus
+            from robot.bus.lx.bus import LxBus
 
             return LxBus(port, baud=baud, robot=robot, **options)  # type: ignore[arg-type]
-        from robot.bus.feetech import FeetechBus
+        from robot.bus.feetech.bus import FeetechBus
 
         return FeetechBus(port, baud=baud, robot=robot, **options)  # type: ignore[arg-type]
     factory = _plugin(kind)

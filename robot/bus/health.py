@@ -19,7 +19,7 @@ from robot.errors import BusError
 from robot.servo.models import BAUD_CODES
 
 if TYPE_CHECKING:
-    from robot.bus.sdk_registers import SdkRegisters
+    from robot.bus.sdk.registers import SdkRegisters
 
 log = logging.getLogger(__name__)
 

@@ -41,6 +41,8 @@ class ServoMap:
         self._rows = list(zip(self.ids, self.zero.tolist(),
                               (self.sign * self.ticks_per_rad).tolist(),
                               self.tick_min.tolist(), self.tick_max.tolist(), strict=True))
+        self._gain = self.sign * self.ticks_per_rad  # [ticks/rad]
+        self._tick_lo, self._tick_hi = self.tick_min.astype(float), self.tick_max.astype(float)
         self._index = {n: i for i, n in enumerate(self.names)}
         self._id_index = {sid: i for i, sid in enumerate(self.ids)}
 
@@ -49,7 +51,7 @@ class ServoMap:
 
     def clamp(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Joint angles clipped to the joint limits [rad]."""
-        return np.clip(np.asarray(q, dtype=float), self.q_min, self.q_max)
+        return np.asarray(q, dtype=float).clip(self.q_min, self.q_max)
 
     def to_ticks(self, q: npt.ArrayLike) -> npt.NDArray[np.int64]:
         """Joint angles [rad] → goal ticks, clamped to the limits (never outside them).
@@ -81,6 +83,17 @@ class ServoMap:
                 self._nan(i)
             out[sid] = lo if t < lo else hi if t > hi else round(t)
         return out
+
+    def tick_vector(self, q: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """``goals`` as one array in joint order: the same goal ticks, whole numbers as
+        floats (numpy's rint rounds half to even, as ``round``); NaN raises BipedError
+        naming the joint."""
+        t = self.zero + self._gain * q
+        ticks: npt.NDArray[np.float64] = np.rint(t.clip(self._tick_lo, self._tick_hi))
+        total = np.add.reduce(ticks)     # finite unless a tick is NaN (the rest are clamped)
+        if total != total:
+            self._nan(int(np.flatnonzero(t != t)[0]))
+        return ticks
 
     def from_positions(self, positions: Mapping[int, int]) -> npt.NDArray[np.float64]:
         """``{servo_id: ticks}`` (all ids) → joint angles [rad] in joint order."""

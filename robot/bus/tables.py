@@ -230,7 +230,7 @@ ERROR_BITS: dict[str, dict[int, str]] = {
     "feetech_sts": FEETECH_STS_ERROR_BITS,
     "dynamixel_xl320": DYNAMIXEL_XL320_ERROR_BITS,
     "feetech_scs": FEETECH_SCS_ERROR_BITS,
-    "lx": {0: "overheating", 1: "voltage", 2: "overload"},   # lx_tables.LX_ALARM_BITS
+    "lx": {0: "overheating", 1: "voltage", 2: "overload"},   # lx.tables.LX_ALARM_BITS
 }
 
 # Unit of one "return delay" register step [s]: Dynamixel X 2 µs, Feetech STS 2 µs.

@@ -1,4 +1,11 @@
-"""`biped curves`: the gait's channels and joint angles as a CSV (and a plot)."""
+"""`biped curves`: the gait's channels and joint angles as a CSV (and a plot).
+
+An imported robot (`biped robots import`) can add its joints in its model's own terms:
+``--model-angles`` adds one column per joint, named as the model file names it, in the
+file's convention (robot/config/model_angles.py: what MuJoCo's qpos takes); ``--targets``
+adds the sole targets the IK solved for, in the model's root link frame
+(``r_sole_x, r_sole_y, r_sole_z, l_sole_x, l_sole_y, l_sole_z`` [m]), so the IK can be
+checked with the model file and the CSV alone."""
 
 from __future__ import annotations
 
@@ -6,6 +13,7 @@ import argparse
 import logging
 
 import numpy as np
+import numpy.typing as npt
 
 from robot.commands.common import (
     add_robot_args,
@@ -18,6 +26,8 @@ from robot.commands.common import (
     seconds,
     writing,
 )
+from robot.config.model_angles import ModelAngles
+from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
 from robot.gait.engine import GaitEngine
 from robot.previs.curves import plot_curves, write_csv
@@ -38,7 +48,30 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--out", required=True, type=output_file, metavar="FILE.csv",
                    help="CSV to write")
     p.add_argument("--plot", type=plot_output, metavar="FILE.png", help="also write a plot")
+    p.add_argument("--model-angles", action="store_true",
+                   help="an imported robot: add each joint under its model's name, in the "
+                        "model's convention [rad]")
+    p.add_argument("--targets", action="store_true",
+                   help="an imported robot: add the sole targets in the model's root link "
+                        "frame [m]")
     return one_line_errors(p)
+
+
+def model_columns(robot: RobotConfig, engine: GaitEngine, times: npt.NDArray[np.float64],
+                  q: npt.NDArray[np.float64], *, angles: bool, targets: bool
+                  ) -> dict[str, npt.NDArray[np.float64]]:
+    """The --model-angles and --targets columns by name (ConfigError for a robot without
+    a model)."""
+    out: dict[str, npt.NDArray[np.float64]] = {}
+    if angles:
+        out.update(ModelAngles.of(robot, what="--model-angles").named(q.T))
+    if targets:
+        ModelAngles.of(robot, what="--targets")
+        assert robot.body is not None
+        soles = robot.body.pelvis_to_root(engine.sole_targets(times))
+        for side, sole in zip("rl", soles, strict=True):
+            out.update({f"{side}_sole_{a}": sole[:, k] for k, a in enumerate("xyz")})
+    return out
 
 
 def run(args: argparse.Namespace) -> int:
@@ -49,10 +82,17 @@ def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
     gait = gait_from(args)
     times = np.arange(n) / args.rate
-    engine = GaitEngine(robot, gait.params)
+    engine = GaitEngine(robot, gait.for_robot(robot))
     channels, q = engine.curves(times)
+    extra = model_columns(robot, engine, times, q, angles=args.model_angles,
+                          targets=args.targets)
     with writing("--out", args.out):
-        write_csv(args.out, times, channels, robot.joint_names, q)
+        try:
+            write_csv(args.out, times, channels, robot.joint_names, q, extra=extra)
+        except ValueError as e:
+            raise ConfigError(f"--model-angles: {robot.source}: the model's joint names a "
+                              f"column of the curves file ({e}); rename it in the model "
+                              "and import again") from None
     print(f"wrote {args.out}: {n} rows, gait {gait.name}, robot {robot.name}")
     if args.plot:
         with writing("--plot", args.plot):

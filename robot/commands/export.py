@@ -84,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
                               f"expected at most {MAX_FRAMES}")
         robot = robot_from(args)
         gait = gait_from(args)
-        _, qt = GaitEngine(robot, gait.params).curves(np.arange(n) / args.fps,
+        _, qt = GaitEngine(robot, gait.for_robot(robot)).curves(np.arange(n) / args.fps,
                                                       with_channels=False)
         q = qt.T
         what, label = f"gait {gait.name}", gait.name

@@ -41,6 +41,7 @@ from robot.commands.common import (
     rate_hz,
     seconds,
 )
+from robot.commands.model_args import add_model_names_arg, model_for
 from robot.commands.physics_check import physics_check, physics_watch
 from robot.commands.show_args import add_show_args, show_options
 from robot.commands.walk import servo_words
@@ -107,6 +108,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
                    "the balance stage corrects the legs while the arms and head perform as "
                    "authored (needs the robot's [imu])")
     add_show_args(p, midi=False)
+    add_model_names_arg(p)
     p.set_defaults(set=[])
     return p
 
@@ -173,6 +175,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         raise ConfigError(f"FILE {args.file}: expected a take (NAME{SUFFIX}) or a keyframe "
                           f"sequence ({', '.join(SUFFIXES)})")
+    model = model_for(args, robot)       # --model-names: checked before anything moves
     soundtrack = _soundtrack(args, show)
     if (soundtrack is not None or live(args.chase)) and kind == "sim":
         args.realtime = True          # the sound (a live timecode) runs in real time: so does the show
@@ -190,7 +193,7 @@ def run(args: argparse.Namespace) -> int:
                   if is_take(args.record)
                   else McapRecorder(args.record, robot, header, params=lambda: engine.params,
                                     body=bus) if is_mcap(args.record)
-                  else Recorder(args.record, robot.joint_names, robot.ids))
+                  else Recorder(args.record, robot.joint_names, robot.ids, model=model))
     if soundtrack is not None and isinstance(writer, McapRecorder):
         soundtrack.on_cue = _logged(soundtrack.on_cue, writer)
     watch = physics_watch(bus)
@@ -240,14 +243,12 @@ def run(args: argparse.Namespace) -> int:
               "record_error": record_error, "exit_code": code}
     if soundtrack is not None:
         result["audio"] = {"file": str(soundtrack.show.audio_path()),
-                           "started_at_show_s": soundtrack.started_at,
-                           "warning": soundtrack.warning}
+                           "started_at_show_s": soundtrack.started_at, "warning": soundtrack.warning}
     if chase is not None:
         result["chase"] = {**summary(chase), "stopped": chase.ended or stats.stop_reason}
     metrics = done.metrics or {}
     if "distance_m" in metrics:      # the sim: where the robot went (a show that walks)
-        result["walked"] = {k: metrics[k] for k in ("distance_m", "lateral_drift_m",
-                                                      "heading_change_deg")}
+        result["walked"] = {k: metrics[k] for k in ("distance_m", "lateral_drift_m", "heading_change_deg")}
     check = physics_check(watch, robot, done.metrics)
     if check is not None and check.fell_at is not None:
         code = result["exit_code"] = max(code, 1)   # the show did not hold up: incomplete

@@ -15,7 +15,8 @@ from pathlib import Path
 
 from robot.body.mjcf_read import read_mjcf
 from robot.body.tree import BodyTree
-from robot.config.model_import import build, check_servo, read_map, summary
+from robot.config.model_import import build, check_servo, summary
+from robot.config.model_recipe import read_map
 from robot.config.model_text import robot_file_text
 from robot.config.robot_file import parse_robot
 from robot.errors import ConfigError
@@ -92,7 +93,7 @@ def run_import(args: argparse.Namespace) -> int:
                                 fix_inertia=args.fix_inertia)
     source, licence = args.source or recipe.source, args.licence or recipe.licence
     imp = build(tree, servo=servo, joint_map=recipe.joints, file=path.name,
-                source=source, licence=licence)
+                source=source, licence=licence, knee=recipe.knee)
     imp.warnings[:0] = warnings
     for leg in imp.model.legs:   # a leg the closed-form IK cannot solve is refused here
         check_layout(leg, where=str(path))
@@ -105,8 +106,10 @@ def run_import(args: argparse.Namespace) -> int:
               *recipe.notes,
               "The body ([model]) is the model's own numbers; docs/robots.md, \"From CAD\"."]
     text = robot_file_text(imp, name=name, kind=kind, servo=servo, baud=baud, header=header,
-                           gains=recipe.gains, balance=recipe.balance)
-    parse_robot(tomllib.loads(text), source=str(out))   # what is written loads
+                           gains=recipe.gains, balance=recipe.balance, gait=recipe.gait)
+    # What is written loads; a fault there comes from the map (a gain register, a value).
+    parse_robot(tomllib.loads(text), source=f"{out} (from --map {args.map})" if args.map
+                else str(out))
     for line in summary(imp, path=path):
         print(line)
     try:

@@ -10,7 +10,7 @@ import logging
 
 from robot.bus import health
 from robot.bus.base import ServoInfo
-from robot.bus.sdk_bus import SdkBus
+from robot.bus.sdk.bus import SdkBus
 from robot.commands.common import HARDWARE_BUSES, add_bus_args, bus_from, id_list, one_line_errors
 from robot.config.bundled import DEFAULT_ROBOT, ROBOTS_DIR, robot_names
 from robot.config.robot import RobotConfig

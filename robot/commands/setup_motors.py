@@ -14,11 +14,11 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable
 
-from robot.bus.dynamixel import DynamixelBus
-from robot.bus.dynamixel1 import Dynamixel1Bus
-from robot.bus.feetech import FeetechBus
-from robot.bus.lx import LxBus
-from robot.bus.sdk_bus import SdkBus
+from robot.bus.dynamixel.protocol1 import Dynamixel1Bus
+from robot.bus.dynamixel.protocol2 import DynamixelBus
+from robot.bus.feetech.bus import FeetechBus
+from robot.bus.lx.bus import LxBus
+from robot.bus.sdk.bus import SdkBus
 from robot.commands.common import HARDWARE_BUSES, add_robot_args, one_line_errors, robot_from
 from robot.config.robot import JointConfig, RobotConfig
 from robot.errors import ConfigError

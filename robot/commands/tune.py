@@ -109,7 +109,8 @@ def run(args: argparse.Namespace) -> int:
         return sensitivity(args, start)
     if args.out is None:
         raise ConfigError("--out: required (the tuned preset to write), unless --sensitivity")
-    knobs = tuple(search_space(args.param, start, hip_yaw=robot.has_hip_yaw))
+    knobs = tuple(search_space(args.param, start, hip_yaw=robot.has_hip_yaw,
+                               robot_gait=robot.gait))
     out = Path(args.out)
     if out.suffix != ".toml":
         raise ConfigError(f"--out {args.out}: a gait preset is a .toml file")

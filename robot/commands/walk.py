@@ -22,6 +22,7 @@ from robot.commands.common import (
     robot_from,
     seconds,
 )
+from robot.commands.model_args import add_model_names_arg, model_for
 from robot.commands.switch_args import add_switch_arg, switches_from
 from robot.commands.world_args import add_world_args, describe_world, world_from
 from robot.config.read_back import MAX_READ_PERIOD_S, check_read_every, max_read_every
@@ -73,6 +74,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
     p.add_argument("--stop-on-fall", action="store_true",
                    help="sim: end the walk as soon as the robot falls (torque off at once, "
                         "as a fall detector on a real robot would)")
+    add_model_names_arg(p)
     add_set_arg(p)
     add_switch_arg(p)
     add_world_args(p)
@@ -81,6 +83,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # t
 
 def run(args: argparse.Namespace) -> int:
     robot = robot_from(args)
+    model = model_for(args, robot)
     gait, params = params_from(args, robot)
     switches = switches_from(args, robot)
     if gait.warning:
@@ -102,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
                      record=args.record, options=RunOptions(
                          rate_hz=args.rate, read_every=every, hold=args.hold,
                          seconds=args.seconds, stop_on_fall=args.stop_on_fall, signals=True),
-                     switches=switches)
+                     switches=switches, model=model)
     result = walk_summary(spec, execute(spec), gait=gait.name)
     if gait.warning:
         result["gait_warning"] = gait.warning

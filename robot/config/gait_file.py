@@ -32,11 +32,15 @@ class Gait:
     warning: str = ""
 
     def for_robot(self, robot: RobotConfig) -> GaitParams:
-        """The parameters with the robot's ``[balance]`` gains for those the preset does
-        not name itself."""
+        """The parameters on ``robot``: its ``[gait]`` over the preset's (what its body
+        needs, whatever the preset), and its ``[balance]`` gains for those the preset does
+        not name itself (docs/robots.md: preset < [gait] < --set; robot [balance] <
+        preset < --set)."""
+        params = self.params
+        if robot.gait:
+            params = params.replace(dict(robot.gait), where=f"{robot.source}: gait")
         own = {k: v for k, v in robot.balance.items() if k not in self.given}
-        return self.params.replace(own, where=f"{robot.source}: balance") if own else \
-            self.params
+        return params.replace(own, where=f"{robot.source}: balance") if own else params
 
 
 def load_gait(name_or_path: str | Path | None = None) -> Gait:

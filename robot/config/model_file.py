@@ -17,7 +17,7 @@ from robot.config.toml_io import TomlValue, show
 from robot.errors import ConfigError
 
 LEG_KEYS = ("hip", "thigh", "shin", "sole", "yaw_axis", "roll_drop", "lateral", "ankle_drop",
-            "has_ankle_roll", "order")
+            "has_ankle_roll", "order", "knee_back")
 
 
 def num(v: float) -> str:
@@ -53,7 +53,9 @@ def model_toml(model: BodyModel) -> str:
         out += [f"roll_drop = {num(leg.roll_drop)}", f"lateral = {num(leg.lateral)}",
                 f"ankle_drop = {num(leg.ankle_drop)}",
                 f"has_ankle_roll = {'true' if leg.has_ankle_roll else 'false'}",
-                f"order = {_q(leg.order)}", ""]
+                f"order = {_q(leg.order)}",
+                f"knee_back = {'true' if leg.knee_back else 'false'}  # true: the knee bends "
+                "backward (knee angles <= 0)", ""]
     for link in t.links:
         out += ["[[model.links]]", f"name = {_q(link.name)}",
                 f"parent = {_q(t.links[link.parent].name if link.parent >= 0 else '')}",
@@ -208,6 +210,9 @@ def _leg(src: str, side: str, tab: Mapping[str, TomlValue]) -> LegChain:
     roll = tab.get("has_ankle_roll", True)
     if not isinstance(roll, bool):
         raise ConfigError(f"{src}: {path}.has_ankle_roll: expected true or false, got {show(roll)}")
+    back = tab.get("knee_back", False)
+    if not isinstance(back, bool):
+        raise ConfigError(f"{src}: {path}.knee_back: expected true or false, got {show(back)}")
     return LegChain(side, _floats(src, f"{path}.hip", _get(src, path, tab, "hip"), 3),  # type: ignore[arg-type]
                     _number(src, f"{path}.thigh", _get(src, path, tab, "thigh"), positive=True),
                     _number(src, f"{path}.shin", _get(src, path, tab, "shin"), positive=True),
@@ -215,7 +220,8 @@ def _leg(src: str, side: str, tab: Mapping[str, TomlValue]) -> LegChain:
                     _floats(src, f"{path}.yaw_axis", tab["yaw_axis"], 2) if "yaw_axis" in tab else None,  # type: ignore[arg-type]
                     _number(src, f"{path}.roll_drop", tab.get("roll_drop", 0.0)),
                     _number(src, f"{path}.lateral", tab.get("lateral", 0.0)),
-                    _number(src, f"{path}.ankle_drop", tab.get("ankle_drop", 0.0)), roll, order)
+                    _number(src, f"{path}.ankle_drop", tab.get("ankle_drop", 0.0)), roll, order,
+                    back)
 
 
 def parse_model(src: str, value: TomlValue) -> BodyModel:

@@ -11,6 +11,10 @@ What each joint gets (robot/body/roles.py finds the roles, signs and offsets):
   map's, else the servo's whole range (a warning names each such joint);
 - ``max_speed_rad_s``: the model's velocity limit, else the servo's no-load speed, at most
   the map's.
+
+Which way the knees bend (robot.body.legs.LegChain.knee_back): the map's ``knee``
+("forward" or "back"), else backward only where the limits let the rest crouch (``REST``)
+bend the knee backward but not forward (the summary says so), else forward.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -29,21 +34,15 @@ from robot.body.model import BodyModel
 from robot.body.roles import Roles, find_roles
 from robot.body.tree import BodyTree, Frame, Link, matrix_to_quat
 from robot.config.joint_names import ARM_NAMES, LEG_NAMES
+from robot.config.model_recipe import KNEES
 from robot.errors import ConfigError
 from robot.servo.models import MODELS, ServoModel
 
 #: A frame on the torso whose name says it is the IMU's (onshape-to-robot's "imu" frame).
 IMU_FRAME = re.compile(r"imu|bno0?55", re.IGNORECASE)
-#: The rest pose of a straight-legged robot [rad]: knees bent as the bundled robots rest.
+#: The rest pose of a straight-legged robot [rad]: knees bent as the bundled robots rest
+#: (a knee that bends backward: each angle negated).
 REST = {"hip_pitch": -0.55, "knee": 1.1, "ankle_pitch": -0.55}
-#: What ``--map`` may say of a model joint: its name (an extra joint's), its servo's id,
-#: limits in the project's convention (min_rad, max_rad) or the model's (model_range,
-#: [rad]: where a vendor documents them so) and where they come from, a slew limit, the
-#: angle an extra joint is held at, weld (true: no servo drives it; welded at the model's zero).
-MAP_KEYS = {"name", "servo_id", "min_rad", "max_rad", "model_range", "max_speed_rad_s",
-            "limits_source", "fixed_rad", "weld"}
-
-
 @dataclass(frozen=True)
 class JointEntry:
     """One ``[joints.NAME]`` table (project convention) and where its limits came from."""
@@ -60,6 +59,7 @@ class JointEntry:
     max_speed_rad_s: float
     limits_source: str
     fixed_rad: float | None = None
+    gains: Mapping[str, int] = field(default_factory=dict)   # the map's gain registers
 
 
 @dataclass
@@ -71,17 +71,39 @@ class Imported:
     measured: Measured
     roles: Roles
     warnings: list[str] = field(default_factory=list)
+    knees: str = "knees bend forward"   # which way the knees bend, and why
 
     @property
     def rest(self) -> dict[str, float]:
         out = {}
         names = {j.name: j for j in self.joints}
-        for side in "rl":
+        for side, leg in zip("rl", self.model.legs, strict=True):
             for part, q in REST.items():
                 j = names.get(f"{side}_{part}")
                 if j is not None:
+                    q = -q if leg.knee_back else q
                     out[j.name] = min(max(q, j.min_rad), j.max_rad)
         return out
+
+
+def _fits(joints: list[JointEntry], sign: float) -> bool:
+    """Whether every leg joint of ``REST`` (times ``sign``) is inside its limits."""
+    names = {j.name: j for j in joints}
+    return all(j.min_rad <= sign * q <= j.max_rad for side in "rl" for part, q in REST.items()
+               if (j := names.get(f"{side}_{part}")) is not None)
+
+
+def knee_back(joints: list[JointEntry], knee: str | None) -> tuple[bool, str]:
+    """Whether the knees bend backward, and why (the module docstring): ``knee`` the map's
+    ("forward", "back" or None)."""
+    if knee is not None:
+        if knee not in KNEES:
+            raise ConfigError(f"--map: knee: {knee!r}; valid: {', '.join(KNEES)}")
+        return KNEES[knee], f"knees bend {'backward' if KNEES[knee] else 'forward'} (--map)"
+    if not _fits(joints, 1.0) and _fits(joints, -1.0):
+        return True, ("knees bend backward: the leg limits let the rest crouch bend them "
+                      "backward only (--map knee = \"forward\" to override)")
+    return False, "knees bend forward"
 
 
 def _sole_frames(tree: BodyTree, roles: Roles, m: Measured) -> BodyTree:
@@ -127,10 +149,10 @@ def _order(name: str) -> tuple[int, int]:
 
 
 def build(tree: BodyTree, *, servo: ServoModel, joint_map: dict[str, dict[str, object]],
-          file: str, source: str = "", licence: str = "") -> Imported:
+          file: str, source: str = "", licence: str = "", knee: str | None = None) -> Imported:
     """Roles, measurements and joint tables of ``tree`` (see the module docstring). A
     model joint the map marks ``weld = true`` (one no servo drives: a PWM servo off the
-    bus, a passive part) is welded at the model's zero."""
+    bus, a passive part) is welded at the model's zero; ``knee``: the map's (``KNEES``)."""
     welded = [n for n, e in joint_map.items() if e.get("weld") is True]
     missing = [n for n in welded if n not in tree.joint_link]
     if missing:
@@ -200,12 +222,17 @@ def build(tree: BodyTree, *, servo: ServoModel, joint_map: dict[str, dict[str, o
         if name not in LEG_NAMES and name not in ARM_NAMES:
             fixed = min(max(float(entry.get("fixed_rad", 0.0)), lo), hi)  # type: ignore[arg-type]
         joints.append(JointEntry(name, role.model_joint, role.sign, role.offset, servo_id,
-                                 role.sign, zero, lo, hi, round(min(speed, 20.0), 3), src, fixed))
+                                 role.sign, zero, lo, hi, round(min(speed, 20.0), 3), src, fixed,
+                                 dict(entry.get("gains", {}))))  # type: ignore[call-overload]
     if unlimited:
         warnings.append(f"no joint limits in the model for {', '.join(unlimited)}: each gets "
                         f"the {servo.name}'s whole range; give real limits with --map "
                         "(min_rad, max_rad, limits_source)")
-    return Imported(model, joints, m, roles, warnings)
+    back, why = knee_back(joints, knee)
+    if back:
+        model = dataclasses.replace(model, legs=tuple(  # type: ignore[arg-type]
+            dataclasses.replace(leg, knee_back=True) for leg in model.legs))
+    return Imported(model, joints, m, roles, warnings, why)
 
 
 def check_servo(kind: str, model: str) -> ServoModel:
@@ -231,7 +258,7 @@ def summary(imp: Imported, *, path: Path) -> list[str]:
            f"{1000 * g['foot_forward']:+.1f} mm ahead of the ankle",
            f"  offsets: yaw axis {1000 * _yaw_off(legs[0]):.1f} mm off the hip, roll-pitch "
            f"{1000 * legs[0].roll_drop:.1f} mm, sideways {1000 * abs(legs[0].lateral):.1f} mm, ankle "
-           f"{1000 * legs[0].ankle_drop:.1f} mm; hip order {legs[0].order}"]
+           f"{1000 * legs[0].ankle_drop:.1f} mm; hip order {legs[0].order}; {imp.knees}"]
     ids = ", ".join(f"{j.name} {j.servo_id}" for j in imp.joints)
     out.append(f"  servo ids: {ids}")
     out += [f"  warning: {w}" for w in imp.warnings]
@@ -245,60 +272,3 @@ def _yaw_off(leg: object) -> float:
     if leg.yaw_axis is None:
         return 0.0
     return math.hypot(leg.yaw_axis[0] - leg.hip[0], leg.yaw_axis[1] - leg.hip[1])
-
-
-@dataclass(frozen=True)
-class Recipe:
-    """An import's ``--map`` file: per model joint what MAP_KEYS allow; the bus (kind,
-    model, baud), the gain registers and balance gains the robot file gets; where the
-    model comes from, its licence, and notes for the file's opening comment."""
-
-    joints: dict[str, dict[str, object]] = field(default_factory=dict)
-    bus: dict[str, object] = field(default_factory=dict)
-    gains: dict[str, int] = field(default_factory=dict)
-    balance: dict[str, float] = field(default_factory=dict)
-    source: str = ""
-    licence: str = ""
-    notes: tuple[str, ...] = ()
-
-
-RECIPE_KEYS = ("joints", "bus", "balance", "source", "licence", "notes")
-
-
-def read_map(path: str | None) -> Recipe:
-    """The ``--map`` file at ``path`` (None: an empty one); one-line ConfigError."""
-    if path is None:
-        return Recipe()
-    from robot.config.toml_io import read_toml
-
-    data = read_toml(Path(path))
-    where = f"--map {path}"
-    bad = sorted(set(data) - set(RECIPE_KEYS))
-    if bad:
-        raise ConfigError(f"{where}: {bad[0]}: unknown key; valid: {', '.join(RECIPE_KEYS)}")
-    joints = data.get("joints", {})
-    if not isinstance(joints, dict):
-        raise ConfigError(f"{where}: joints: expected [joints.MODEL_JOINT] tables")
-    out: dict[str, dict[str, object]] = {}
-    for name, tab in joints.items():
-        if not isinstance(tab, dict):
-            raise ConfigError(f"{where}: joints.{name}: expected a table")
-        unknown = sorted(set(tab) - MAP_KEYS)
-        if unknown:
-            raise ConfigError(f"{where}: joints.{name}.{unknown[0]}: unknown key; valid: "
-                              f"{', '.join(sorted(MAP_KEYS))}")
-        out[name] = dict(tab)
-    bus = data.get("bus", {})
-    balance = data.get("balance", {})
-    notes = data.get("notes", [])
-    if not isinstance(bus, dict) or not isinstance(balance, dict) or not isinstance(notes, list):
-        raise ConfigError(f"{where}: bus and balance must be tables, notes a list of strings")
-    gains = bus.pop("gains", {}) if isinstance(bus.get("gains", {}), dict) else None
-    if gains is None:
-        raise ConfigError(f"{where}: bus.gains: expected a table of register values")
-    unknown = sorted(set(bus) - {"kind", "model", "baud"})
-    if unknown:
-        raise ConfigError(f"{where}: bus.{unknown[0]}: unknown key; valid: kind, model, baud, gains")
-    return Recipe(out, dict(bus), dict(gains), dict(balance),  # type: ignore[arg-type]
-                  str(data.get("source", "")), str(data.get("licence", "")),
-                  tuple(str(n) for n in notes))

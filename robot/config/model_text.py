@@ -21,9 +21,11 @@ GEOMETRY_ORDER = ("hip_width", "thigh", "shin", "ankle_height", "foot_length", "
 
 def robot_file_text(imp: Imported, *, name: str, kind: str, servo: ServoModel, baud: int,
                     header: list[str], gains: Mapping[str, int] | None = None,
-                    balance: Mapping[str, float] | None = None) -> str:
+                    balance: Mapping[str, float] | None = None,
+                    gait: Mapping[str, float] | None = None) -> str:
     """The robot file for ``imp`` (``header``: comment lines to open it with; ``gains``:
-    ``[bus.gains]``; ``balance``: ``[balance]``)."""
+    ``[bus.gains]``; ``balance``: ``[balance]``; ``gait``: ``[gait]``; each joint's own
+    gains: ``[joints.NAME.gains]``)."""
     out = [f"# {line}" if line else "#" for line in header]
     out += ["", f"name = {_q(name)}", "", "[bus]", f"kind = {_q(kind)}", f"model = {_q(servo.name)}",
             'port = "/dev/ttyUSB0"', f"baud = {baud}", "",
@@ -31,6 +33,8 @@ def robot_file_text(imp: Imported, *, name: str, kind: str, servo: ServoModel, b
                *(f"{k} = {v}" for k, v in gains.items()), ""] if gains else []),
             *(["[balance]  # this robot's balance gains (docs/gait.md)",
                *(f"{k} = {num(float(v))}" for k, v in balance.items()), ""] if balance else []),
+            *(["[gait]  # what this robot's body needs, over any preset (docs/robots.md)",
+               *(f"{k} = {num(float(v))}" for k, v in gait.items()), ""] if gait else []),
             "[imu]  # simulated at the torso's centre of mass (the model's \"imu\" frame); docs/imu.md",
             'kind = "sim"', "", "[geometry]  # measured from the model at the zero pose [m]; "
             "scales the gait (the sim and the IK use [model])"]
@@ -47,6 +51,8 @@ def robot_file_text(imp: Imported, *, name: str, kind: str, servo: ServoModel, b
                 f"max_speed_rad_s = {num(j.max_speed_rad_s)}"]
         if j.fixed_rad is not None:
             out.append(f"fixed_rad = {num(round(j.fixed_rad, 6))}  # held while the gait runs")
+        if j.gains:
+            out += ["", f"[joints.{j.name}.gains]", *(f"{k} = {v}" for k, v in j.gains.items())]
         out.append("")
     rest = imp.rest
     if rest:

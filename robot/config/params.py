@@ -8,6 +8,7 @@ panel all read it.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -211,12 +212,14 @@ class GaitParams:
     def as_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)
 
-    @property
+    # Derived values are cached on the (frozen) instance: the control loop reads them
+    # every tick. They are not fields (replace, as_dict and equality ignore them).
+    @functools.cached_property
     def omega(self) -> float:
         """Main phase rate d(theta)/dt [rad/s]."""
         return self.vM * self.fps
 
-    @property
+    @functools.cached_property
     def cycle_s(self) -> float:
         """Duration of one gait cycle [s] (inf when vM is 0)."""
         return math.inf if self.omega == 0 else 2 * math.pi / self.omega

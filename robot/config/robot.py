@@ -171,6 +171,11 @@ class RobotConfig:
     #: "balance feedback") for this robot; a gait preset that names a gain itself, and
     #: --set, take precedence.
     balance: Mapping[str, float] = field(default_factory=dict)
+    #: The ``[gait]`` section (optional): gait parameters this robot's body needs (a
+    #: cadence, a stance width, a crouch), over whatever preset is walked: preset <
+    #: ``[gait]`` < --set (docs/robots.md); no balance gain (those are ``balance``) and no
+    #: steering command.
+    gait: Mapping[str, float] = field(default_factory=dict)
     #: Servo physics read from the model files the robot file names, per joint name
     #: (joints without one use their model's bundled physics: ``servo_physics``).
     physics: Mapping[str, ServoPhysics] = field(default_factory=dict)

@@ -22,7 +22,7 @@ from robot.config.gains_file import check_fits, parse_gains, split_gains
 from robot.config.imu_file import parse_imu
 from robot.config.joint_names import ARM_NAMES, HIP_YAW_NAMES, JOINT_NAMES
 from robot.config.model_file import parse_model
-from robot.config.params import BALANCE, SPECS, canonical_name, check_value
+from robot.config.params import BALANCE, SPECS, STEER, canonical_name, check_value
 from robot.config.robot import ANGLE, BusConfig, Geometry, JointConfig, Masses, RobotConfig
 from robot.config.servo_file import servo_files
 from robot.config.toml_io import Range, TomlValue, build, number, read_toml, show, table
@@ -40,7 +40,8 @@ def load_robot(name_or_path: str | Path | None = None) -> RobotConfig:
 def parse_robot(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> RobotConfig:
     """A validated robot from a robot file's table (ConfigError, one line, on any problem)."""
     src = source
-    allowed = {"name", "bus", "geometry", "mass", "joints", "rest", "imu", "balance", "model"}
+    allowed = {"name", "bus", "geometry", "mass", "joints", "rest", "imu", "balance", "gait",
+               "model"}
     unknown = sorted(set(data) - allowed)
     if unknown:
         raise ConfigError(f"{src}: {unknown[0]}: unknown key; valid: {', '.join(sorted(allowed))}")
@@ -125,8 +126,29 @@ def parse_robot(data: Mapping[str, TomlValue], *, source: str = "<memory>") -> R
     if body is not None:
         check_model_joints(src, body, joints)
     robot = RobotConfig(name=name, bus=bus, geometry=geometry, mass=mass, joints=tuple(joints),
-                        rest=rest, source=src, imu=imu, balance=balance, body=body,
+                        rest=rest, source=src, imu=imu, balance=balance,
+                        gait=parse_gait_table(src, data.get("gait", {})), body=body,
                         physics=servo_files(src, bus.servo_file, [
                             (j.name, j.servo_file, j.model or bus.model) for j in joints]))
     check_ticks(robot)
     return robot
+
+
+def parse_gait_table(src: str, value: TomlValue) -> dict[str, float]:
+    """A robot file's ``[gait]``: gait parameters by name (aliases allowed), each checked
+    against its documented range; a balance gain (``[balance]``'s) or a steering command
+    is refused, naming the valid ones."""
+    out: dict[str, float] = {}
+    for key, v in table(src, "gait", value).items():
+        where = f"{src}: gait.{key}"
+        canon = canonical_name(key, where=where)
+        group = SPECS[canon].group
+        if group in (BALANCE, STEER):
+            valid = ", ".join(n for n, spec in SPECS.items() if spec.group not in (BALANCE, STEER))
+            why = ("a balance gain belongs in [balance]" if group == BALANCE
+                   else "a steering command is given when walking (--set, the panel)")
+            raise ConfigError(f"{where}: not a gait parameter of the robot ({why}); valid: {valid}")
+        if canon in out:
+            raise ConfigError(f"{where}: {canon} given twice (alias of {canon})")
+        out[canon] = check_value(canon, v, where=where)
+    return out

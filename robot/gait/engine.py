@@ -29,6 +29,8 @@ from robot.gait.targets import NO_TRIM, BodyTrim, body_targets
 from robot.gait.tick import TickKernel
 from robot.gait.vectorised import solve
 from robot.gait.xmath import Num
+from robot.gait.xmath import plain as _plain
+from robot.gait.xmath import smoothstep as _smoothstep
 
 log = logging.getLogger(__name__)
 
@@ -38,16 +40,6 @@ __all__ = ["PARAM_TAU_S", "PRESET_BLEND_S", "STEER_BUDGET", "STEER_RATE", "GaitE
 #: The envelope's slowest rate [-] relative to its own while a feedback loop holds the
 #: phase: a stop braced again and again still ends, in at most 1 / this the time.
 ENVELOPE_MIN_RATE = 0.25
-
-
-def _plain(values: tuple[Num, ...]) -> bool:
-    """Every value a Python float or int (not a numpy scalar or array)."""
-    return all(type(v) is float or type(v) is int for v in values)
-
-
-def _smoothstep(x: float) -> float:
-    x = min(max(x, 0.0), 1.0)
-    return x * x * (3.0 - 2.0 * x)
 
 
 class GaitEngine:
@@ -74,6 +66,7 @@ class GaitEngine:
         self.time = 0.0
         self._ramp = 0.0          # linear ramp variable in [0, 1]
         self._stop: str | None = None   # a closing stop's stage (gait.stop_close)
+        self._amplitude = 0.0     # _smoothstep(_ramp), set with it
         self._running = False
         self.unreachable_ticks = 0
         #: The heading change [rad] the gait's ``turn`` asked for so far: ``turn`` per step,
@@ -158,7 +151,7 @@ class GaitEngine:
     @property
     def amplitude(self) -> float:
         """Current envelope value in [0, 1]."""
-        return _smoothstep(self._ramp)
+        return self._amplitude
 
     @property
     def stopped(self) -> bool:
@@ -273,6 +266,7 @@ class GaitEngine:
                                               self.lift != (0.0, 0.0), p, least=least)
         else:
             self._ramp = max(0.0, self._ramp - step)
+        self._amplitude = _smoothstep(self._ramp)
         if self._ramp > 0.0:
             theta = self.phase.theta
             rate = 1.0 if self.stairs is None else self.stairs.rate   # x 1.0: same bits
@@ -298,3 +292,7 @@ class GaitEngine:
         ``with_channels=False`` returns an empty channel dict and only the joint angles."""
         return vectorised.curves(self.robot, self._target, times, chunk=chunk,
                                  with_channels=with_channels)
+
+    def sole_targets(self, times: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """The sole targets (2, n, 3) [m, pelvis frame] that ``curves`` solves for."""
+        return vectorised.sole_targets(self.robot, self._target, times)

@@ -21,7 +21,8 @@ Otherwise ``NEWTON`` Newton steps from that with the root term at 1 (the error f
 tests/test_ik_chain.py). n then gives the hip yaw and roll, these the hip pitch point,
 and the knee, ankle pitch and hip pitch follow as robot.gait.ik.leg_ik's: the law of
 cosines in the pitch plane, clamped along the ankle → hip line within the knee limits'
-span.
+span; a leg whose knee bends backward (``LegChain.knee_back``) takes the other branch of
+the law, the knee's angle negated (``Chain.kb``), the rest of the solution unchanged.
 
 A leg without ankle roll keeps the sole point and the foot's x axis (its heading and
 pitch) exactly and gives up the roll about that axis: the same equation with A the sole
@@ -39,7 +40,7 @@ from typing import NamedTuple
 from robot.body.legs import ORDERS, LegChain
 from robot.errors import ConfigError
 from robot.gait import xmath as xm
-from robot.gait.ik import REACH_TOL, LegIK, Reach, leg_ik_at
+from robot.gait.ik import REACH_TOL, LegIK, Reach, leg_ik_at, reach
 from robot.gait.xmath import Rot, Vec
 
 #: Newton steps on the lateral constraint when the yaw axis is off the hip sideways: 2
@@ -81,6 +82,7 @@ class Chain(NamedTuple):
     lo_tol: float    # lo - REACH_TOL
     hi_tol: float    # hi + REACH_TOL
     steps: int       # Newton steps (NEWTON)
+    kb: float        # the knee's bend direction: 1.0 forward, -1.0 backward (knee_back)
 
 
 def layout_name(leg: LegChain) -> str:
@@ -114,6 +116,14 @@ def check_layout(leg: LegChain, *, where: str = "leg") -> None:
                           "5-DoF without ankle roll (yaw_roll or roll_yaw)")
 
 
+def knee_span(leg: LegChain, knee_lo: float, knee_hi: float) -> Reach:
+    """The hip to ankle distances [m] ``leg`` spans with its knee between ``knee_lo`` and
+    ``knee_hi`` [rad] (the joint's limits): bends of ``knee_lo``..``knee_hi``, or of
+    ``-knee_hi``..``-knee_lo`` for a knee that bends backward (``knee_back``)."""
+    lo, hi = (-knee_hi, -knee_lo) if leg.knee_back else (knee_lo, knee_hi)
+    return reach(leg.thigh, leg.shin, lo, hi)
+
+
 @lru_cache(maxsize=64)
 def chain_constants(leg: LegChain, span: Reach | None = None) -> Chain:
     """What ``chain_leg_ik`` derives from the leg alone (span: as leg_ik's)."""
@@ -132,7 +142,8 @@ def chain_constants(leg: LegChain, span: Reach | None = None) -> Chain:
     return Chain(six, yaw_roll, px, py, hz, ux, uy, hx, hy, hz, leg.roll_drop,
                  leg.ankle_drop, sx, sy, oz, k0, k1, a, b, a + b, abs(a - b), 4.0 * a * b,
                  lo, hi, lo - REACH_TOL, hi + REACH_TOL,
-                 NEWTON[0] if abs(uy) < NEWTON_NEAR * (a + b) else NEWTON[1])
+                 NEWTON[0] if abs(uy) < NEWTON_NEAR * (a + b) else NEWTON[1],
+                 -1.0 if leg.knee_back else 1.0)
 
 
 def chain_leg_ik(leg: LegChain, sole: Vec, foot_rot: Rot = xm.IDENTITY, *,
@@ -208,7 +219,7 @@ def chain_leg_ik(leg: LegChain, sole: Vec, foot_rot: Rot = xm.IDENTITY, *,
     s_ = xm.clip(dist, k.lo, k.hi)   # ik.bend(a, b, s_) with t = 0
     out = xm.clip((k.far - s_) * (k.far + s_), 0.0, k.span)
     inn = xm.clip((s_ - k.near) * (s_ + k.near), 0.0, k.span)
-    knee = 2.0 * xm.atan2(xm.sqrt(out), xm.sqrt(inn))
+    knee = k.kb * (2.0 * xm.atan2(xm.sqrt(out), xm.sqrt(inn)))
     ankle_a = xm.atan2(k.a * xm.sin(knee), k.b + k.a * xm.cos(knee))
     ankle_pitch = -xm.atan2(px_, pz_) - ankle_a
     ankle_pitch = xm.atan2(xm.sin(ankle_pitch), xm.cos(ankle_pitch))

@@ -33,7 +33,7 @@ def leg_solver(leg: LegChain, span: Reach) -> Solver:
 def chain_ik(k: Chain, sole: Sole, f: Rot) -> tuple[list[float], bool]:
     """chain_leg_ik on floats: the six leg angles [rad] and the reachable flag."""
     (six, yaw_roll, px, py, pz, ux, uy, hx, hy, hz, drop, ad, ox, oy, oz, k0, k1, a, b,
-     far, near, span, lo, hi, lo_tol, hi_tol, steps) = k
+     far, near, span, lo, hi, lo_tol, hi_tol, steps, kb) = k
     f0, f1, f2, f3, f4, f5, f6, f7, f8 = f
     sx, sy, sz = sole
     if six:
@@ -99,7 +99,7 @@ def chain_ik(k: Chain, sole: Sole, f: Rot) -> tuple[list[float], bool]:
     out = 0.0 if out < 0.0 else span if out > span else out
     inn = (s_ - near) * (s_ + near)
     inn = 0.0 if inn < 0.0 else span if inn > span else inn
-    knee = 2.0 * atan2(sqrt(out), sqrt(inn))
+    knee = kb * (2.0 * atan2(sqrt(out), sqrt(inn)))
     ankle_a = atan2(a * sin(knee), b + a * cos(knee))
     ankle_pitch = -atan2(px_, pz_) - ankle_a
     ankle_pitch = atan2(sin(ankle_pitch), cos(ankle_pitch))

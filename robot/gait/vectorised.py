@@ -25,8 +25,8 @@ import numpy.typing as npt
 from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.gait import expressions as gait
-from robot.gait.ik import Reach, arm_ik, arm_reach, reach
-from robot.gait.ik_chain import chain_leg_ik
+from robot.gait.ik import Reach, arm_ik, arm_reach
+from robot.gait.ik_chain import chain_leg_ik, knee_span
 from robot.gait.targets import BodyTargets, body_targets
 from robot.gait.xmath import Num
 
@@ -39,8 +39,7 @@ def spans(robot: RobotConfig) -> tuple[Reach, Reach, Reach | None, Reach | None]
         j = robot.joint(name)
         return j.min_rad, j.max_rad
     g = robot.geometry
-    r_leg, l_leg = (reach(leg.thigh, leg.shin, *limits(f"{leg.side}_knee"))
-                    for leg in robot.legs)
+    r_leg, l_leg = (knee_span(leg, *limits(f"{leg.side}_knee")) for leg in robot.legs)
     if not robot.has_arms:
         return r_leg, l_leg, None, None
     return r_leg, l_leg, arm_reach(g, *limits("r_elbow")), arm_reach(g, *limits("l_elbow"))
@@ -113,3 +112,13 @@ def curves(robot: RobotConfig, p: GaitParams, times: npt.NDArray[np.float64], *,
             for _ in pool.map(one, starts):  # re-raises a chunk's exception
                 pass
     return out_ch, out_q
+
+
+def sole_targets(robot: RobotConfig, p: GaitParams, times: npt.NDArray[np.float64]
+                 ) -> npt.NDArray[np.float64]:
+    """The right and left sole targets (2, n, 3) [m, pelvis frame] the IK of ``curves``
+    solves for over ``times`` [s] (before the joint limits clamp the angles)."""
+    times = np.asarray(times, dtype=float)
+    t = body_targets(gait.curves(times, p), p, robot.geometry, leg_yaw=robot.has_hip_yaw)
+    return np.stack([np.stack([np.broadcast_to(np.asarray(v, float), times.shape)
+                               for v in sole], axis=1) for sole in (t.r_sole, t.l_sole)])

@@ -18,6 +18,20 @@ Vec = tuple[Num, Num, Num]
 
 IDENTITY: Rot = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 
+_PLAIN_TYPES = frozenset({float, int})
+
+
+def plain(values: tuple[Num, ...]) -> bool:
+    """Every value a Python float or int (not a numpy scalar or array, nor a bool): the
+    values for which the ``math`` path gives the bits the general one gives."""
+    return _PLAIN_TYPES.issuperset(map(type, values))
+
+
+def smoothstep(x: float) -> float:
+    """3x^2 - 2x^3 of x clipped to [0, 1]."""
+    x = min(max(x, 0.0), 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
 
 def sin(x: Num) -> Num:
     return math.sin(x) if type(x) is float else np.sin(x)

@@ -30,7 +30,8 @@ def quat_conj(q: Quat) -> Quat:
 
 
 def quat_normalize(q: Quat) -> Quat:
-    n = math.sqrt(sum(c * c for c in q))
+    w, x, y, z = q
+    n = math.sqrt(sum((w * w, x * x, y * y, z * z)))
     if n == 0.0:
         return (1.0, 0.0, 0.0, 0.0)
     return (q[0] / n, q[1] / n, q[2] / n, q[3] / n)

@@ -70,10 +70,12 @@ class FollowCheck:
         self._count += 1
         if self._count < self.reads:
             return None
-        r_goal = np.ptp(self._goal, axis=0)
-        r_present = np.ptp(self._present, axis=0)
+        # np.ptp's reductions, called directly (this runs at every read-back)
+        r_goal = np.maximum.reduce(self._goal, axis=0) - np.minimum.reduce(self._goal, axis=0)
+        r_present = (np.maximum.reduce(self._present, axis=0)
+                     - np.minimum.reduce(self._present, axis=0))
         stuck = (r_goal >= self.travel) & (r_present <= FROZEN_SHARE * r_goal)
-        if not stuck.any():
+        if not np.logical_or.reduce(stuck):
             return None
         i = int(np.argmax(stuck))
         return i, float(r_goal[i]), float(r_present[i])

@@ -19,8 +19,9 @@ the ``rosbags`` type store: no ROS install needed; Foxglove's own JSON schema fo
 
 Times: every message's log time and header stamp is the tick's, on the loop's clock,
 anchored to the wall clock (UNIX epoch) at the first tick; a simulation faster than real
-time keeps its own time base. ``/joint_states`` is stamped when the reply was in (the host's
-monotonic clock from the same anchor: a take's ``present_t``; the log time is the tick's).
+time keeps its own time base. ``/joint_states`` is stamped when the reply was in (on the
+loop's clock from the same anchor, the sim's on the sim bus: a take's ``present_t``; the
+log time is the tick's).
 Effort is the servo's load (% of its maximum torque) times its stall torque. A channel
 appears at its first message; the run's take header (robot, joints, rate) is the metadata
 record ``biped`` (``take_header``: its JSON), so
@@ -243,8 +244,8 @@ class McapRecorder:
         loads = [tel.servo[i].load if i in tel.servo else None for i in self.ids]
         effort = np.array([math.nan if v is None else v / 100.0 * s
                            for v, s in zip(loads, self._stall, strict=True)])
-        assert self._t0 is not None    # stamped when the reply was in (a take's present_t)
-        replied = self._epoch_ns + int(round((time.monotonic() - self._t0) * 1e9))
+        assert self._t0 is not None    # stamped when the reply was in (a take's present_t),
+        replied = self._epoch_ns + int(round((tel.t_read - self._t0) * 1e9))  # loop's clock
         self._ros("/joint_states", "sensor_msgs/msg/JointState", header=self._header(stamp=replied),
                   name=self.names, position=np.asarray(tel.q_present, dtype=np.float64),
                   velocity=np.empty(0), effort=effort)

@@ -41,9 +41,9 @@ class PendingParams:
     def apply(self, source: MotionSource) -> None:
         """Give ``source`` what is pending: a blend (``blend_to`` where the source has one,
         else as a change), then the changes asked after it."""
+        if not self._changes and self._blend is None:   # the usual tick: nothing asked
+            return                 # (a change asked meanwhile is applied at the next tick)
         with self._lock:
-            if not self._changes and self._blend is None:
-                return
             changes, self._changes = self._changes, {}
             blend, self._blend = self._blend, None
         if blend is not None:

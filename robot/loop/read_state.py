@@ -26,7 +26,8 @@ def read_state(bus: Bus, servo_map: ServoMap, watchdog: Watchdog, tel: Telemetry
     watchdog.bus_ok("read")
     tel.t_read = clock.now()
     tel.servo = states
-    tel.q_present = servo_map.from_positions({i: s.position for i, s in states.items()}).tolist()
+    present = servo_map.from_positions({i: s.position for i, s in states.items()})
+    tel.q_present = present.tolist()
     tel.fresh = True
-    watchdog.check(states, q_goal)
+    watchdog.check(states, q_goal, present=present)
     return True

@@ -15,6 +15,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from robot.config.model_angles import ModelAngles
 from robot.errors import ConfigError
 from robot.files.atomic import OutputFile
 from robot.loop.streamer import Telemetry
@@ -26,10 +27,13 @@ class Recorder:
     """Writes time since the first tick [s], commanded and present joint positions, loop
     timing, temperatures and loads (present values only on read-back ticks, blank / null
     otherwise), and the joints held at a limit that tick (``clamped``: names separated by
-    spaces, blank when none)."""
+    spaces, blank when none). ``model``: an imported robot's joints in its model's terms
+    (robot/config/model_angles.py): the commanded and present angles again, as
+    ``model_cmd_<model joint>`` and ``model_present_<model joint>`` [rad, the model's
+    convention], after the rest."""
 
     def __init__(self, path: str | Path, joint_names: tuple[str, ...],
-                 ids: tuple[int, ...]) -> None:
+                 ids: tuple[int, ...], *, model: ModelAngles | None = None) -> None:
         self.path = Path(path)
         if self.path.suffix not in FORMATS:
             raise ConfigError(f"--record {path}: unknown format {self.path.suffix!r}; "
@@ -37,6 +41,7 @@ class Recorder:
                               "play)")
         self.names = joint_names
         self.ids = ids
+        self.model = model
         self._file: OutputFile | None = None
         self._row = io.StringIO()
         self._csv: Any = None  # a csv.writer on _row (its type is private to the csv module)
@@ -48,7 +53,11 @@ class Recorder:
         cols = ["t", "state", "tick", "period_error_ms", "overruns", "amplitude"]
         cols += [f"cmd_{n}" for n in self.names] + [f"present_{n}" for n in self.names]
         cols += [f"temp_{n}" for n in self.names] + [f"load_{n}" for n in self.names]
-        return [*cols, "clamped"]
+        cols.append("clamped")
+        if self.model is not None:
+            cols += [f"model_cmd_{n}" for n in self.model.names]
+            cols += [f"model_present_{n}" for n in self.model.names]
+        return cols
 
     def open(self) -> Recorder:
         """Create the temporary file (ConfigError naming the path if it cannot be)."""
@@ -109,6 +118,9 @@ class Recorder:
         loads = [servo[i].load if i in servo else None for i in self.ids]
         row = [tel.t - self._t0, tel.state, tel.tick, tel.period_error_ms, tel.overruns, tel.amplitude,
                *tel.q_cmd, *present, *temps, *loads, " ".join(tel.clamped) or None]
+        if self.model is not None:
+            row += [*self.model.values(tel.q_cmd).tolist(),
+                    *self.model.values(present).tolist()]
         if self._csv is not None:
             self._write_row(["" if v is None or (isinstance(v, float) and math.isnan(v))
                              else v for v in row])

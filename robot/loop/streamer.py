@@ -240,14 +240,14 @@ class Streamer(Generic[SourceT]):
         if self._feedback_on:
             q = self._feed_back(q)
         limited = self.map.clamp(q)
-        own = np.flatnonzero(limited != q)
-        clamped = (tuple(self.map.names[i] for i in sorted({*held, *own.tolist()}))
-                   if held or own.size else ())
-        q = np.clip(limited, self._q_last - self._step, self._q_last + self._step)
+        own = limited != q
+        clamped = (tuple(self.map.names[i] for i in sorted({*held, *np.flatnonzero(own).tolist()}))
+                   if held or np.logical_or.reduce(own) else ())
+        q = limited.clip(self._q_last - self._step, self._q_last + self._step)
         q_list = q.tolist()
         self._wait_deadline()
         try:
-            self.bus.write_goals(self.map.goals(q_list))
+            self.bus.write_joint_goals(self.map, q)
             self.watchdog.bus_ok("write")
         except BusError as e:
             self._bus_errors += 1

@@ -89,24 +89,27 @@ class Watchdog:
             raise SafetyStop(f"{self._overrun_streak} loop overruns in a row: the loop cannot "
                              f"keep its rate; lower --rate or the read-back frequency")
 
-    def check(self, states: Mapping[int, ServoState], q_cmd: npt.NDArray[np.float64]) -> None:
-        """Raise SafetyStop on a hardware fault, overheating, or a servo not following."""
+    def check(self, states: Mapping[int, ServoState], q_cmd: npt.NDArray[np.float64], *,
+              present: npt.NDArray[np.float64] | None = None) -> None:
+        """Raise SafetyStop on a hardware fault, overheating, or a servo not following.
+        ``present``: the positions of ``states`` in radians, joint order, if known."""
         self.faults(states)
-        self._following(states, q_cmd)
+        self._following(states, q_cmd, present)
 
     def faults(self, states: Mapping[int, ServoState]) -> None:
         """Raise SafetyStop on a hardware fault or overheating."""
+        hot = self.cfg.max_temperature_c
         for sid, s in states.items():
-            bad = sorted(s.errors & FAULTS)
-            if bad:
-                raise SafetyStop(f"{self.name(sid)} reports {', '.join(bad)}")
-            if s.temperature is not None and s.temperature > self.cfg.max_temperature_c:
+            if s.errors and s.errors & FAULTS:
+                raise SafetyStop(f"{self.name(sid)} reports {', '.join(sorted(s.errors & FAULTS))}")
+            if s.temperature is not None and s.temperature > hot:
                 raise SafetyStop(f"{self.name(sid)} at {s.temperature:.0f} °C "
-                                 f"(limit {self.cfg.max_temperature_c:.0f} °C)")
+                                 f"(limit {hot:.0f} °C)")
 
-    def _following(self, states: Mapping[int, ServoState],
-                   q_cmd: npt.NDArray[np.float64]) -> None:
-        present = self.map.from_positions({i: s.position for i, s in states.items()})
+    def _following(self, states: Mapping[int, ServoState], q_cmd: npt.NDArray[np.float64],
+                   present: npt.NDArray[np.float64] | None) -> None:
+        if present is None:
+            present = self.map.from_positions({i: s.position for i, s in states.items()})
         stuck = self._follow.add(q_cmd, present)
         if stuck is not None:
             i, r_goal, r_present = stuck

@@ -1,6 +1,7 @@
 """Stick figure of the robot from joint angles, as 2-D polylines for the panel's canvases.
 
-Forward kinematics (robot.gait.ik) in the pelvis frame (REP-103: x forward, y left, z up) [m].
+Forward kinematics (robot.gait.ik; an imported robot's model: robot/panel/figure_body.py)
+in the pelvis frame (REP-103: x forward, y left, z up) [m].
 The side view looks at the robot's right side (screen x = x forward, screen y = z up);
 the front view faces the robot (screen x = y, the robot's left on the viewer's right).
 """
@@ -15,6 +16,7 @@ from robot.config.joint_names import ARM_JOINTS, LEG_JOINTS
 from robot.config.robot import Geometry, RobotConfig
 from robot.gait.ik import arm_fk_local, hip_centre, leg_fk_full, shoulder_centre
 from robot.gait.xmath import Vec
+from robot.panel.figure_body import body_figure
 
 Point = tuple[float, float, float]
 
@@ -46,7 +48,10 @@ def _arm_points(g: Geometry, side: str, q: tuple[float, float, float]) -> list[P
 
 
 def stick_figure(robot: RobotConfig, q: Sequence[float]) -> dict[str, list[Point]]:
-    """Named 3-D polylines [m] for joint angles ``q`` [rad] in ``robot.joints`` order."""
+    """Named 3-D polylines [m] for joint angles ``q`` [rad] in ``robot.joints`` order (an
+    imported robot's from its model: robot/panel/figure_body.py)."""
+    if robot.body is not None:
+        return body_figure(robot, q)
     g = robot.geometry
     angles = dict(zip(robot.joint_names, (float(v) for v in q), strict=True))
     lines: dict[str, list[Point]] = {}

@@ -9,6 +9,7 @@ from collections import deque
 from collections.abc import Mapping
 from typing import Any
 
+from robot.config.model_angles import ModelAngles
 from robot.config.params import GROUPS, SPECS, GaitParams
 from robot.config.robot import RobotConfig
 from robot.loop.telemetry import Telemetry
@@ -58,9 +59,11 @@ def state_snapshot(robot: RobotConfig, tel: Mapping[str, Any], sim: Mapping[str,
                    show: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """A JSON-ready snapshot: loop state and timing, servos, sim metrics, stick figure;
     while a show plays (``show``: its progress), the state "playing" and ``doing``, what
-    it is doing in words."""
+    it is doing in words; an imported robot's joints in its model's terms (``model``:
+    the model's joint names, the commanded and present angles in its convention [rad],
+    robot/config/model_angles.py), and each servo's ``model_joint``."""
     names = robot.joint_names
-    servos = [{"id": j.servo_id, "joint": j.name,
+    servos = [{"id": j.servo_id, "joint": j.name, "model_joint": j.model_joint,
                "temperature": s.temperature if s else None,
                "load": s.load if s else None,
                "errors": sorted(s.errors) if s else []}
@@ -70,6 +73,13 @@ def state_snapshot(robot: RobotConfig, tel: Mapping[str, Any], sim: Mapping[str,
     figure = {"cmd": views(robot, q_cmd) if len(q_cmd) == len(names) else None,
               "present": views(robot, q_present)
               if q_present and len(q_present) == len(names) else None}
+    model = None
+    if robot.body is not None:
+        angles = ModelAngles.of(robot)
+        model = {"joints": list(angles.names),
+                 "q_cmd": angles.values(q_cmd).tolist() if len(q_cmd) == len(names) else None,
+                 "q_present": angles.values(q_present).tolist()
+                 if q_present and len(q_present) == len(names) else None}
     state = tel.get("state", "idle")
     playing = bool(running and show and show.get("playing") and state == "walking")
     return {
@@ -81,7 +91,7 @@ def state_snapshot(robot: RobotConfig, tel: Mapping[str, Any], sim: Mapping[str,
         "stop_reason": tel.get("stop_reason"), "clamped": list(tel.get("clamped", [])),
         "joints": list(names),
         "q_cmd": q_cmd, "q_present": q_present, "servos": servos, "sim": sim or None,
-        "figure": figure, "wall_time": time.time()}
+        "figure": figure, "model": model, "wall_time": time.time()}
 
 
 def describe_params(params: GaitParams, preset: str | None) -> dict[str, Any]:

@@ -66,8 +66,8 @@ class BoneMap:
 
 def by_name(robot: RobotConfig) -> BoneMap:
     """The map of the skeleton ``biped export`` writes for ``robot`` (robot/previs/bvh.py)."""
-    maps = [JointMap(joint, b.name, axis) for b in skeleton(robot)
-            for axis, joint in b.axes if joint is not None]
+    maps = [JointMap(joint, b.name, axis, b.sign(k)) for b in skeleton(robot)
+            for k, (axis, joint) in enumerate(b.axes) if joint is not None]
     return BoneMap(tuple(maps))
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -33,13 +34,19 @@ assert sorted(n for g in CHANNEL_GROUPS.values() for n in g) == sorted(CHANNELS)
 
 def write_csv(path: str | Path, times: npt.NDArray[np.float64],
               channels: dict[str, npt.NDArray[np.float64]], joint_names: tuple[str, ...],
-              q: npt.NDArray[np.float64]) -> None:
-    """Columns: ``t`` [s], every channel of equations.md, ``q_<joint>`` [rad]."""
+              q: npt.NDArray[np.float64], *,
+              extra: Mapping[str, npt.NDArray[np.float64]] | None = None) -> None:
+    """Columns: ``t`` [s], every channel of equations.md, ``q_<joint>`` [rad], then the
+    ``extra`` columns by name (ValueError if one is named as a column before it)."""
+    more = dict(extra or {})
     header = ["t", *CHANNELS, *(f"q_{n}" for n in joint_names)]
-    data = np.column_stack([times, *(channels[c] for c in CHANNELS), *q])
+    taken = set(header) & set(more)
+    if taken:
+        raise ValueError(f"column {sorted(taken)[0]!r} twice")
+    data = np.column_stack([times, *(channels[c] for c in CHANNELS), *q, *more.values()])
     text = io.StringIO()
     w = csv.writer(text)
-    w.writerow(header)
+    w.writerow([*header, *more])
     w.writerows(data.tolist())  # repr precision: the channels round-trip exactly
     write_text(path, text.getvalue())
 

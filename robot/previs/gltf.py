@@ -24,7 +24,8 @@ import pygltflib as gl
 
 from robot.config.robot import RobotConfig
 from robot.files.atomic import replacing
-from robot.previs.bvh import Bone, root_motion, skeleton, to_bvh
+from robot.previs.bones import Bone
+from robot.previs.bvh import root_motion, skeleton, to_bvh
 
 Array = npt.NDArray[np.float64]
 #: Robot axis → glTF unit axis (x fwd → +Z, y left → +X, z up → +Y).
@@ -53,9 +54,9 @@ def quat_mul(a: Array, b: Array) -> Array:
 def bone_rotations(bone: Bone, names: Sequence[str], q: Array) -> Array:
     """A bone's rotation per frame (n, 4), (x, y, z, w)."""
     out = np.tile([0.0, 0.0, 0.0, 1.0], (len(q), 1))
-    for axis, joint in bone.axes:
+    for k, (axis, joint) in enumerate(bone.axes):
         if joint is not None:
-            out = quat_mul(out, axis_quat(axis, q[:, names.index(joint)]))
+            out = quat_mul(out, axis_quat(axis, bone.sign(k) * q[:, names.index(joint)]))
     return out
 
 

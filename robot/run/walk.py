@@ -10,6 +10,7 @@ import math
 from typing import Any
 
 from robot.bus.base import Bus
+from robot.config.model_angles import ModelAngles
 from robot.config.params import GaitParams
 from robot.config.robot import RobotConfig
 from robot.errors import ConfigError
@@ -55,12 +56,14 @@ def walk_imu(robot: RobotConfig, bus: Bus, *, balance: bool = True,
 def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
               imu: Imu | None = None, keyframes: Sequence | None = None,
               record: str | None = None, options: RunOptions | None = None,
-              switches: tuple[PresetSwitch, ...] = ()) -> RunSpec[GaitEngine]:
+              switches: tuple[PresetSwitch, ...] = (),
+              model: ModelAngles | None = None) -> RunSpec[GaitEngine]:
     """The run of a walk with ``params`` (preset ``gait``, for a take's header), a
     keyframe layer on the arms, a recording (NAME.take.jsonl: the parameter
     timeline; .csv or .jsonl: the joint stream; .mcap: the run's channels,
     robot.loop.mcap_recorder) and preset ``switches`` (blended live,
-    robot.run.switching; a take records them as blends)."""
+    robot.run.switching; a take records them as blends); ``model``: a .csv or .jsonl
+    record adds the joints in the model's terms (robot.loop.recorder)."""
     options = options or RunOptions()
     recorder: Recording | None = None
     engine: GaitEngine
@@ -81,7 +84,7 @@ def walk_spec(robot: RobotConfig, params: GaitParams, bus: Bus, *, gait: str,
             recorder = McapRecorder(record, robot, header, params=lambda: source.params,
                                     body=bus)
         elif record:
-            recorder = Recorder(record, robot.joint_names, robot.ids)
+            recorder = Recorder(record, robot.joint_names, robot.ids, model=model)
     return RunSpec(robot=robot, source=engine, bus=bus, options=options, imu=imu,
                    recorder=recorder,
                    observer=PresetSwitcher(engine, switches) if switches else None)

@@ -1,4 +1,4 @@
-"""HiWonder/LewanSoul LX serial bus servos (robot/bus/lx.py speaks their protocol).
+"""HiWonder/LewanSoul LX serial bus servos (robot/bus/lx/bus.py speaks their protocol).
 
 The protocol has no model number: ``number`` is biped's own label (scan reports the robot
 file's model). No gains: the firmware takes a position and a move time, nothing else (gain

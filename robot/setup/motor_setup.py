@@ -23,8 +23,8 @@ import logging
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
-from robot.bus.lx import LxBus
-from robot.bus.sdk_bus import SdkBus
+from robot.bus.lx.bus import LxBus
+from robot.bus.sdk.bus import SdkBus
 from robot.bus.tables import EEPROM_LOCK, RETURN_DELAY_UNIT_S
 from robot.config.robot import SERVO_ID, JointConfig, RobotConfig
 from robot.errors import BusError, ConfigError
@@ -36,7 +36,7 @@ FACTORY_ID = 1
 # Baud rates as shipped: robot.servo.models.FACTORY_BAUD (per family; a model may differ:
 # the MX series on Protocol 1.0 ships at 57600 where the AX ships at 1 Mbps). LX servos
 # have one rate (no Baud Rate register) and find a lone servo by a broadcast ID read
-# (robot/bus/lx.py).
+# (robot/bus/lx/bus.py).
 __all__ = ["FACTORY_BAUD", "find_servo", "set_up_already", "assign"]
 #: The buses setup-motors drives (LX: the same calls, on its own protocol).
 SetupBus = SdkBus | LxBus

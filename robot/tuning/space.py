@@ -101,13 +101,23 @@ def parse_knob(text: str, params: GaitParams) -> Knob:
     return Knob(name, lo, hi, targets)
 
 
-def search_space(texts: Sequence[str], params: GaitParams, *,
-                 hip_yaw: bool = True) -> list[Knob]:
+def search_space(texts: Sequence[str], params: GaitParams, *, hip_yaw: bool = True,
+                 robot_gait: Iterable[str] = ()) -> list[Knob]:
     """The knobs of ``--param`` items, or DEFAULT_KNOBS when none is given (and
     FIVE_DOF_KNOBS for legs without ``hip_yaw``); a parameter searched twice is an
-    error."""
+    error. ``robot_gait``: the parameters the robot file's ``[gait]`` sets, which win over
+    any preset (so a tuned preset could not change them): left out of the default search,
+    and an error when ``--param`` names one."""
+    fixed = set(robot_gait)
     default = DEFAULT_KNOBS if hip_yaw else DEFAULT_KNOBS + FIVE_DOF_KNOBS
     knobs = [parse_knob(t, params) for t in (texts or default)]
+    for k in knobs:
+        taken = fixed.intersection(k.targets)
+        if taken and texts:
+            raise ConfigError(f"--param {k.name}: {sorted(taken)[0]} is set by the robot "
+                              "file's [gait], which wins over a preset: tune it on a copy of "
+                              "the robot file without it, then put the result in [gait]")
+    knobs = [k for k in knobs if not fixed.intersection(k.targets)]
     seen: set[str] = set()
     for k in knobs:
         clash = seen.intersection(k.targets)

@@ -1,7 +1,7 @@
 """The emulator's own transcription of the LX bus servo commands (HiWonder/LewanSoul "Bus
 Servo Communication Protocol": 4. Command list, Table 2; Table 4, the read commands and
 the length of their answers). Written from the manual, not from the driver's
-``robot.bus.lx_tables.LX_COMMANDS`` (``tests/test_lx_tables.py`` compares the two).
+``robot.bus.lx.tables.LX_COMMANDS`` (``tests/test_lx_tables.py`` compares the two).
 
 Each entry: command number -> (name, length byte of the host's packet, length byte of the
 servo's answer or None: write commands are never answered). The length byte counts

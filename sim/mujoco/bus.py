@@ -12,13 +12,13 @@ its goals at the present positions.
 
 Time is simulation time: ``bus.clock.sleep_until(t)`` steps the physics to exactly ``t``
 (whole ``timestep`` steps, batched into one ``mj_step`` call once the setpoints are
-constant, then one shorter step to land on ``t``).
+constant, then one shorter step to land on ``t``; the sensors computed in the last step
+only: sim.mujoco.stepping).
 """
 
 from __future__ import annotations
 
 import logging
-import math
 from collections.abc import Iterable, Mapping
 from typing import Any
 
@@ -37,8 +37,9 @@ from sim.mujoco.push_state import body_state
 from sim.mujoco.run_watch import SimRunWatch
 from sim.mujoco.servo_law import ChainLaw, robot_servos
 from sim.mujoco.servos import AMBIENT_C, SimServos
+from sim.mujoco.stepping import physics_to
 from sim.mujoco.view import OffscreenRenderer, SimClock, WallPacer, check_display, launch_viewer
-from sim.mujoco.world import PUSH_WINDOW_S, TimedForces
+from sim.mujoco.world import PUSH_WINDOW_S, TimedForces, heading_force
 from sim.mujoco.world_scene import apply_world_to_model, place_on_floor
 
 __all__ = ["AMBIENT_C", "MujocoBus", "SimClock"]
@@ -46,8 +47,6 @@ __all__ = ["AMBIENT_C", "MujocoBus", "SimClock"]
 log = logging.getLogger(__name__)
 
 _TIME_EPS = 1e-9  # [s]
-_OVERLOAD = frozenset({"overload"})
-_NO_ERRORS: frozenset[str] = frozenset()
 
 
 class MujocoBus(BodyObservation, Bus):
@@ -113,8 +112,6 @@ class MujocoBus(BodyObservation, Bus):
                                       & ((model.geom_contype | model.geom_conaffinity) != 0))
         self._feet = foot_geoms(model)
         self._torso = model.body("torso").id
-        self._dt = float(model.opt.timestep)
-        self._opt = model.opt
         self._servos = SimServos(self.servo_map, law.force, data.qpos[self._qadr],
                                  latency_s=world.latency_s if world is not None else 0.0,
                                  max_speed=np.minimum(self.servo_map.max_speed,
@@ -213,21 +210,16 @@ class MujocoBus(BodyObservation, Bus):
             idx = np.array(self._indices(goals))
         servos.write(idx, servos.to_rad(goals, idx), d.time)
 
+    def write_joint_goals(self, servo_map: ServoMap, q: npt.NDArray[np.float64]) -> None:
+        if servo_map.ids != self.servo_map.ids:
+            return super().write_joint_goals(servo_map, q)
+        self._servos.write_ticks(servo_map.tick_vector(q), self.data.time)
+
     def read_state(self, ids: Iterable[int]) -> dict[int, ServoState]:
         idx = self._indices(ids)
-        servos = self._servos
-        force = self.data.actuator_force[self._act]
-        servos.flush(force)
-        ticks = self.present_ticks().tolist()
-        load = servos.load_percent(force).tolist()
-        temperature = servos.temperature.tolist()
-        overloaded = servos.overloaded().tolist()
         volts = self.robot.voltage(self.robot.joints[0])   # one supply for the bus
-        sids = self.servo_map.ids
-        return {sids[i]: ServoState(id=sids[i], position=ticks[i], load=load[i],
-                                    temperature=temperature[i], voltage=volts,
-                                    errors=_OVERLOAD if overloaded[i] else _NO_ERRORS)
-                for i in idx}
+        return self._servos.states(idx, self.present_ticks().tolist(),
+                                   self.data.actuator_force[self._act], volts)
 
     # ------------------------------------------------------------------ simulation
 
@@ -245,19 +237,22 @@ class MujocoBus(BodyObservation, Bus):
         if needed), applying delayed goals when they fall due; with realtime, then wait for
         the wall clock. No-op if already past."""
         d = self.data
-        t0 = float(d.time)
+        t0 = d.time
         if deadline <= t0:
             return
-        self._law.tick(self._servos.setpoint, deadline - t0)
+        servos = self._servos
+        self._law.tick(servos.setpoint, deadline - t0)
         while (event := self._next_event()) < deadline - _TIME_EPS:
             if event > d.time:
-                self._physics_to(event)
+                physics_to(self.model, d, servos, self._law, event, sensed=False)
                 d.time = event
             self._events_due(event)
-        self._physics_to(deadline)
+        physics_to(self.model, d, servos, self._law, deadline, sensed=True)
         d.time = deadline
-        self._events_due(deadline)
-        self._servos.elapse(d.actuator_force[self._act], deadline - t0)
+        if servos.pending or self._forces.active:   # delayed goals, pushes in progress
+            self._events_due(deadline)
+        if servos.add_time(deadline - t0):    # the thermal and saturation bookkeeping
+            servos.flush(d.actuator_force[self._act])
         if self.realtime:
             self._pacer.wait(deadline)
         if self._viewer is not None:
@@ -278,23 +273,6 @@ class MujocoBus(BodyObservation, Bus):
         if not window_s > 0:
             raise BusError(f"sim bus: push window must be > 0 s, got {window_s}")
         d, state = self.data, body_state(self.model, self.data, self.contacts_feet())
-        c, s = math.cos(state["yaw_rad"]), math.sin(state["yaw_rad"])
-        force = np.array([c * jx - s * jy, s * jx + c * jy, 0.0]) / window_s
+        force = heading_force(d.qpos[3:7].tolist(), jx, jy) / window_s
         self._forces.start(d.time + window_s, force, d.xfrc_applied[self._torso])
         return state
-
-    def _physics_to(self, stop: float) -> None:
-        """Physics steps up to ``stop`` [s]: the setpoints slew before each step until they
-        are settled, then the remaining whole steps run in one call, then one short step."""
-        m, d, opt, servos, dt = self.model, self.data, self._opt, self._servos, self._dt
-        while (remaining := stop - d.time) > _TIME_EPS:
-            if not servos.settled:
-                d.ctrl[self._act] = self._law.ctrl(servos.slew(min(dt, remaining)))
-            if remaining < dt:
-                opt.timestep = remaining
-                try:
-                    mujoco.mj_step(m, d)
-                finally:
-                    opt.timestep = dt
-            else:
-                mujoco.mj_step(m, d, int(remaining / dt + 1e-6) if servos.settled else 1)

@@ -74,6 +74,7 @@ class SimImu(Imu):
         self.bus = bus
         self.config = config
         self._mount = Mount.from_rpy_deg(config.mount_rpy_deg)
+        self._level = self._mount.is_identity   # the chip's axes are the torso's
         self._adr: dict[str, int] | None = None
         self._buffer: deque[ImuSample] = deque()
         self._rng = np.random.default_rng(config.seed)
@@ -114,14 +115,14 @@ class SimImu(Imu):
     def exact(self) -> ImuSample:
         """The noise-free, bias-free measurement of the present state, in the torso frame
         (for tests and metrics; the robot should use ``read``)."""
-        if self._adr is None:
+        a = self._adr
+        if a is None:
             raise ImuError("sim imu: not open; call open() (or use `with`) first")
         d = self.bus.data
-        s = d.sensordata
-        a = self._adr
-        quat = tuple(s[a["quat"]:a["quat"] + 4].tolist())
-        return ImuSample(float(d.time), _vec(s, a["gyro"]), _vec(s, a["accel"]),
-                         quat if self.config.fusion else None)  # type: ignore[arg-type]
+        s = d.sensordata.tolist()
+        g, c, q = a["gyro"], a["accel"], a["quat"]
+        return ImuSample(d.time, (s[g], s[g + 1], s[g + 2]), (s[c], s[c + 1], s[c + 2]),
+                         (s[q], s[q + 1], s[q + 2], s[q + 3]) if self.config.fusion else None)
 
     def read(self) -> ImuSample:
         """The newest sample at least ``latency_ms`` old (module docstring), torso frame."""
@@ -134,12 +135,12 @@ class SimImu(Imu):
         due = now.t - self.config.latency_ms / 1000.0 + _TIME_EPS
         while len(buf) > 1 and buf[1].t <= due:
             buf.popleft()
-        return self._mount.to_torso(buf[0])
+        return buf[0] if self._level else self._mount.to_torso(buf[0])
 
     def _measure(self, exact: ImuSample) -> ImuSample:
         """What the chip reports for ``exact`` (torso frame): in its own frame, with bias
         and a fresh draw of noise."""
-        dev = self._mount.to_imu(exact)
+        dev = exact if self._level else self._mount.to_imu(exact)
         c = self.config
         if c.noise == 0.0 and c.bias == 0.0:
             return dev
@@ -191,11 +192,6 @@ def _noisy(v: tuple[float, float, float], bias: tuple[float, float, float], sigm
     """(v + bias) + sigma * z, per axis (the order numpy's normal(0, sigma) adds in)."""
     return (v[0] + bias[0] + sigma * z[0], v[1] + bias[1] + sigma * z[1],
             v[2] + bias[2] + sigma * z[2])
-
-
-def _vec(s: Any, i: int) -> tuple[float, float, float]:
-    x, y, z = s[i:i + 3].tolist()
-    return (x, y, z)
 
 
 def _tuple3(v: Any) -> tuple[float, float, float]:

@@ -31,6 +31,7 @@ from collections.abc import Mapping
 import numpy as np
 import numpy.typing as npt
 
+from robot.bus.base import ServoState
 from robot.bus.servo_map import ServoMap
 
 AMBIENT_C = 25.0  # [°C]
@@ -41,6 +42,8 @@ SATURATED_RATIO = 0.999  # |force| / stall torque at or above this counts as sat
 #: Thermal and saturation bookkeeping period [s of sim time]: 2 % of OVERLOAD_AFTER_S.
 ACCOUNT_PERIOD_S = 0.02
 _TIME_EPS = 1e-9  # [s]
+_OVERLOAD = frozenset({"overload"})
+_NO_ERRORS: frozenset[str] = frozenset()
 
 Floats = npt.NDArray[np.float64]
 
@@ -81,6 +84,10 @@ class SimServos:
 
     def to_rad(self, goals: Mapping[int, int], idx: npt.NDArray[np.intp]) -> Floats:
         """Goal ticks (values of ``goals``, for joints ``idx``) → radians in the limits."""
+        return self._rad(np.fromiter(goals.values(), float, len(idx)), idx)
+
+    def _rad(self, q: Floats, idx: npt.NDArray[np.intp]) -> Floats:
+        """Ticks ``q`` of joints ``idx`` → radians in the limits, in place."""
         sm = self.map
         if idx is self._all:
             zero, per_rad, lo, hi = sm.zero, self._signed_tpr, sm.q_min, sm.q_max
@@ -88,11 +95,15 @@ class SimServos:
             zero, per_rad = sm.zero[idx], self._signed_tpr[idx]
             lo, hi = sm.q_min[idx], sm.q_max[idx]
         # (t - zero) / (sign * ticks_per_rad): bit-identical to * sign / ticks_per_rad.
-        q = np.fromiter(goals.values(), float, len(idx))
         q -= zero
         q /= per_rad
         np.maximum(q, lo, out=q)
         return np.minimum(q, hi, out=q)
+
+    def write_ticks(self, ticks: Floats, now: float) -> None:
+        """Goal ticks of every joint in joint order (whole numbers as floats; the array is
+        used up), written at sim time ``now`` [s]: ``write`` of their radians."""
+        self.write(self._all, self._rad(ticks, self._all), now)
 
     def index_all(self, goals: Mapping[int, int]) -> npt.NDArray[np.intp] | None:
         """All joints' indices if ``goals`` names every servo in joint order, else None."""
@@ -111,6 +122,11 @@ class SimServos:
         else:
             self.goal[idx] = q
         self.settled = False
+
+    @property
+    def pending(self) -> bool:
+        """Delayed goals are waiting (``latency_s`` > 0)."""
+        return bool(self._pending)
 
     def next_due(self) -> float:
         """Sim time [s] at which the next delayed goal takes effect (inf if none)."""
@@ -132,12 +148,12 @@ class SimServos:
         vmax = self._vmax
         error = self.goal - self.setpoint
         within = np.abs(error) <= vmax
-        if within.all():         # the usual tick: every setpoint reaches its goal
+        if np.logical_and.reduce(within):    # the usual tick: every setpoint reaches its goal
             self.setpoint = self.goal.copy()
             self.settled = True
             return self.setpoint
         self.setpoint = np.where(within, self.goal, self.setpoint + np.sign(error) * vmax)
-        self.settled = bool(np.all((self.setpoint == self.goal) | ~self.enabled))
+        self.settled = bool(np.logical_and.reduce((self.setpoint == self.goal) | ~self.enabled))
         return self.setpoint
 
     def set_torque(self, idx: list[int], enabled: bool, present: Floats) -> None:
@@ -151,12 +167,11 @@ class SimServos:
 
     # ------------------------------------------------------------------ thermal, load
 
-    def elapse(self, force: Floats, span: float) -> None:
-        """``span`` [s] of simulation passed with the actuators at ``force`` [N m] now;
-        the bookkeeping runs once ACCOUNT_PERIOD_S has accumulated (``flush`` forces it)."""
+    def add_time(self, span: float) -> bool:
+        """``span`` [s] of simulation passed: True once ACCOUNT_PERIOD_S has accumulated
+        and the bookkeeping is due (then ``flush`` with the actuators' force now)."""
         self._unaccounted_s += span
-        if self._unaccounted_s >= ACCOUNT_PERIOD_S - _TIME_EPS:
-            self.flush(force)
+        return self._unaccounted_s >= ACCOUNT_PERIOD_S - _TIME_EPS
 
     def flush(self, force: Floats) -> None:
         """Account the time elapsed since the last bookkeeping at ``force`` [N m]."""
@@ -169,12 +184,13 @@ class SimServos:
             return
         ratio = np.abs(force)
         ratio /= self.stall
-        if ratio.max() >= SATURATED_RATIO:
+        if np.maximum.reduce(ratio) >= SATURATED_RATIO:
             saturated = self.enabled & (ratio >= SATURATED_RATIO)
             self.saturated_s = np.where(saturated, self.saturated_s + span, 0.0)
+            self._any_saturated = bool(np.logical_or.reduce(self.saturated_s != 0.0))
         elif self._any_saturated:
             self.saturated_s.fill(0.0)
-        self._any_saturated = bool(self.saturated_s.any())
+            self._any_saturated = False
         if span != self._decay_span:
             self._decay_span, self._decay = span, -math.expm1(-span / THERMAL_TAU_S)
         decay = self._decay
@@ -185,6 +201,20 @@ class SimServos:
         ratio += AMBIENT_C * decay
         self.temperature *= 1.0 - decay
         self.temperature += ratio
+
+    def states(self, idx: list[int], ticks: list[int], force: Floats, volts: float
+               ) -> dict[int, ServoState]:
+        """The read-back of joints ``idx`` (the bookkeeping flushed first) at present
+        positions ``ticks`` (all joints) [ticks], actuator ``force`` [N m], supply [V]."""
+        self.flush(force)
+        load = self.load_percent(force).tolist()
+        temperature = self.temperature.tolist()
+        overloaded = self.overloaded().tolist()
+        sids = self._ids
+        # positional: id, position, load, temperature, voltage, errors
+        return {sids[i]: ServoState(sids[i], ticks[i], load[i], temperature[i], volts,
+                                    _OVERLOAD if overloaded[i] else _NO_ERRORS)
+                for i in idx}
 
     def load_percent(self, force: Floats) -> Floats:
         """Load [%] of stall torque, signed in each servo's direction."""

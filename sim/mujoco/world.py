@@ -26,6 +26,15 @@ PUSH_WINDOW_S = 0.02
 _TIME_EPS = 1e-9  # [s]
 
 
+def heading_force(quat: Sequence[float], fx: float, fy: float) -> npt.NDArray[np.float64]:
+    """(fx forward, fy left) in the heading frame (yaw only) of the body whose orientation
+    is ``quat`` (w, x, y, z) → the world-frame vector (x, y, 0)."""
+    w, x, y, z = quat
+    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([c * fx - s * fy, s * fx + c * fy, 0.0])
+
+
 class PushTarget(Protocol):
     """What PushScheduler needs of the bus (``sim.mujoco.bus.MujocoBus``)."""
 
@@ -95,6 +104,11 @@ class TimedForces:
         xfrc[:3] += force
         self._count += 1
         heapq.heappush(self._heap, (end_s, self._count, force))
+
+    @property
+    def active(self) -> bool:
+        """A force is on (until ``next_end()``)."""
+        return bool(self._heap)
 
     def next_end(self) -> float:
         """Sim time [s] at which the next force ends (inf if none)."""

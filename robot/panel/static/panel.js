@@ -163,7 +163,9 @@ function showState(s) {
   if (s.fault) html += row("fault", "<b style='color:#ff4d4d'>" + esc(s.fault) + "</b>");
   $("loop").innerHTML = html;
   $("servos").tBodies[0].innerHTML = s.servos.map((v) => "<tr><td>" + v.id + "</td><td>" +
-    v.joint + "</td><td>" + fmt(v.temperature, 1) + "</td><td>" + fmt(v.load, 1) + "</td><td>" +
+    v.joint + (v.model_joint && v.model_joint !== v.joint ?
+      " <small title='its name in the model file'>" + esc(v.model_joint) + "</small>" : "") +
+    "</td><td>" + fmt(v.temperature, 1) + "</td><td>" + fmt(v.load, 1) + "</td><td>" +
     v.errors.join(" ") + "</td></tr>").join("");
   if (s.params && !busy && !queued) showParams(s.params);
   for (const f2 of listeners) f2(s);

@@ -3,7 +3,7 @@
 No vendor Python package is worth depending on (checked: ``pylx16a`` 1.1.1, last release
 2022-04; ``lewansoul-lx16a`` 0.1, 2019; ``lx16a`` 0.0.2, 2020; ``lewanlib`` 0.1.1; HiWonder
 ships its Python only as scripts inside its robots' images), and the protocol is small:
-``robot.bus.lx_packet`` frames it, ``robot.bus.lx_tables.LX_COMMANDS`` holds the commands.
+``robot.bus.lx.packet`` frames it, ``robot.bus.lx.tables.LX_COMMANDS`` holds the commands.
 
 What the protocol makes different from the other buses (docs/hardware.md, "LX servos"):
 
@@ -12,7 +12,7 @@ What the protocol makes different from the other buses (docs/hardware.md, "LX se
   streaming; ``move_time_s`` for the first), so each servo arrives as the next goal comes.
   Write commands are never answered: a write cannot fail on the wire, a read shows it.
 - No status read in one packet: ``read_state`` reads every position (POS_READ) and one
-  more value of one servo in turn (``robot.bus.lx_status``).
+  more value of one servo in turn (``robot.bus.lx.status``).
 - No model number and no baud register: ``ping`` (ID_READ) answers with the id only; the
   model reported is the robot file's. 115200 baud only.
 - No communication watchdog: ``arm_failsafe`` returns None. A servo keeps its last goal
@@ -31,12 +31,12 @@ import serial
 from robot.bus import health
 from robot.bus.base import Bus, ServoInfo, ServoState
 from robot.bus.limits import TickLimits
-from robot.bus.lx_packet import encode, value, word
-from robot.bus.lx_port import LX_VALUES, LxPort
-from robot.bus.lx_status import LxStatus
-from robot.bus.lx_tables import LX_BAUD, LX_BROADCAST_ID
-from robot.bus.lx_wire import check_rate, max_rate_hz
-from robot.bus.sdk_port import PORT_ERRORS, READ_BLOCK_S
+from robot.bus.lx.packet import encode, value, word
+from robot.bus.lx.port import LX_VALUES, LxPort
+from robot.bus.lx.status import LxStatus
+from robot.bus.lx.tables import LX_BAUD, LX_BROADCAST_ID
+from robot.bus.lx.wire import check_rate, max_rate_hz
+from robot.bus.sdk.port import PORT_ERRORS, READ_BLOCK_S
 from robot.config.robot import RobotConfig
 from robot.errors import BusError
 from robot.servo.models import MODELS

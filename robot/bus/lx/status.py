@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from robot.bus.base import ServoState
 
-#: The values read in turn, after the limits (names of lx_port.LX_VALUES).
+#: The values read in turn, after the limits (names of port.LX_VALUES).
 CYCLE = ("present_temperature", "present_voltage_mv", "torque_enable")
 LIMITS = ("temperature_limit", "min_voltage_limit_mv")   # the second also brings the max
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Iterable, Mapping
 
-from robot.bus.sdk_registers import SdkRegisters
+from robot.bus.sdk.registers import SdkRegisters
 from robot.bus.tables import EEPROM_LOCK, GAIN_REGISTERS, Register
 from robot.errors import BusError
 from robot.servo.gains import GAIN_SETS

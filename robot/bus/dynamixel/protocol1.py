@@ -20,9 +20,9 @@ from typing import Any
 import dynamixel_sdk
 
 from robot.bus.base import ServoState
-from robot.bus.dynamixel import _Port
-from robot.bus.sdk_bus import SdkBus
-from robot.bus.sdk_port import error_names, sign_magnitude
+from robot.bus.dynamixel.protocol2 import _Port
+from robot.bus.sdk.bus import SdkBus
+from robot.bus.sdk.port import error_names, sign_magnitude
 
 #: Status error bits that mean "instruction refused" (angle limit, range, checksum,
 #: instruction); the others (voltage, overheating, overload) are conditions.

@@ -3,7 +3,7 @@
 Subclasses set the SDK module and the control-table families their protocol speaks (the
 bus drives one: its robot's servo model's), and implement three hooks (packet handler,
 status-byte failure, state decoding). Register access, retries and messages live in
-``SdkRegisters`` (robot/bus/sdk_registers.py); the bus adds opening and closing, scans,
+``SdkRegisters`` (robot/bus/sdk/registers.py); the bus adds opening and closing, scans,
 goals, state reads and the failsafe, once.
 """
 
@@ -14,12 +14,13 @@ import time
 from collections.abc import Iterable, Mapping
 from typing import Any, ClassVar
 
-from robot.bus import failsafe, gain_writer, health, rate_check
+from robot.bus import health, rate_check
 from robot.bus.base import Bus, ServoInfo, ServoState
 from robot.bus.limits import TickLimits
-from robot.bus.sdk_port import PORT_ERRORS
-from robot.bus.sdk_registers import SdkRegisters
-from robot.bus.sync_read import BlockSyncRead, Reply
+from robot.bus.sdk import failsafe, gain_writer
+from robot.bus.sdk.port import PORT_ERRORS
+from robot.bus.sdk.registers import SdkRegisters
+from robot.bus.sdk.sync_read import BlockSyncRead, Reply
 from robot.bus.tables import COMM_WATCHDOG, RETURN_DELAY_UNIT_S, STATE_BLOCK, TABLES
 from robot.bus.wire_time import TickWire, tick_wire
 from robot.config.robot import RobotConfig
@@ -215,7 +216,7 @@ class SdkBus(SdkRegisters, Bus):
 
     def set_torque(self, ids: Iterable[int], *, enabled: bool) -> None:
         """Torque on or off; before the first torque-on of a servo since ``open()``, its
-        gains from the robot file are written and verified (robot.bus.gain_writer)."""
+        gains from the robot file are written and verified (robot.bus.sdk.gain_writer)."""
         ids = sorted(set(ids))
         pending = [sid for sid in ids if sid not in self._gains_done] if enabled else []
         if pending:

@@ -3,14 +3,14 @@ checksum, and finding one servo's answer in the bytes that come back.
 
 ``0x55 0x55 | id | length | command | parameters | checksum``; length = parameters + 3;
 checksum = ~(id + length + command + sum(parameters)) & 0xFF (command numbers and lengths:
-``robot.bus.lx_tables.LX_COMMANDS``). Pure functions and a small parser: no I/O here.
+``robot.bus.lx.tables.LX_COMMANDS``). Pure functions and a small parser: no I/O here.
 """
 
 from __future__ import annotations
 
 from typing import NamedTuple
 
-from robot.bus.lx_tables import LX_BROADCAST_ID, LX_COMMANDS, LX_HEADER, LxCommand
+from robot.bus.lx.tables import LX_BROADCAST_ID, LX_COMMANDS, LX_HEADER, LxCommand
 
 #: Bytes of a packet around its parameters: header 2, id, length, command, checksum.
 OVERHEAD = 6

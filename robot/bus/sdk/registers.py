@@ -1,7 +1,7 @@
 """Register access through one vendor SDK: the port, retries, the SDK's PORT_BUSY and
 stale-data pitfalls, and error messages that name the servo and its joint.
 
-``SdkBus`` (robot/bus/sdk_bus.py) builds the ``base.Bus`` API on it; the communication
+``SdkBus`` (robot/bus/sdk/bus.py) builds the ``base.Bus`` API on it; the communication
 watchdog (``failsafe``) and the health checks (``health``) need only this layer, so they
 import it, not the bus. One lock serialises transactions, so a telemetry thread may share it.
 """
@@ -14,7 +14,7 @@ from collections.abc import Callable, Iterable, Mapping
 from types import ModuleType
 from typing import Any, ClassVar
 
-from robot.bus.sdk_port import PORT_ERRORS
+from robot.bus.sdk.port import PORT_ERRORS
 from robot.bus.tables import BYTE_ORDER, TABLES, Register
 from robot.config.robot import RobotConfig
 from robot.errors import BusError

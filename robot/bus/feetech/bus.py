@@ -17,8 +17,8 @@ from typing import Any
 import scservo_sdk
 
 from robot.bus.base import ServoState
-from robot.bus.sdk_bus import SdkBus
-from robot.bus.sdk_port import TimedPort, error_names, sign_magnitude
+from robot.bus.sdk.bus import SdkBus
+from robot.bus.sdk.port import TimedPort, error_names, sign_magnitude
 from robot.bus.tables import BYTE_ORDER, TABLES
 from robot.servo.models import ServoModel, lookup
 

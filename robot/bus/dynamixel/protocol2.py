@@ -14,8 +14,8 @@ from typing import Any
 import dynamixel_sdk
 
 from robot.bus.base import ServoState
-from robot.bus.sdk_bus import SdkBus
-from robot.bus.sdk_port import TimedPort, error_names, sign_magnitude, twos_complement
+from robot.bus.sdk.bus import SdkBus
+from robot.bus.sdk.port import TimedPort, error_names, sign_magnitude, twos_complement
 
 #: XL-320 Present Load(41): bit 10 the direction, bits 0-9 the magnitude [0.1 %].
 XL320_DIRECTION_BIT = 10

@@ -1,5 +1,5 @@
 """The wire under the LX bus: the serial port, one lock, requests and their answers, and
-messages that name the servo and its joint (``LxBus`` in robot/bus/lx.py builds the Bus
+messages that name the servo and its joint (``LxBus`` in robot/bus/lx/bus.py builds the Bus
 API on it, as ``SdkBus`` does on ``SdkRegisters``).
 
 A write command is sent and never answered; a read command is retried (``retries``) until
@@ -16,9 +16,9 @@ from typing import NamedTuple
 
 import serial
 
-from robot.bus.lx_packet import ReplyParser, encode, value
-from robot.bus.lx_tables import LX_BAUD, LX_BROADCAST_ID, LX_COMMANDS
-from robot.bus.sdk_port import PORT_ERRORS
+from robot.bus.lx.packet import ReplyParser, encode, value
+from robot.bus.lx.tables import LX_BAUD, LX_BROADCAST_ID, LX_COMMANDS
+from robot.bus.sdk.port import PORT_ERRORS
 from robot.config.robot import RobotConfig
 from robot.errors import BusError
 

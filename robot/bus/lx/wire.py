@@ -16,8 +16,8 @@ moves) and says which rate fits.
 
 from __future__ import annotations
 
-from robot.bus.lx_packet import BITS_PER_BYTE, packet_bytes
-from robot.bus.lx_tables import LX_BAUD, LX_COMMANDS
+from robot.bus.lx.packet import BITS_PER_BYTE, packet_bytes
+from robot.bus.lx.tables import LX_BAUD, LX_COMMANDS
 from robot.errors import ConfigError
 
 #: The servo's time from the end of a request to the start of its answer [s]. The manual

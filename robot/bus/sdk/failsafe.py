@@ -15,7 +15,7 @@ from robot.bus.tables import CommWatchdog
 from robot.errors import BusError, ConfigError
 
 if TYPE_CHECKING:
-    from robot.bus.sdk_registers import SdkRegisters
+    from robot.bus.sdk.registers import SdkRegisters
 
 #: Slack for timeouts that are whole steps in decimal but not in binary (0.1 / 0.02) [steps].
 _EPS = 1e-9

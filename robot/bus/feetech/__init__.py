@@ -1,0 +1,1 @@
+"""Feetech STS/SMS and SCS buses on ``scservo_sdk`` (``bus``)."""

@@ -3,7 +3,7 @@ swing of a load (robot.servo.move_time), against hand computations and MuJoCo's 
 model: the DC motor's speed-up at full duty, a slewed goal, the legs' straddle at the
 walk's height, a joint limit that cuts the reach (checked by forward kinematics), the
 swinging leg's inertia against MuJoCo's joint-space mass matrix (box models and the
-imported kits)."""
+imported kits), every bundled robot's 0-step limit standing still."""
 
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from robot.balance.capture_limit import Foot, PushState, limits, numbers
 from robot.balance.capture_robot import (
     FOOT_GAP_M,
     Leg,
@@ -23,6 +24,8 @@ from robot.balance.capture_robot import (
     reach,
     swing,
 )
+from robot.config.bundled import robot_names
+from robot.config.gait_file import load_gait
 from robot.config.robot_file import load_robot
 from robot.gait.ik import leg_fk_full
 from robot.servo.law import Law
@@ -146,3 +149,32 @@ def test_the_swing_gets_further_with_time_and_stops_at_its_target() -> None:
     turn = math.atan2(0.1, h) - math.atan2(-0.05, h)
     assert arrive >= turn / ROBOT.joint("r_hip_pitch").max_speed_rad_s
     assert arrive < 2.0 * turn / ROBOT.joint("r_hip_pitch").max_speed_rad_s
+
+
+@pytest.mark.parametrize("name", robot_names())
+def test_every_bundled_robots_limit_standing_still_is_its_toe(name: str) -> None:
+    """Every bundled robot, the imported kits too: standing on the left foot at rest, the
+    0-step limit of a forward push is min(toe, ankle stall torque / weight) x M w0, with
+    the weight MuJoCo's model's and the stall the servo model's at the robot's voltage;
+    with a step it is larger."""
+    robot = load_robot(name)
+    params = load_gait("walk").for_robot(robot)
+    n = numbers(robot, params.stance, params.foot_spread)
+    bus = MujocoBus(robot)
+    bus.open()
+    try:
+        mass = float(np.sum(bus.model.body_mass))
+    finally:
+        bus.close()
+    g = robot.geometry
+    stall = min(robot.servo_physics(robot.joint(f"{s}_ankle_pitch")).stall_torque(
+        robot.voltage(robot.joint(f"{s}_ankle_pitch"))) for s in "rl")
+    toe = min(g.foot_forward + 0.5 * g.foot_length, stall / (mass * 9.81))
+    corners = np.array([[g.foot_forward + sx * g.foot_length / 2, sy * g.foot_width / 2]
+                        for sx in (-1, 1) for sy in (-1, 1)])
+    left = Foot(True, (0.0, 0.0), (0.0, 0.0), corners)
+    right = Foot(False, (0.0, -g.hip_width), (0.0, -g.hip_width), corners - [0, g.hip_width])
+    z = params.stance * leg_length(robot)
+    lim = limits(PushState(z, (0.0, 0.0), mass, (right, left)), n, 0.0)
+    assert lim[0] == pytest.approx(toe * mass * math.sqrt(9.81 / z), rel=1e-3)
+    assert lim[1] > lim[0] > 0.0

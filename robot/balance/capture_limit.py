@@ -176,9 +176,8 @@ def _first_reach(n: Numbers, step_side: int, foot: Foot) -> tuple[Floats, Floats
     r, hw = n.reach, zero_width(n.robot)
     dx = foot.ankle[0] - foot.hip[0]
     out_sign = 1.0 if step_side == 1 else -1.0
-    # outward of where the ankle hangs at the zero pose (an imported leg's lateral offset)
-    chain = n.robot.legs[step_side]
-    dy = out_sign * (foot.ankle[1] - foot.hip[1] - chain.lateral)
+    # outward of where the ankle hangs at the zero pose (sim.mujoco.push_state's hip)
+    dy = out_sign * (foot.ankle[1] - foot.hip[1])
     fx, bx = 0.5 * r.forward, 0.5 * r.back
     oy, iy = 0.5 * (r.out - hw), 0.5 * (r.inward - hw)
     dx, dy = min(max(dx, -bx), fx), min(max(dy, iy), oy)

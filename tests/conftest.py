@@ -51,7 +51,8 @@ def any_gait(request: pytest.FixtureRequest) -> Gait:
 #: hands out these files first, then the rest by their number of tests, as before.
 LONGEST_FIRST = ("test_fault_matrix.py", "test_command_ends.py", "test_setup_motors.py",
                  "test_zoo_wire.py", "test_panel_end_paths.py", "test_walk_sim.py",
-                 "test_bench_sim.py", "test_tune_detuned.py", "test_tune.py",
+                 "test_bench_sim.py", "test_tune_detuned.py", "test_tune_study.py",
+                 "test_tune.py",
                  "test_bench_sim_presets_0.py", "test_bench_sim_presets_1.py")
 
 

@@ -58,10 +58,11 @@ def test_the_runs_result_on_the_sim_bus_is_the_clis_json(
     got = json.loads(json.dumps(result.as_dict()))
     header = {"robot", "gait", "bus", "seconds", "balance"}
     # What walk_summary adds from the engine: the heading asked for and the drift beyond
-    # it, the time a target was out of reach and each joint held at a limit, the flight
-    # time per gait cycle.
+    # it, the time a target was out of reach and each joint held at a limit or to its
+    # servo's speed, the flight time per gait cycle.
     engine_keys = {"heading_asked_deg", "heading_drift_deg_min", "heading_drifts",
-                   "ik_unreachable_s", "clamped_joints_s", "flight_s_per_cycle"}
+                   "ik_unreachable_s", "clamped_joints_s", "speed_limited_joints_s",
+                   "flight_s_per_cycle"}
     assert set(got) == set(want) - header - engine_keys
     wall = {"realtime_factor"}                    # wall clock: differs run to run
     assert {k: got[k] for k in set(got) - wall} == {k: want[k] for k in set(got) - wall}

@@ -135,7 +135,7 @@ def format_summary(r: dict[str, Any]) -> str:
         if feet:
             lines.append(f"  feet          at least {feet['fewest_feet_down']} on the ground, flight "
                          f"{r.get('flight_s_per_cycle', 0.0) * 1e3:.0f} ms per cycle")
-        if r.get("clamped_joints_s") or r.get("ik_unreachable_s"):
+        if r.get("clamped_joints_s") or r.get("ik_unreachable_s") or r.get("speed_limited_joints_s"):
             lines.append(f"  joint limits  {clamp_words(r)}")
         world = describe_world(r.get("world"))
         if world:
@@ -169,12 +169,15 @@ def heading_words(r: dict[str, Any]) -> str:
 
 
 def clamp_words(r: dict[str, Any]) -> str:
-    """Which joints the gait held at a limit and for how long, and how long a target was
-    out of the IK's reach."""
+    """Which joints the gait held at a limit and for how long, how long a target was out
+    of the IK's reach, and which joints the loop held to their servo's speed."""
     held = ", ".join(f"{name} {t:.2f} s" for name, t in r["clamped_joints_s"].items())
     words = [f"held at a limit: {held}"] if held else []
     if r["ik_unreachable_s"]:
         words.append(f"target out of reach {r['ik_unreachable_s']:.2f} s")
+    fast = ", ".join(f"{name} {t:.2f} s" for name, t in r.get("speed_limited_joints_s", {}).items())
+    if fast:
+        words.append(f"asked faster than the servo turns (held to its speed): {fast}")
     return "; ".join(words)
 
 

@@ -46,14 +46,7 @@ from robot.loop.latency import SampleStats
 from robot.loop.pending import PendingParams
 from robot.loop.priority import loop_priority
 from robot.loop.read_state import read_state
-from robot.loop.source import (
-    ClampReporter,
-    Feedback,
-    JointTargets,
-    JointVector,
-    MotionSource,
-    SourceT,
-)
+from robot.loop.source import ClampReporter, Feedback, JointTargets, JointVector, MotionSource, SourceT
 from robot.loop.start_check import check_inside_limits
 from robot.loop.telemetry import LoopStats, Telemetry, TickObserver, loop_stats
 from robot.loop.watchdog import Watchdog, WatchdogConfig
@@ -92,7 +85,7 @@ class Streamer(Generic[SourceT]):
         self._fault: str | None = None
         self._bus_dead = False
         self._q_last: JointVector = np.zeros(len(robot_map.ids))
-        self._lateness = SampleStats()
+        self._lateness, self._slewed = SampleStats(), np.zeros(len(robot_map.ids), np.int64)
         self._overruns = self._bus_errors = self._ticks = 0
         self._pacer = Pacer(self.clock, self.dt)
 
@@ -168,7 +161,8 @@ class Streamer(Generic[SourceT]):
                           overruns=self._overruns, bus_errors=self._bus_errors,
                           wall_s=time.perf_counter() - wall0, stop_reason=reason or "stopped",
                           fault=self._fault is not None, holding=torque == "on",
-                          estop=self._estop.is_set(), torque=torque)
+                          estop=self._estop.is_set(), torque=torque,
+                          slew_limited=tuple(self._slewed.tolist()))
 
     def _stream(self, seconds: float | None) -> None:
         src = self.source
@@ -244,6 +238,7 @@ class Streamer(Generic[SourceT]):
         clamped = (tuple(self.map.names[i] for i in sorted({*held, *np.flatnonzero(own).tolist()}))
                    if held or np.logical_or.reduce(own) else ())
         q = limited.clip(self._q_last - self._step, self._q_last + self._step)
+        self._slewed += q != limited            # asked faster than the servo goes
         q_list = q.tolist()
         self._wait_deadline()
         try:

@@ -52,7 +52,9 @@ class LoopStats:
     holding: it ended with torque left on (``hold_at_end`` and no fault or emergency stop);
     estop: it ended by an emergency stop (torque off at once); torque: what the bus told
     of the servos' torque at the end (robot.loop.ending.TORQUE_STATES: "on", "off",
-    "sent": torque off sent but not confirmed, "unknown": nothing could be sent).
+    "sent": torque off sent but not confirmed, "unknown": nothing could be sent);
+    slew_limited: per joint (the map's order), the ticks whose goal the loop held to the
+    servo's speed (max_speed_rad_s) because the source asked it to move faster.
     """
 
     ticks: int
@@ -70,6 +72,7 @@ class LoopStats:
     holding: bool = False
     estop: bool = False
     torque: str = "off"
+    slew_limited: tuple[int, ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         return dict(self.__dict__)
@@ -77,7 +80,8 @@ class LoopStats:
 
 def loop_stats(lateness: SampleStats, *, ticks: int, rate_hz: float, duration_s: float,
                overruns: int, bus_errors: int, wall_s: float, stop_reason: str,
-               fault: bool, holding: bool, estop: bool, torque: str) -> LoopStats:
+               fault: bool, holding: bool, estop: bool, torque: str,
+               slew_limited: tuple[int, ...] = ()) -> LoopStats:
     """The statistics of a run from the tick-start lateness samples [s] and its counts."""
     return LoopStats(
         ticks=ticks, rate_hz=rate_hz, duration_s=duration_s, achieved_hz=ticks / duration_s,
@@ -85,7 +89,7 @@ def loop_stats(lateness: SampleStats, *, ticks: int, rate_hz: float, duration_s:
         period_error_p99_ms=lateness.percentile(99) * 1e3,
         period_error_max_ms=max(lateness.max, 0.0) * 1e3 if lateness.count else 0.0,
         overruns=overruns, bus_errors=bus_errors, wall_s=wall_s, stop_reason=stop_reason,
-        fault=fault, holding=holding, estop=estop, torque=torque)
+        fault=fault, holding=holding, estop=estop, torque=torque, slew_limited=slew_limited)
 
 
 class GaitClock:

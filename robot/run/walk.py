@@ -102,7 +102,9 @@ def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *,
     the heading the gait asked for, the drift beyond it per minute and whether that is
     more than ``HEADING_DRIFT_DEG_MIN``; the time [s, at the loop's rate] the IK met an
     unreachable target (``ik_unreachable_s``) and each joint was held at a limit
-    (``clamped_joints_s``: only those that were); where the bus counted the feet on the
+    (``clamped_joints_s``: only those that were) and asked faster than its servo turns, so
+    that the loop held it to the servo's speed (``speed_limited_joints_s``: only those that
+    were); where the bus counted the feet on the
     ground (simulation), the flight time per gait cycle (``flight_s_per_cycle``); the
     preset switches made (``switches``)."""
     out = {"robot": spec.robot.name, "gait": gait, "bus": spec.bus.kind,
@@ -118,6 +120,9 @@ def walk_summary(spec: RunSpec[GaitEngine], result: RunResult, *,
     out["clamped_joints_s"] = {name: n / rate for name, n in
                                zip(spec.robot.joint_names, engine.clamp_ticks, strict=True)
                                if n and rate}
+    slewed = result.stats.slew_limited or (0,) * len(spec.robot.joint_names)
+    out["speed_limited_joints_s"] = {name: n / rate for name, n in
+                                     zip(spec.robot.joint_names, slewed, strict=True) if n and rate}
     ran_min = result.stats.ticks / result.stats.rate_hz / 60.0 if result.stats.rate_hz else 0.0
     if "heading_change_deg" in out and ran_min > 0.0:
         asked = math.degrees(engine.asked_yaw)

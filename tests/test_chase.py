@@ -20,8 +20,8 @@ import mido
 import mido.sockets
 import numpy as np
 import pytest
+from command_ends import assert_goals_safe
 from ltc_encode import drop_frame_labels, encode, plain_labels, write_wav
-from test_command_ends import assert_goals_safe
 
 import robot.cli as cli
 from robot.config.robot_file import load_robot

@@ -3,9 +3,10 @@ import shows its progress; an animation beyond what can be imported is one line,
 nothing written.
 
 The bound is shown without a 200 MB file: two BVHs with the same frames (so the same take),
-one written compactly and one with every number padded to 100 characters (45 MB of text).
-Reading text as Python words cost about 1.4 bytes of memory per byte of text; parsed as a
-stream into arrays the two imports peak within a few MB of each other. Peak RSS is the
+one written compactly and one with every number padded to 300 characters (45 MB of text).
+Reading text as Python words cost about 1.4 bytes of memory per byte of text (100-character
+numbers; at 300, ``open().read().split()`` of the padded file peaks 85 MB over the compact
+one's); parsed as a stream into arrays the two imports peak within a few MB of each other. Peak RSS is the
 ``biped import`` subprocess's own (``resource.getrusage`` of the waited-for child, one child
 per measuring process).
 """
@@ -22,8 +23,11 @@ from anim_files import KNEE_HIERARCHY
 REPO = Path(__file__).resolve().parent.parent
 HEAD = KNEE_HIERARCHY
 FPS = 120.0
-FRAMES = 30_000          # 250 s: a 60,000-tick take at 240 Hz
-PAD = 96                 # zeros after each number's one decimal: 100 characters a number
+#: 83 s: a 20,000-tick take at 240 Hz. The text's size, not the take's length, is what the
+#: bound is about; 30,000 frames padded to 100 characters made the same 45 MB of text and
+#: three times the take to import (4.3 s an import, the file's 13 s of 7 CPU-s).
+FRAMES = 10_000
+PAD = 296                # zeros after each number's one decimal: 300 characters a number
 #: Measures ``biped import`` in a child of its own and prints its peak RSS [kB].
 PEAK = ("import resource, subprocess, sys; r = subprocess.run(sys.argv[1:], "
         "capture_output=True, text=True); sys.stderr.write(r.stderr); "

@@ -22,9 +22,9 @@ from pathlib import Path
 import pytest
 from anim_files import write_blender_bvh
 from bus_harness import PATIENT_TIMEOUT_MS
+from command_ends import Biped
 from full_disk import LEFT
 from test_bad_input import assert_refused, run_cli
-from test_command_ends import Biped
 from test_end_paths import ticks_of
 from test_keyframes import WAVE
 

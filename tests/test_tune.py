@@ -1,17 +1,15 @@
-"""`biped tune`: the search space, the score, the study across worker processes in one
-SQLite file (and resumed). The detuned preset tuned back into a walk is
-tests/test_tune_detuned.py (a file of its own: the suite's longest test, so that pytest's
-file-per-worker split runs it beside this file's study tests, not after them)."""
+"""`biped tune`: the search space, the score. The study across worker processes in one
+SQLite file (and resumed) or a PostgreSQL server is tests/test_tune_study.py, the detuned
+preset tuned back into a walk tests/test_tune_detuned.py (files of their own, so that
+pytest's file-per-worker split runs the long tests side by side, not one after another)."""
 
 from __future__ import annotations
 
 import argparse
-import json
 import subprocess
 import sys
 from pathlib import Path
 
-import optuna
 import pytest
 
 from robot.commands.tune import made_for
@@ -191,34 +189,6 @@ def test_the_target_speed_of_a_bundled_preset_is_measured_on_the_default_robot(
     assert made_for(args, load_gait(str(own)), load_robot("biped12-legs")) is None
 
 
-# -- the study ---------------------------------------------------------------------------------
-
-def test_two_workers_share_one_sqlite_study_and_a_rerun_resumes_it(tmp_path: Path) -> None:
-    """Flat walks only (every other group skipped), 3 s each: the trials of both worker
-    processes land in one study; the same command with more trials adds to it."""
-    out = tmp_path / "quick.toml"
-    skip = [a for g in ("slope", "cross slope", "bumps", "push*", "latency", "imu noise")
-            for a in ("--skip", g)]
-    argv = ["tune", "--robot", "biped12-legs", "--out", str(out), "--param", "sway",
-            "--param", "Fhgt", "--seconds", "3", "--jobs", "2", *skip, "--json"]
-    first = biped(*argv, "--trials", "3")
-    assert first.returncode == 0, first.stderr[-2000:]
-    r = json.loads(first.stdout)
-    assert r["trials"] >= 3 and r["runs_per_trial"] == 1
-    storage = f"sqlite:///{tmp_path / 'quick.db'}"
-    study = optuna.load_study(study_name=r["study"], storage=storage)
-    pids = {t.user_attrs.get("worker_pid") for t in study.trials}
-    assert len(pids - {None}) == 2                         # both workers ran trials
-    before = [t.params for t in study.trials]
-    again = biped(*argv, "--trials", "5")
-    assert again.returncode == 0, again.stderr[-2000:]
-    study = optuna.load_study(study_name=r["study"], storage=storage)
-    assert len(study.trials) >= 5
-    assert [t.params for t in study.trials][:len(before)] == before   # resumed, not anew
-    assert load_gait(str(out)).name == "quick"
-    assert (tmp_path / "quick.history.png").stat().st_size > 5000
-
-
 def test_sensitivity_candidates_move_one_knob_and_switch_zero_gains_on() -> None:
     from robot.tuning.sensitivity import candidates
 
@@ -235,22 +205,3 @@ def test_tune_without_out_is_one_line() -> None:
     assert r.returncode == 2 and r.stdout == ""
     assert r.stderr.strip().splitlines() == [
         "biped tune: error: --out: required (the tuned preset to write), unless --sensitivity"]
-
-
-def test_two_workers_share_one_postgresql_study(tmp_path: Path) -> None:
-    """The several-machines path: a PostgreSQL server (started here, Debian's binaries)
-    as the storage; two worker processes put their trials into one study there."""
-    from pg_server import postgres
-
-    with postgres() as url:
-        out = tmp_path / "pg.toml"
-        skip = [a for g in ("slope", "cross slope", "bumps", "push*", "latency", "imu noise")
-                for a in ("--skip", g)]
-        r = biped("tune", "--robot", "biped12-legs", "--out", str(out), "--param", "sway",
-                  "--seconds", "3", "--jobs", "2", "--trials", "3", "--storage", url,
-                  "--study", "shared", *skip, "--json")
-        assert r.returncode == 0, r.stderr[-2000:]
-        study = optuna.load_study(study_name="shared", storage=url)
-        assert len(study.trials) >= 3
-        assert len({t.user_attrs.get("worker_pid") for t in study.trials} - {None}) == 2
-        assert load_gait(str(out)).name == "pg"

@@ -74,11 +74,12 @@ def test_the_heading_loop_turns_back_after_a_yaw_push() -> None:
 
 @pytest.mark.parametrize("seconds", [3.0])
 def test_zero_gain_balance_is_the_open_loop_walk(seconds: float) -> None:
-    """With every balance gain 0 the corrections are exactly 0: the same simulation."""
+    """With every balance gain 0 the corrections are exactly 0: the same simulation (the
+    stop that finishes its step, bal_stop_close, is the balance stage's too: off)."""
     robot = load_robot("biped18-dynamixel")
     zero = {n: 0.0 for n in ("bal_ankle_pd", "bal_hip_pd", "bal_ankle_pp", "bal_lean_i",
                              "bal_step_gain", "bal_brace_xi", "bal_swing_level", "bal_hold_xi",
-                             "bal_heading_p", "bal_heading_i")}
+                             "bal_heading_p", "bal_heading_i", "bal_stop_close")}
     ends = []
     for with_stage in (False, True):
         bus = MujocoBus(robot)

@@ -62,7 +62,7 @@ def test_the_runs_result_on_the_sim_bus_is_the_clis_json(
     # servo's speed, the flight time per gait cycle.
     engine_keys = {"heading_asked_deg", "heading_drift_deg_min", "heading_drifts",
                    "ik_unreachable_s", "clamped_joints_s", "speed_limited_joints_s",
-                   "flight_s_per_cycle"}
+                   "flight_s_per_cycle", "braced_s", "stop_braced_s"}
     assert set(got) == set(want) - header - engine_keys
     wall = {"realtime_factor"}                    # wall clock: differs run to run
     assert {k: got[k] for k in set(got) - wall} == {k: want[k] for k in set(got) - wall}

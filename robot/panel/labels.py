@@ -46,6 +46,7 @@ LABELS: dict[str, str] = {
     "bal_heading_p": "Heading hold",
     "bal_heading_i": "Heading hold, slow part", "bal_turn_max": "Largest heading trim",
     "bal_stride_turn": "Heading hold by step length (no hip yaw)",
+    "bal_stop_close": "Stop: finish the step",
 }
 
 #: The simple view: steer, foot height, stride, crouch (and the presets above them).

@@ -97,15 +97,19 @@ def _one_change(emu: Emulator, panel: Panel, send: Callable[[], object]
     emu.log(clear=True)
     assert panel.request("POST", "/api/start")[0] == 200
     _walking(panel)
-    t_walk = time.monotonic()
-    sleep_until(t_walk + 4.3 * CYCLE_S)             # the amplitude ramps in over ~3 cycles
+    # the amplitude ramps in over ~3 cycles: the loop says when it is whole (on a loaded
+    # machine the wall clock's cycles are not the loop's)
+    assert wait_for(lambda: panel.state().get("amplitude", 0.0) >= 0.999, timeout_s=30), \
+        panel.state()
+    t_full = time.monotonic()
+    sleep_until(t_full + 1.1 * CYCLE_S)
     t_change = time.monotonic()
     send()
     assert wait_for(lambda: panel.request("GET", "/api/params")[1]["params"]["torso_lean"]
                     == LEAN)
     sleep_until(t_change + 1.0 + 1.2 * CYCLE_S)     # 10 time constants of the follow, then
     log = emu.log()                                 # a cycle
-    before = _goals(log, ids, t_walk + 3.2 * CYCLE_S)[:N]
+    before = _goals(log, ids, t_full)[:N]
     after = _goals(log, ids, t_change + 1.0)[:N]
     _stopped(panel)
     assert before.shape == after.shape == (N, len(ids)), (before.shape, after.shape)

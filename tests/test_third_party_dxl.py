@@ -88,7 +88,12 @@ def test_rustypot_goals_settle_as_a_real_xl430(baud: int) -> None:
         last: list[list[int]] = []
 
         def at_rest() -> bool:
-            last.append(c.sync_read_present_position(ids))
+            try:
+                last.append(c.sync_read_present_position(ids))
+            except RuntimeError as e:     # a reply later than rustypot's 0.3 s (a loaded
+                if "timed out" not in str(e):   # machine starves the emulator): read again
+                    raise
+                return False
             return len(last) > 5 and all(p == last[-1] for p in last[-5:]) and \
                 not any(emu.registers(i)["moving"] for i in ids)
         assert wait_for(at_rest, timeout_s=10), last[-5:]

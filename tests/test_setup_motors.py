@@ -89,7 +89,10 @@ def test_two_servos_connected_is_refused_with_nothing_written(
     fresh.log(clear=True)
     assert setup(fresh, robot_toml, "--joint", "r_knee", "--yes") == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "more than one servo answers as id 1" in err
+    assert err.count("\n") == 1 and "more than one servo answers as id" in err, err
+    # three replies at once collide on the wire: the search may meet the garble first at
+    # another baud, where it reads as some other id; then it says so
+    assert "answers as id 1 " in err or "(garbled replies)" in err, err
     assert "connect only the servo" in err
     assert writes(fresh) == []
     assert all(fresh.registers_of(i)["id"] == 1 for i in range(len(JOINTS)))

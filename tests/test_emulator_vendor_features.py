@@ -253,7 +253,13 @@ def test_sts_goal_without_torque_enable_moves(st: tuple[Emulator, Any, Any]) -> 
     # Present position is the rounded horn angle: it reads the goal up to half a step
     # (1.25 ms here) before the horn stops, so the speed reads 0 within a moment (waited
     # for as long as the position: a starved emulator answered late in a loaded run).
-    assert until(lambda: ok(ph.read2ByteTxRx(port, 1, S_PRESENT_SPEED)) == 0, 10.0)
+    seen: list[tuple[int, int]] = []
+
+    def still() -> bool:
+        seen.append((ok(ph.read2ByteTxRx(port, 1, S_PRESENT_SPEED)),
+                     ok(ph.read2ByteTxRx(port, 1, S_PRESENT))))
+        return seen[-1][0] == 0
+    assert until(still, 10.0), seen[-5:]
     assert ph.write2ByteTxRx(port, 1, S_GOAL, 2000) == (0, 0)
     assert ok(ph.read2ByteTxRx(port, 1, S_PRESENT_SPEED)) & 0x8000     # bit 15: direction
 

@@ -107,6 +107,8 @@ def advance(servo: ServoState, pos: float, dt: float) -> float:
                 velocity = speed if goal > pos else -speed
         error = goal - pos
         moving = torque and round(pos) != round(goal)
+        if not moving:       # within half a tick of its goal it has stopped: the servo is
+            velocity = 0.0   # at rest (and is no longer stepped), so it reads 0 speed
     else:
         top = servo.speed_tps
         if mode is Mode.VELOCITY:

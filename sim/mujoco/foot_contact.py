@@ -36,24 +36,26 @@ class FootContacts:
         self.longest_flight_s = 0.0
         self._last_t: float | None = None
         self._flight_s = 0.0               # the flight in progress [s]
+        self.right_down = False            # at the last update
 
-    def feet_down(self) -> int:
-        """How many feet touch something that is not the robot, now."""
+    def down(self) -> np.ndarray:
+        """The feet (1 right, 2 left) that touch something that is not the robot, now."""
         # The contact list's columns as arrays (a Python loop over the contacts cost as
         # much as the physics step).
         g1, g2 = self.data.contact.geom1, self.data.contact.geom2
         soles = np.concatenate((self._foot[g1[self._sole[g1] & ~self._robot[g2]]],
                                 self._foot[g2[self._sole[g2] & ~self._robot[g1]]]))
-        return len(np.unique(soles))
+        return np.unique(soles)
 
-    def right_down(self) -> bool:
-        """Whether the right sole touches something that is not the robot, now."""
-        g1, g2 = self.data.contact.geom1, self.data.contact.geom2
-        return bool(((self._foot[g1] == 1) & ~self._robot[g2]).any()
-                    or ((self._foot[g2] == 1) & ~self._robot[g1]).any())
+    def feet_down(self) -> int:
+        """How many feet touch something that is not the robot, now."""
+        return len(self.down())
 
     def update(self, t: float) -> None:
-        n = self.feet_down()
+        """Count the tick at ``t`` [s]; ``right_down``: the right sole on the ground now."""
+        feet = self.down()
+        n = len(feet)
+        self.right_down = bool(n) and int(feet[0]) == 1
         if self._last_t is not None:
             dt = t - self._last_t
             self.seconds[n] += dt

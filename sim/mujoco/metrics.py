@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -49,15 +49,17 @@ class WalkMonitor:
     max_tilt: float = 0.0
     stop_heading: float | None = None  # the heading it walked when told to stop [rad]
     stop_at: float | None = None
-    _cycle: list[float] = field(default_factory=list)    # headings since a touchdown
-    _last_cycle: list[float] = field(default_factory=list)
+    _sum: float = 0.0          # the headings since a right touchdown [rad], summed
+    _n: int = 0                # and counted
+    _last_mean: float | None = None   # the mean heading of the last whole cycle [rad]
 
     def walking(self, right_landed: bool) -> None:
         """A walking tick (after ``update``): the heading joins the current cycle's, which
         ends when the right foot lands (``right_landed``)."""
-        if right_landed and self._cycle:
-            self._last_cycle, self._cycle = self._cycle, []
-        self._cycle.append(self.heading)
+        if right_landed and self._n:
+            self._last_mean, self._sum, self._n = self._sum / self._n, 0.0, 0
+        self._sum += self.heading
+        self._n += 1
 
     def mark_stop(self, t: float) -> None:
         """The walk was told to stop at ``t`` [s] (its ramp-out begins). The heading it
@@ -66,8 +68,9 @@ class WalkMonitor:
         steps, so the heading of one tick is not the walk's); the change from it to the
         end is the stop's."""
         if self.stop_heading is None:
-            cycle = self._last_cycle or self._cycle or [self.heading]
-            self.stop_heading, self.stop_at = sum(cycle) / len(cycle), t
+            mean = (self._last_mean if self._last_mean is not None
+                    else self._sum / self._n if self._n else self.heading)
+            self.stop_heading, self.stop_at = mean, t
 
     def update_qpos(self, t: float, qpos: Sequence[float]) -> None:
         """``update`` from the free joint's qpos (x, y, z, qw, qx, qy, qz) as Python floats

@@ -43,7 +43,7 @@ class SimRunWatch:
         self.effort.update(tel.t)
         if tel.state == "walking" and not self.monitor.fell:   # on its feet, walking
             self.feet.update(tel.t)
-            right = self.feet.right_down()
+            right = self.feet.right_down
             self.monitor.walking(right and not self._right)
             self._right = right
             self._walked = True
